@@ -1,0 +1,419 @@
+/*
+ * softhap: real-time soft-tissue simulation and haptic force rendering.
+ *
+ * The one public header. C99. Conventions (see README):
+ *  - every fallible function returns sh_status (SH_OK = 0); sh_last_error_message() gives the
+ *    detail of the calling thread's last failure;
+ *  - heavy objects (sh_world, sh_mesh) are opaque pointers with create/destroy; bodies are
+ *    generation-checked uint64_t ids (0 is null);
+ *  - definition structs are initialised by their *_def_default function, then edited;
+ *  - units are SI (m, kg, s, N, Pa, N/m); vectors are in the world frame unless said otherwise;
+ *  - "Thread:" says which thread may call (sim, haptic, any); "Alloc:" whether it may allocate.
+ */
+#ifndef SOFTHAP_H
+#define SOFTHAP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32)
+#define SH_API __declspec(dllexport)
+#else
+#define SH_API __attribute__((visibility("default")))
+#endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* Version                                                                                      */
+
+/** Major version: incremented on ABI-incompatible changes. */
+#define SH_VERSION_MAJOR 0
+/** Minor version: incremented when features are added compatibly. */
+#define SH_VERSION_MINOR 1
+/** Patch version: incremented for fixes. */
+#define SH_VERSION_PATCH 0
+/** Version this header declares: MAJOR*1000000 + MINOR*1000 + PATCH. */
+#define SH_VERSION (SH_VERSION_MAJOR * 1000000 + SH_VERSION_MINOR * 1000 + SH_VERSION_PATCH)
+
+/** Version of the loaded library, in the SH_VERSION encoding. Compare with SH_VERSION.
+ *  Thread: any. Alloc: none. */
+SH_API int32_t sh_version(void);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Status and errors                                                                            */
+
+/** Result of every fallible call. */
+typedef enum sh_status {
+    SH_OK = 0,                  /**< success */
+    SH_ERR_INVALID_ARGUMENT = 1,/**< a parameter is NULL, out of range or not finite */
+    SH_ERR_INVALID_HANDLE = 2,  /**< a NULL, destroyed or stale object pointer or id */
+    SH_ERR_UNINITIALIZED_DEF = 3,/**< a def struct not initialised by its *_def_default */
+    SH_ERR_OUT_OF_MEMORY = 4,   /**< an allocation failed; nothing was changed */
+    SH_ERR_IO = 5,              /**< a file could not be opened, read or written */
+    SH_ERR_PARSE = 6,           /**< a file's content is malformed (message names the line) */
+    SH_ERR_DEGENERATE_MESH = 7, /**< mesh data is invalid (message names the element or node) */
+    SH_ERR_UNSTABLE = 8,        /**< a step was rejected or rolled back: state is unchanged */
+    SH_ERR_UNSUPPORTED = 9,     /**< a feature not built in or not available for this object */
+    SH_ERR_SOLVER = 10,         /**< a linear solve or factorisation failed */
+    SH_ERR_NOT_CONVERGED = 11,  /**< an iterative method did not converge */
+    SH_ERR_CAPACITY = 12,       /**< a fixed capacity would be exceeded */
+    SH_ERR_BUSY = 13,           /**< the call is not allowed while objects are alive */
+    SH_ERR_INTERNAL = 14        /**< an unexpected internal failure (a bug: please report) */
+} sh_status;
+
+/** Static, human-readable name of a status code ("SH_ERR_PARSE: ..."). Never NULL.
+ *  Thread: any. Alloc: none. */
+SH_API const char* sh_status_string(sh_status status);
+
+/** Detail of the calling thread's last failed call (file and line, element, node or parameter).
+ *  Empty string if the last call succeeded. Valid until the thread's next softhap call.
+ *  Thread: any. Alloc: none. */
+SH_API const char* sh_last_error_message(void);
+
+/** Kinds of warnings. Warnings never stop a run; each kind has a counter. */
+typedef enum sh_warning {
+    SH_WARN_UNSTABLE = 0,       /**< a step was rejected or rolled back as unstable */
+    SH_WARN_SUBSTEPPED = 1,     /**< a step was split into sub-steps to stay below dt_crit */
+    SH_WARN_INVERTED = 2,       /**< an element had det F <= 0 during a step */
+    SH_WARN_CAPACITY = 3,       /**< a fixed capacity clamped a result */
+    SH_WARN_FORCE_CLAMPED = 4,  /**< an output force was clamped */
+    SH_WARN_COUNT = 5           /**< number of warning kinds */
+} sh_warning;
+
+/* ------------------------------------------------------------------------------------------ */
+/* Memory                                                                                       */
+
+/** Host-provided allocator. alloc returns memory aligned to at least `alignment` (a power of
+ *  two, at most 64) or NULL; free accepts NULL. */
+typedef struct sh_allocator {
+    void* (*alloc)(size_t size, size_t alignment, void* user); /**< allocate size bytes */
+    void (*free)(void* ptr, void* user);                       /**< release ptr */
+    void* user;                                                /**< passed to both */
+} sh_allocator;
+
+/** Install the allocator every softhap allocation goes through (NULL restores the default
+ *  aligned malloc/free). Returns SH_ERR_BUSY while any softhap object is alive.
+ *  Thread: sim (with no other softhap call running). Alloc: none. */
+SH_API sh_status sh_set_allocator(const sh_allocator* allocator);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Meshes                                                                                       */
+
+/** An immutable tetrahedral mesh: nodes, tets (reoriented to positive volume) and its outward
+ *  surface. Bodies copy what they need; a mesh may be destroyed after a body is made from it. */
+typedef struct sh_mesh sh_mesh;
+
+/** Facts about a mesh. */
+typedef struct sh_mesh_info {
+    int32_t node_count;             /**< nodes, including orphans */
+    int32_t tet_count;              /**< tetrahedra */
+    int32_t surface_triangle_count; /**< boundary triangles (faces of exactly one tet) */
+    int32_t edge_count;             /**< unique tet edges */
+    int32_t orphan_node_count;      /**< nodes used by no tet (kept, excluded from dynamics) */
+    int32_t reoriented_tet_count;   /**< inverted tets whose orientation was flipped on input */
+    int32_t skipped_element_count;  /**< non-tet elements skipped by the loader */
+    double bounds_min[3];           /**< axis-aligned bounding box, file units (m) */
+    double bounds_max[3];           /**< axis-aligned bounding box, file units (m) */
+    double volume;                  /**< total tet volume (m^3) */
+} sh_mesh_info;
+
+/** Create a mesh from arrays: nodes are node_count x 3 doubles (m), tets are tet_count x 4
+ *  zero-based node indices. Validates: finite coordinates, indices in range, no repeated node
+ *  in a tet, no duplicate tet, no zero-volume tet (SH_ERR_DEGENERATE_MESH naming the element);
+ *  inverted tets are reoriented and counted. Thread: sim. Alloc: may. */
+SH_API sh_status sh_mesh_create(const double* nodes, int32_t node_count, const int32_t* tets,
+                                int32_t tet_count, sh_mesh** out_mesh);
+
+/** Load a tetrahedral mesh, format chosen by extension and content: Gmsh .msh (1, 2.2 and 4.1
+ *  ASCII), legacy VTK .vtk (ASCII UNSTRUCTURED_GRID), VTK XML .vtu (ascii data), TetGen
+ *  .node/.ele (either path; the other is found beside it). Non-tet elements are skipped.
+ *  SH_ERR_IO if unreadable, SH_ERR_PARSE naming the line, SH_ERR_DEGENERATE_MESH naming the
+ *  element. Thread: sim. Alloc: may. */
+SH_API sh_status sh_mesh_load(const char* path, sh_mesh** out_mesh);
+
+/** Destroy a mesh. NULL is a no-op returning SH_OK; a destroyed pointer returns
+ *  SH_ERR_INVALID_HANDLE. Thread: sim. Alloc: none. */
+SH_API sh_status sh_mesh_destroy(sh_mesh* mesh);
+
+/** Fill *out_info. Thread: sim. Alloc: none. */
+SH_API sh_status sh_mesh_get_info(const sh_mesh* mesh, sh_mesh_info* out_info);
+
+/** Copy node positions (node_count x 3 doubles, m) into out; capacity is in doubles.
+ *  Thread: sim. Alloc: none. */
+SH_API sh_status sh_mesh_get_nodes(const sh_mesh* mesh, double* out, int64_t capacity);
+
+/** Copy tets (tet_count x 4 node indices) into out; capacity is in int32 values.
+ *  Thread: sim. Alloc: none. */
+SH_API sh_status sh_mesh_get_tets(const sh_mesh* mesh, int32_t* out, int64_t capacity);
+
+/** Copy surface triangles (surface_triangle_count x 3 node indices, counter-clockwise seen
+ *  from outside, so normals point outward) into out; capacity is in int32 values.
+ *  Thread: sim. Alloc: none. */
+SH_API sh_status sh_mesh_get_surface_triangles(const sh_mesh* mesh, int32_t* out,
+                                               int64_t capacity);
+
+/** Copy unique edges (edge_count x 2 node indices, smaller first, sorted) into out; capacity is
+ *  in int32 values. Thread: sim. Alloc: none. */
+SH_API sh_status sh_mesh_get_edges(const sh_mesh* mesh, int32_t* out, int64_t capacity);
+
+/** Write the mesh as VTK XML unstructured grid (ASCII .vtu). Thread: sim. Alloc: may. */
+SH_API sh_status sh_mesh_write_vtu(const sh_mesh* mesh, const char* path);
+
+/* ------------------------------------------------------------------------------------------ */
+/* World                                                                                        */
+
+/** A simulation world: owns bodies and steps them. */
+typedef struct sh_world sh_world;
+
+/** Generation-checked body id. 0 is the null id; a destroyed body's id stays invalid. */
+typedef uint64_t sh_body_id;
+
+/** The null body id. */
+#define SH_NULL_BODY ((sh_body_id)0)
+
+/** World definition. Initialise with sh_world_def_default. */
+typedef struct sh_world_def {
+    uint32_t internal_init; /**< set by sh_world_def_default; do not touch */
+    double gravity[3];      /**< gravitational acceleration (m/s^2), default (0, 0, -9.81) */
+} sh_world_def;
+
+/** Fill a world def with defaults. Thread: any. Alloc: none. */
+SH_API void sh_world_def_default(sh_world_def* def);
+
+/** Create a world. Thread: sim. Alloc: may. */
+SH_API sh_status sh_world_create(const sh_world_def* def, sh_world** out_world);
+
+/** Destroy a world and all its bodies. NULL is a no-op returning SH_OK; a destroyed pointer
+ *  returns SH_ERR_INVALID_HANDLE. Thread: sim. Alloc: none. */
+SH_API sh_status sh_world_destroy(sh_world* world);
+
+/** Set gravity (m/s^2). Thread: sim. Alloc: none. */
+SH_API sh_status sh_world_set_gravity(sh_world* world, const double gravity[3]);
+
+/** Read the world's warning counters (SH_WARN_COUNT values) into out. Thread: sim. Alloc: none. */
+SH_API sh_status sh_world_get_warnings(const sh_world* world, uint64_t out[SH_WARN_COUNT]);
+
+/** What one sh_world_step did and cost. */
+typedef struct sh_step_report {
+    double wall_seconds;    /**< wall-clock time of the step (s) */
+    int32_t substeps;       /**< largest number of sub-steps any body took (1 = none) */
+    double dt_critical;     /**< smallest critical explicit step over the bodies (s) */
+    double kinetic_energy;  /**< sum of 1/2 m v^2 after the step (J) */
+    double elastic_energy;  /**< stored elastic energy after the step (J) */
+    double potential_energy;/**< gravitational energy -m g.x after the step (J) */
+    uint32_t warnings;      /**< bit (1 << sh_warning) set for each kind raised in this step */
+    int32_t unstable_body_count; /**< bodies rejected or rolled back in this step */
+} sh_step_report;
+
+/** Advance every body by dt seconds with its own integrator. A body whose step is rejected
+ *  (dt above its critical step under SH_UNSTABLE_REJECT) or whose state became non-finite or
+ *  runaway is restored to its state before the call; the call then returns SH_ERR_UNSTABLE,
+ *  the other bodies still advance, and SH_WARN_UNSTABLE is counted. report may be NULL.
+ *  Thread: sim. Alloc: none once the scene is built. */
+SH_API sh_status sh_world_step(sh_world* world, double dt, sh_step_report* report);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Bodies: shared definitions                                                                   */
+
+/** Explicit time integrators. */
+typedef enum sh_integrator {
+    SH_INTEGRATOR_FORWARD_EULER = 0,   /**< x += dt v, v += dt a (first order) */
+    SH_INTEGRATOR_SYMPLECTIC_EULER = 1,/**< v += dt a, x += dt v (first order, symplectic) */
+    SH_INTEGRATOR_RK2 = 2,             /**< explicit midpoint (second order) */
+    SH_INTEGRATOR_RK4 = 3              /**< classical Runge-Kutta (fourth order) */
+} sh_integrator;
+
+/** What a step larger than the body's critical step does. */
+typedef enum sh_unstable_policy {
+    SH_UNSTABLE_REJECT = 0, /**< return SH_ERR_UNSTABLE, body state untouched */
+    SH_UNSTABLE_SUBSTEP = 1 /**< split the step into equal sub-steps below dt_crit */
+} sh_unstable_policy;
+
+/** Constitutive models for tetrahedral elements. */
+typedef enum sh_material_model {
+    SH_MATERIAL_LINEAR = 0,       /**< small-strain linear elasticity (not rotation invariant) */
+    SH_MATERIAL_STVK = 1,         /**< St. Venant-Kirchhoff on Green-Lagrange strain */
+    SH_MATERIAL_COROTATIONAL = 2, /**< linear elasticity in the element's polar rotation frame */
+    SH_MATERIAL_NEOHOOKEAN = 3    /**< stable neo-Hookean (Smith, de Goes, Kim 2018) */
+} sh_material_model;
+
+/** An isotropic material. */
+typedef struct sh_material {
+    sh_material_model model; /**< constitutive model */
+    double young;            /**< Young's modulus E (Pa), > 0 */
+    double poisson;          /**< Poisson's ratio nu, in (-1, 0.5) */
+    double density;          /**< mass density rho (kg/m^3), > 0 */
+} sh_material;
+
+/* ------------------------------------------------------------------------------------------ */
+/* FEM bodies                                                                                   */
+
+/** Definition of a tetrahedral FEM body. Initialise with sh_fem_body_def_default. */
+typedef struct sh_fem_body_def {
+    uint32_t internal_init;         /**< set by sh_fem_body_def_default; do not touch */
+    const sh_mesh* mesh;            /**< rest shape (copied); required */
+    sh_material material;           /**< material of every element (regions: sh_body_set_material) */
+    sh_integrator integrator;       /**< default SH_INTEGRATOR_SYMPLECTIC_EULER */
+    sh_unstable_policy on_unstable; /**< default SH_UNSTABLE_SUBSTEP */
+    double damping_mass;            /**< Rayleigh alpha (1/s): f = -alpha m v; default 0 */
+    double damping_stiffness;       /**< Rayleigh beta (s): f = -beta K v; default 0 */
+    double runaway_speed;           /**< a node faster than this (m/s) rolls the step back;
+                                         default 1e4 */
+} sh_fem_body_def;
+
+/** Fill an FEM body def with defaults: StVK, E = 3 kPa, nu = 0.45, rho = 1000 kg/m^3 (soft
+ *  tissue), symplectic Euler, sub-stepping. Thread: any. Alloc: none. */
+SH_API void sh_fem_body_def_default(sh_fem_body_def* def);
+
+/** Create an FEM body from def; nodes start at the mesh's rest positions at rest. Orphan nodes
+ *  keep their index, get no mass and are never integrated. Thread: sim. Alloc: may. */
+SH_API sh_status sh_world_add_fem_body(sh_world* world, const sh_fem_body_def* def,
+                                       sh_body_id* out_body);
+
+/** Set the material of the listed elements (a region: capsule, parenchyma, vessel). Masses are
+ *  recomputed from the new densities. Thread: sim. Alloc: may. */
+SH_API sh_status sh_body_set_material(sh_world* world, sh_body_id body, const int32_t* elements,
+                                      int32_t element_count, const sh_material* material);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Mass-spring bodies                                                                           */
+
+/** Force laws of a spring of rest length l0 and current length l (tension positive). */
+typedef enum sh_spring_law {
+    SH_SPRING_LINEAR = 0,     /**< T = k (l - l0) */
+    SH_SPRING_CUBIC = 1,      /**< T = lambda1 d^3 + lambda2 d, d = (l - l0) / l0 */
+    SH_SPRING_HYPERBOLIC = 2, /**< T = dx / (a |dx| + b), dx = l - l0 (saturates at 1/a) */
+    SH_SPRING_TABLE = 3       /**< T = curve(d), monotone cubic through (strain, force) rows */
+} sh_spring_law;
+
+/** Parameters of a spring law; only the chosen law's fields are read. */
+typedef struct sh_spring_params {
+    sh_spring_law law;     /**< the law */
+    double stiffness;      /**< linear: k (N/m), > 0 */
+    double damping;        /**< every law: c (N s/m), >= 0, force -c dl/dt along the spring */
+    double lambda1;        /**< cubic: coefficient of d^3 (N), >= 0 */
+    double lambda2;        /**< cubic: coefficient of d (N), > 0 */
+    double a;              /**< hyperbolic: 1/a is the saturation force (1/N), >= 0 */
+    double b;              /**< hyperbolic: b is the small-strain compliance (m/N), > 0 */
+    const double* table;   /**< table: rows of (strain, force N), strain strictly increasing,
+                                copied at creation */
+    int32_t table_rows;    /**< table: number of rows, >= 2 */
+} sh_spring_params;
+
+/** Definition of a mass-spring body. Initialise with sh_spring_body_def_default. Nodes come
+ *  from `nodes` or, if NULL, from `mesh`; springs from `springs` or, if NULL, from the mesh's
+ *  edges (or none: a body of one node and no spring is a particle). */
+typedef struct sh_spring_body_def {
+    uint32_t internal_init;         /**< set by sh_spring_body_def_default; do not touch */
+    const double* nodes;            /**< node_count x 3 positions (m), or NULL to use mesh */
+    int32_t node_count;             /**< number of nodes in `nodes` */
+    const int32_t* springs;         /**< spring_count x 2 node indices, or NULL */
+    int32_t spring_count;           /**< number of springs in `springs` */
+    const sh_mesh* mesh;            /**< optional: nodes and edge springs from this mesh */
+    sh_spring_params params;        /**< law of every spring; default linear k = 100 N/m */
+    double node_mass;               /**< mass of each node (kg) if node_masses is NULL */
+    const double* node_masses;      /**< optional per-node masses (kg), node_count values */
+    sh_integrator integrator;       /**< default SH_INTEGRATOR_SYMPLECTIC_EULER */
+    sh_unstable_policy on_unstable; /**< default SH_UNSTABLE_SUBSTEP */
+    double damping_mass;            /**< per-node viscous damping alpha (1/s): f = -alpha m v */
+    double runaway_speed;           /**< a node faster than this (m/s) rolls back; default 1e4 */
+} sh_spring_body_def;
+
+/** Fill a spring body def with defaults: linear springs k = 100 N/m, c = 0, node mass 1 g,
+ *  symplectic Euler, sub-stepping. Thread: any. Alloc: none. */
+SH_API void sh_spring_body_def_default(sh_spring_body_def* def);
+
+/** Create a mass-spring body from def; rest lengths are the initial lengths. A spring of zero
+ *  rest length, a repeated node or a non-positive mass is SH_ERR_INVALID_ARGUMENT naming it.
+ *  Thread: sim. Alloc: may. */
+SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_def* def,
+                                          sh_body_id* out_body);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Bodies: state, boundary conditions, loads                                                    */
+
+/** Facts about a body. */
+typedef struct sh_body_info {
+    int32_t node_count;     /**< nodes (including orphans) */
+    int32_t element_count;  /**< tets (FEM) or springs (mass-spring) */
+    int32_t is_fem;         /**< 1 for an FEM body, 0 for a mass-spring body */
+    int32_t fixed_node_count; /**< nodes fixed or prescribed */
+    double total_mass;      /**< sum of nodal masses (kg) */
+    double dt_critical;     /**< critical explicit step of its integrator (s); INFINITY if none */
+} sh_body_info;
+
+/** Destroy a body; its id becomes stale. Thread: sim. Alloc: none. */
+SH_API sh_status sh_world_remove_body(sh_world* world, sh_body_id body);
+
+/** 1 if body is a live body of world, else 0. Thread: sim. Alloc: none. */
+SH_API int32_t sh_body_is_valid(const sh_world* world, sh_body_id body);
+
+/** Fill *out_info. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_info(const sh_world* world, sh_body_id body, sh_body_info* out_info);
+
+/** Copy positions (node_count x 3, m) into out; capacity in doubles. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_positions(const sh_world* world, sh_body_id body, double* out,
+                                       int64_t capacity);
+
+/** Set all positions (node_count x 3, m). Must be finite. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_set_positions(sh_world* world, sh_body_id body, const double* positions,
+                                       int32_t node_count);
+
+/** Copy velocities (node_count x 3, m/s) into out. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_velocities(const sh_world* world, sh_body_id body, double* out,
+                                        int64_t capacity);
+
+/** Set all velocities (node_count x 3, m/s). Must be finite; fixed and orphan nodes keep
+ *  zero velocity. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_set_velocities(sh_world* world, sh_body_id body,
+                                        const double* velocities, int32_t node_count);
+
+/** Copy lumped nodal masses (node_count, kg; 0 for orphans) into out. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_masses(const sh_world* world, sh_body_id body, double* out,
+                                    int64_t capacity);
+
+/** Fix nodes at their current positions (velocity zero). Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_fix_nodes(sh_world* world, sh_body_id body, const int32_t* nodes,
+                                   int32_t count);
+
+/** Release fixed or prescribed nodes: they move freely again. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_release_nodes(sh_world* world, sh_body_id body, const int32_t* nodes,
+                                       int32_t count);
+
+/** Prescribe positions (count x 3, m) of nodes: each is moved linearly to its target over the
+ *  next step and then held there (a kinematic boundary condition). Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_prescribe_positions(sh_world* world, sh_body_id body,
+                                             const int32_t* nodes, const double* positions,
+                                             int32_t count);
+
+/** Set external nodal forces (node_count x 3, N), held until changed; NULL clears them.
+ *  Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_set_external_forces(sh_world* world, sh_body_id body,
+                                             const double* forces, int32_t node_count);
+
+/** Set per-node viscous damping coefficients (node_count, 1/s): f_i = -c_i m_i v_i, added to
+ *  the body's mass damping; NULL clears. Thread: sim. Alloc: may (first call). */
+SH_API sh_status sh_body_set_node_damping(sh_world* world, sh_body_id body,
+                                          const double* coefficients, int32_t node_count);
+
+/** Internal elastic nodal forces at the current positions (node_count x 3, N) into out.
+ *  Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_elastic_forces(const sh_world* world, sh_body_id body, double* out,
+                                            int64_t capacity);
+
+/** Elastic energy stored at the current positions (J). Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_elastic_energy(const sh_world* world, sh_body_id body,
+                                            double* out_energy);
+
+/** Write the body's current shape as ASCII .vtu (FEM: tets; springs: lines) with point data
+ *  "velocity". Thread: sim. Alloc: may. */
+SH_API sh_status sh_body_write_vtu(const sh_world* world, sh_body_id body, const char* path);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SOFTHAP_H */

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs what softhap needs and is missing: Debian packages and Python packages.
+# Safe to run repeatedly; does nothing when everything is present.
+set -euo pipefail
+
+debian_packages=(libeigen3-dev libccd-dev libsuitesparse-dev libcmocka-dev pkg-config)
+missing=()
+for package in "${debian_packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "install-deps: installing Debian packages: ${missing[*]}"
+  sudo_cmd=()
+  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq "${missing[@]}" </dev/null
+fi
+
+python=${PYTHON:-python3}
+if ! "$python" -c "import numpy, pytest" 2>/dev/null; then
+  echo "install-deps: installing numpy and pytest with pip"
+  "$python" -m pip install -q numpy pytest </dev/null ||
+    "$python" -m pip install -q --break-system-packages numpy pytest </dev/null
+fi

@@ -1,0 +1,157 @@
+#include "mesh/tet_mesh.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace sh {
+namespace {
+
+std::string tet_name(const MeshData& data, size_t t) {
+    if (t < data.tet_lines.size() && data.tet_lines[t] > 0)
+        return format("tet %zu (line %d)", t, data.tet_lines[t]);
+    return format("tet %zu", t);
+}
+
+// Faces of tet (0,1,2,3) oriented outward for a positively oriented tet.
+constexpr int kFaces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+
+void build_surface(TetMesh& mesh) {
+    struct Face {
+        std::array<int32_t, 3> key;   // sorted node indices
+        std::array<int32_t, 3> nodes; // outward order
+    };
+    const int32_t tet_count = mesh.tet_count();
+    vec<Face> faces;
+    faces.reserve(static_cast<size_t>(tet_count) * 4);
+    for (int32_t t = 0; t < tet_count; ++t) {
+        const int32_t* tet = &mesh.tets[4 * static_cast<size_t>(t)];
+        for (const auto& f : kFaces) {
+            Face face{{tet[f[0]], tet[f[1]], tet[f[2]]}, {tet[f[0]], tet[f[1]], tet[f[2]]}};
+            std::sort(face.key.begin(), face.key.end());
+            faces.push_back(face);
+        }
+    }
+    std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.key < b.key; });
+    for (size_t i = 0; i < faces.size();) {
+        size_t j = i + 1;
+        while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+        if (j - i == 1)
+            mesh.surface_triangles.insert(mesh.surface_triangles.end(), faces[i].nodes.begin(), faces[i].nodes.end());
+        i = j;
+    }
+}
+
+void build_edges(TetMesh& mesh) {
+    const int32_t tet_count = mesh.tet_count();
+    vec<std::array<int32_t, 2>> edges;
+    edges.reserve(static_cast<size_t>(tet_count) * 6);
+    for (int32_t t = 0; t < tet_count; ++t) {
+        const int32_t* tet = &mesh.tets[4 * static_cast<size_t>(t)];
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b)
+                edges.push_back({std::min(tet[a], tet[b]), std::max(tet[a], tet[b])});
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    mesh.edges.reserve(edges.size() * 2);
+    for (const auto& e : edges) mesh.edges.insert(mesh.edges.end(), e.begin(), e.end());
+}
+
+}  // namespace
+
+double signed_tet_volume(const double* a, const double* b, const double* c, const double* d) {
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+            u[2] * (v[0] * w[1] - v[1] * w[0])) / 6.0;
+}
+
+TetMesh build_tet_mesh(MeshData data, const std::string& origin) {
+    require(data.nodes.size() % 3 == 0 && data.tets.size() % 4 == 0, SH_ERR_INTERNAL,
+            origin + ": node or tet array has a partial entry");
+    require(data.nodes.size() / 3 <= static_cast<size_t>(std::numeric_limits<int32_t>::max()) &&
+                data.tets.size() / 4 <= static_cast<size_t>(std::numeric_limits<int32_t>::max()),
+            SH_ERR_DEGENERATE_MESH, origin + ": too many nodes or tets for int32 indices");
+    TetMesh mesh;
+    mesh.skipped_element_count = data.skipped_elements;
+    const int32_t node_count = static_cast<int32_t>(data.nodes.size() / 3);
+    const size_t tet_count = data.tets.size() / 4;
+    require(tet_count > 0, SH_ERR_DEGENERATE_MESH, origin + ": the mesh has no tetrahedra");
+
+    for (int32_t n = 0; n < node_count; ++n)
+        for (int k = 0; k < 3; ++k)
+            require(std::isfinite(data.nodes[3 * static_cast<size_t>(n) + k]), SH_ERR_DEGENERATE_MESH,
+                    format("%s: node %d has a non-finite coordinate", origin.c_str(), n));
+
+    // Scale for the zero-volume test: relative to the mesh's bounding box.
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t n = 0; n < node_count; ++n)
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = std::min(lo[k], data.nodes[3 * static_cast<size_t>(n) + k]);
+            hi[k] = std::max(hi[k], data.nodes[3 * static_cast<size_t>(n) + k]);
+        }
+
+    mesh.node_used.assign(static_cast<size_t>(node_count), 0);
+    vec<std::array<int32_t, 5>> sorted;  // sorted nodes + tet index, for duplicate detection
+    sorted.reserve(tet_count);
+    for (size_t t = 0; t < tet_count; ++t) {
+        int32_t* tet = &data.tets[4 * t];
+        for (int a = 0; a < 4; ++a)
+            require(tet[a] >= 0 && tet[a] < node_count, SH_ERR_DEGENERATE_MESH,
+                    format("%s: %s: node index %d out of range [0, %d)", origin.c_str(),
+                           tet_name(data, t).c_str(), tet[a], node_count));
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b)
+                require(tet[a] != tet[b], SH_ERR_DEGENERATE_MESH,
+                        format("%s: %s repeats node %d", origin.c_str(), tet_name(data, t).c_str(), tet[a]));
+        const double* p[4];
+        for (int a = 0; a < 4; ++a) p[a] = &data.nodes[3 * static_cast<size_t>(tet[a])];
+        double longest = 0.0;
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b) {
+                const double dx = p[a][0] - p[b][0], dy = p[a][1] - p[b][1], dz = p[a][2] - p[b][2];
+                longest = std::max(longest, dx * dx + dy * dy + dz * dz);
+            }
+        longest = std::sqrt(longest);
+        double volume = signed_tet_volume(p[0], p[1], p[2], p[3]);
+        // A tet is degenerate when its volume is negligible against a cube of its longest edge.
+        require(std::fabs(volume) > 1e-12 * longest * longest * longest, SH_ERR_DEGENERATE_MESH,
+                format("%s: %s has zero volume (nodes %d %d %d %d)", origin.c_str(),
+                       tet_name(data, t).c_str(), tet[0], tet[1], tet[2], tet[3]));
+        if (volume < 0) {
+            std::swap(tet[2], tet[3]);
+            volume = -volume;
+            ++mesh.reoriented_tet_count;
+        }
+        mesh.volume += volume;
+        std::array<int32_t, 5> key{tet[0], tet[1], tet[2], tet[3], static_cast<int32_t>(t)};
+        std::sort(key.begin(), key.begin() + 4);
+        sorted.push_back(key);
+        for (int a = 0; a < 4; ++a) mesh.node_used[static_cast<size_t>(tet[a])] = 1;
+    }
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t i = 1; i < sorted.size(); ++i)
+        require(!std::equal(sorted[i].begin(), sorted[i].begin() + 4, sorted[i - 1].begin()),
+                SH_ERR_DEGENERATE_MESH,
+                format("%s: %s duplicates %s", origin.c_str(),
+                       tet_name(data, static_cast<size_t>(std::max(sorted[i][4], sorted[i - 1][4]))).c_str(),
+                       tet_name(data, static_cast<size_t>(std::min(sorted[i][4], sorted[i - 1][4]))).c_str()));
+
+    for (int32_t n = 0; n < node_count; ++n) mesh.orphan_node_count += mesh.node_used[static_cast<size_t>(n)] ? 0 : 1;
+    for (int k = 0; k < 3; ++k) {
+        mesh.bounds_min[k] = node_count ? lo[k] : 0.0;
+        mesh.bounds_max[k] = node_count ? hi[k] : 0.0;
+    }
+    mesh.nodes = std::move(data.nodes);
+    mesh.tets = std::move(data.tets);
+    build_surface(mesh);
+    build_edges(mesh);
+    return mesh;
+}
+
+}  // namespace sh

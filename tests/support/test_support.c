@@ -1,0 +1,63 @@
+#include "test_support.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+void sh_test_assert_status(sh_status got, sh_status expected, const char* expr, const char* file, int line) {
+    if (got != expected) {
+        print_error("%s:%d: %s returned %s, expected %s (last error: %s)\n", file, line, expr,
+                    sh_status_string(got), sh_status_string(expected), sh_last_error_message());
+        _fail(file, line);
+    }
+}
+
+void sh_test_assert_close(double a, double b, double tol, const char* expr, const char* file, int line) {
+    const double scale = fabs(b) > 1.0 ? fabs(b) : 1.0;
+    if (!(fabs(a - b) <= tol * scale)) {
+        print_error("%s:%d: %s = %.17g, expected %.17g (tolerance %g)\n", file, line, expr, a, b, tol);
+        _fail(file, line);
+    }
+}
+
+sh_mesh* sh_test_unit_tet(double s) {
+    const double nodes[12] = {0, 0, 0, s, 0, 0, 0, s, 0, 0, 0, s};
+    const int32_t tets[4] = {0, 1, 2, 3};
+    sh_mesh* mesh = NULL;
+    sh_test_assert_status(sh_mesh_create(nodes, 4, tets, 1, &mesh), SH_OK, "sh_mesh_create", __FILE__, __LINE__);
+    return mesh;
+}
+
+sh_mesh* sh_test_box(double lx, double ly, double lz, int nx, int ny, int nz) {
+    const int px = nx + 1, py = ny + 1, pz = nz + 1;
+    const int node_count = px * py * pz, tet_count = 6 * nx * ny * nz;
+    double* nodes = malloc(sizeof(double) * 3 * (size_t)node_count);
+    int32_t* tets = malloc(sizeof(int32_t) * 4 * (size_t)tet_count);
+    for (int k = 0; k < pz; ++k)
+        for (int j = 0; j < py; ++j)
+            for (int i = 0; i < px; ++i) {
+                double* p = &nodes[3 * (size_t)((k * py + j) * px + i)];
+                p[0] = lx * i / nx;
+                p[1] = ly * j / ny;
+                p[2] = lz * k / nz;
+            }
+    /* Kuhn split of each cube along its main diagonal 0-6: conforming between cubes. */
+    static const int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
+    int t = 0;
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                const int c[8] = {
+                    (k * py + j) * px + i, (k * py + j) * px + i + 1,
+                    (k * py + j + 1) * px + i + 1, (k * py + j + 1) * px + i,
+                    ((k + 1) * py + j) * px + i, ((k + 1) * py + j) * px + i + 1,
+                    ((k + 1) * py + j + 1) * px + i + 1, ((k + 1) * py + j + 1) * px + i};
+                for (int s = 0; s < 6; ++s, ++t)
+                    for (int a = 0; a < 4; ++a) tets[4 * t + a] = c[kuhn[s][a]];
+            }
+    sh_mesh* mesh = NULL;
+    sh_test_assert_status(sh_mesh_create(nodes, node_count, tets, tet_count, &mesh), SH_OK, "sh_mesh_create", __FILE__, __LINE__);
+    free(nodes);
+    free(tets);
+    return mesh;
+}

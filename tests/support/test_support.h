@@ -1,0 +1,37 @@
+/* Shared fixtures for the cmocka tests. Include after <stdarg.h>, <stddef.h>, <setjmp.h>. */
+#ifndef SOFTHAP_TEST_SUPPORT_H
+#define SOFTHAP_TEST_SUPPORT_H
+
+#include <softhap/softhap.h>
+
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+/** Path of a file in ../shared/meshes (tests run from the repository root). */
+#define SH_TEST_MESH(name) ("../shared/meshes/" name)
+
+/** Asserts that expr returns status, printing the last-error message if not. */
+#define assert_status(expr, status) sh_test_assert_status((expr), (status), #expr, __FILE__, __LINE__)
+
+/** Asserts that expr returns SH_OK. */
+#define assert_ok(expr) assert_status((expr), SH_OK)
+
+/** Implementation of assert_status. */
+void sh_test_assert_status(sh_status got, sh_status expected, const char* expr, const char* file, int line);
+
+/** Asserts |a - b| <= tol * max(1, |b|) (relative above 1, absolute below). */
+#define assert_close(a, b, tol) sh_test_assert_close((a), (b), (tol), #a, __FILE__, __LINE__)
+
+/** Implementation of assert_close. */
+void sh_test_assert_close(double a, double b, double tol, const char* expr, const char* file, int line);
+
+/** A unit right-handed tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) scaled by s, as a mesh. */
+sh_mesh* sh_test_unit_tet(double s);
+
+/** An axis-aligned box [0,lx]x[0,ly]x[0,lz] split into nx*ny*nz cubes of 6 tets each. */
+sh_mesh* sh_test_box(double lx, double ly, double lz, int nx, int ny, int nz);
+
+#endif

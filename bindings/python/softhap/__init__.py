@@ -1,0 +1,53 @@
+"""softhap: Python bindings (ctypes + numpy) of the softhap C library for real-time soft-tissue
+simulation. They mirror the C API of include/softhap/softhap.h:
+
+    import softhap
+    liver = softhap.Mesh.load("liver.msh")
+    with softhap.World(gravity=(0, 0, -9.81)) as world:
+        body = world.add_fem_body(liver, model="corotational", young=5e3, poisson=0.45)
+        body.fix_nodes([0, 1, 2])
+        report = world.step(1e-3)
+        print(report.substeps, body.positions[:3])
+
+The C library is found through $SOFTHAP_LIBRARY, else libsofthap.so next to this package, else
+<repo>/build/libsofthap.so; importing refuses a library of another version. Every failing C
+call raises softhap.Error with the status and sh_last_error_message().
+"""
+
+from ._errors import Error, status_name
+from ._lib import SH_VERSION, Status, WarningKind, version_string
+from ._loaded import lib as _c_library
+from ._loaded import status_string
+from ._record import BodyInfo, MeshInfo, StepReport
+from .mesh import Mesh
+from .world import Body, World
+
+__version__ = version_string(SH_VERSION)
+
+#: Path of the loaded C library.
+library_path = _c_library.softhap_path
+
+
+def version():
+    """Version of the loaded C library in the SH_VERSION encoding (MAJOR*1000000 + MINOR*1000
+    + PATCH); equal to softhap.SH_VERSION, since import refuses a mismatch."""
+    return int(_c_library.sh_version())
+
+
+__all__ = [
+    "Body",
+    "BodyInfo",
+    "Error",
+    "Mesh",
+    "MeshInfo",
+    "SH_VERSION",
+    "Status",
+    "StepReport",
+    "WarningKind",
+    "World",
+    "library_path",
+    "status_name",
+    "status_string",
+    "version",
+    "version_string",
+]

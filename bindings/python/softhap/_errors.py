@@ -1,0 +1,43 @@
+"""softhap.Error: the exception every failing C call raises."""
+
+from ._lib import Status
+
+
+def status_name(status):
+    """Return the C enum name of a status code ("SH_ERR_PARSE"), or "SH_STATUS_<n>" if unknown."""
+    try:
+        return Status(status).name
+    except ValueError:
+        return "SH_STATUS_%d" % int(status)
+
+
+class Error(Exception):
+    """A softhap C call failed.
+
+    Attributes:
+        status: the sh_status code (a softhap.Status, which is an int).
+        status_name: its C name, e.g. "SH_ERR_PARSE".
+        message: sh_last_error_message() of the failed call (which file and line, element,
+            node or parameter), or a description written by the bindings.
+        function: the C function that failed (e.g. "sh_mesh_load"), or None.
+        report: for sh_world_step failing with SH_ERR_UNSTABLE, the StepReport of that step
+            (the other bodies still advanced); None otherwise.
+    """
+
+    def __init__(self, status, message, function=None, report=None):
+        try:
+            status = Status(status)
+        except ValueError:
+            status = int(status)
+        self.status = status
+        self.status_name = status_name(status)
+        self.message = message
+        self.function = function
+        self.report = report
+        super().__init__(self._describe())
+
+    def _describe(self):
+        where = "%s: " % self.function if self.function else ""
+        if self.message:
+            return "%s%s: %s" % (where, self.status_name, self.message)
+        return "%s%s" % (where, self.status_name)

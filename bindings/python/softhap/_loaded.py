@@ -1,0 +1,34 @@
+"""The loaded C library (found, version-checked and declared at import) and status checking."""
+
+from ._errors import Error
+from ._lib import Status, load_library
+
+lib = load_library()
+
+
+def last_error_message():
+    """Return sh_last_error_message() of the calling thread as text."""
+    raw = lib.sh_last_error_message()
+    return raw.decode("utf-8", errors="replace") if raw else ""
+
+
+def status_string(status):
+    """Return sh_status_string(status) as text ("SH_ERR_PARSE: malformed file content")."""
+    raw = lib.sh_status_string(int(status))
+    return raw.decode("utf-8", errors="replace") if raw else ""
+
+
+def check(status, function):
+    """Raise softhap.Error if status (returned by the C function named function) is not SH_OK."""
+    if status != Status.SH_OK:
+        message = last_error_message() or status_string(status)
+        raise Error(status, message, function)
+
+
+def closed_error(what, function=None):
+    """Return the Error raised when a closed World or Mesh (or a Body of a closed World) is used."""
+    return Error(
+        Status.SH_ERR_INVALID_HANDLE,
+        "the %s has been closed; its C object no longer exists" % what,
+        function,
+    )

@@ -1,0 +1,42 @@
+"""Record: a dict whose keys can also be read as attributes (report["substeps"] or
+report.substeps). Used for mesh info, body info and step reports."""
+
+
+class Record(dict):
+    """A dict of named values, also readable as attributes."""
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(
+                "%s has no field %r (fields: %s)" % (type(self).__name__, name, ", ".join(self))
+            ) from None
+
+    def __dir__(self):
+        return list(super().__dir__()) + list(self.keys())
+
+    def __repr__(self):
+        items = ", ".join("%s=%r" % item for item in self.items())
+        return "%s(%s)" % (type(self).__name__, items)
+
+
+class MeshInfo(Record):
+    """Facts about a mesh (sh_mesh_info): node_count, tet_count, surface_triangle_count,
+    edge_count, orphan_node_count, reoriented_tet_count, skipped_element_count, bounds_min,
+    bounds_max (tuples, m) and volume (m^3)."""
+
+
+class BodyInfo(Record):
+    """Facts about a body (sh_body_info): node_count, element_count (tets or springs), is_fem
+    (bool), fixed_node_count, total_mass (kg) and dt_critical (s; inf if none)."""
+
+
+class StepReport(Record):
+    """What one World.step did and cost (sh_step_report).
+
+    Fields: wall_seconds (s), substeps, dt_critical (s), kinetic_energy, elastic_energy,
+    potential_energy (J), warnings (a frozenset of warning names raised in this step, e.g.
+    {"SH_WARN_SUBSTEPPED"}), warning_bits (the raw bit mask, bit 1 << sh_warning) and
+    unstable_body_count.
+    """

@@ -1,0 +1,174 @@
+"""softhap.Mesh: an immutable tetrahedral mesh (sh_mesh)."""
+
+import ctypes
+
+import numpy as np
+
+from . import _arrays
+from ._lib import sh_mesh_info
+from ._loaded import check, closed_error, lib
+from ._record import MeshInfo
+
+
+class Mesh:
+    """An immutable tetrahedral mesh: nodes (m), tets reoriented to positive volume and the
+    outward surface. Wraps sh_mesh.
+
+    Create one from arrays with Mesh(nodes, tets) or from a file with Mesh.load(path). Bodies
+    copy what they need, so a mesh may be closed once the bodies are made. The C object is freed
+    by close(), by leaving a ``with`` block, or when the Mesh is garbage collected.
+    """
+
+    def __init__(self, nodes, tets):
+        """Create a mesh from nodes (n x 3 floats, m) and tets (m x 4 zero-based node indices).
+
+        The C library validates the data (finite coordinates, indices in range, no repeated
+        node, no duplicate or zero-volume tet) and raises softhap.Error with status
+        SH_ERR_DEGENERATE_MESH naming the element; inverted tets are reoriented and counted in
+        info["reoriented_tet_count"]. A wrong array shape raises ValueError.
+        """
+        self._handle = None
+        nodes = _arrays.float_array(nodes, "nodes", (None, 3))
+        tets = _arrays.index_array(tets, "tets", (None, 4))
+        handle = ctypes.c_void_p()
+        check(
+            lib.sh_mesh_create(
+                _arrays.double_ptr(nodes),
+                _arrays.count(nodes.shape[0], "node count"),
+                _arrays.int32_ptr(tets),
+                _arrays.count(tets.shape[0], "tet count"),
+                ctypes.byref(handle),
+            ),
+            "sh_mesh_create",
+        )
+        self._handle = handle.value
+
+    @classmethod
+    def load(cls, path):
+        """Load a tetrahedral mesh file: Gmsh .msh (1, 2.2, 4.1 ASCII), legacy VTK .vtk, VTK XML
+        .vtu (ascii) or TetGen .node/.ele. Non-tet elements are skipped (counted in
+        info["skipped_element_count"]).
+
+        Raises softhap.Error: SH_ERR_IO if the file cannot be read, SH_ERR_PARSE (message names
+        the line) if it is malformed, SH_ERR_DEGENERATE_MESH if its data is invalid.
+        """
+        handle = ctypes.c_void_p()
+        check(lib.sh_mesh_load(_arrays.path_bytes(path), ctypes.byref(handle)), "sh_mesh_load")
+        mesh = cls.__new__(cls)
+        mesh._handle = handle.value
+        return mesh
+
+    # -- lifetime --------------------------------------------------------------------------
+
+    def close(self):
+        """Destroy the C mesh now. Safe to call more than once; later use raises softhap.Error."""
+        handle, self._handle = self._handle, None
+        if handle is not None:
+            check(lib.sh_mesh_destroy(handle), "sh_mesh_destroy")
+
+    @property
+    def closed(self):
+        """True once close() has been called."""
+        return self._handle is None
+
+    def __enter__(self):
+        """Use the mesh in a ``with`` block; it is closed at the end."""
+        return self
+
+    def __exit__(self, *exc_info):
+        """Close the mesh at the end of a ``with`` block."""
+        self.close()
+        return False
+
+    def __del__(self):
+        """Free the C mesh if close() was not called."""
+        handle = getattr(self, "_handle", None)
+        if handle is not None:
+            self._handle = None
+            try:
+                lib.sh_mesh_destroy(handle)
+            except Exception:  # interpreter shutdown: ctypes may already be torn down
+                pass
+
+    def _require_handle(self, function):
+        if self._handle is None:
+            raise closed_error("mesh", function)
+        return self._handle
+
+    def __repr__(self):
+        if self._handle is None:
+            return "<softhap.Mesh (closed)>"
+        info = self.info
+        return "<softhap.Mesh %d nodes, %d tets>" % (info["node_count"], info["tet_count"])
+
+    # -- queries ---------------------------------------------------------------------------
+
+    @property
+    def info(self):
+        """Facts about the mesh as a MeshInfo (a dict with attribute access): node_count,
+        tet_count, surface_triangle_count, edge_count, orphan_node_count, reoriented_tet_count,
+        skipped_element_count, bounds_min, bounds_max (m) and volume (m^3)."""
+        handle = self._require_handle("sh_mesh_get_info")
+        raw = sh_mesh_info()
+        check(lib.sh_mesh_get_info(handle, ctypes.byref(raw)), "sh_mesh_get_info")
+        return MeshInfo(
+            node_count=raw.node_count,
+            tet_count=raw.tet_count,
+            surface_triangle_count=raw.surface_triangle_count,
+            edge_count=raw.edge_count,
+            orphan_node_count=raw.orphan_node_count,
+            reoriented_tet_count=raw.reoriented_tet_count,
+            skipped_element_count=raw.skipped_element_count,
+            bounds_min=tuple(raw.bounds_min),
+            bounds_max=tuple(raw.bounds_max),
+            volume=raw.volume,
+        )
+
+    @property
+    def node_count(self):
+        """Number of nodes, including orphans (nodes used by no tet)."""
+        return self.info["node_count"]
+
+    @property
+    def tet_count(self):
+        """Number of tetrahedra."""
+        return self.info["tet_count"]
+
+    @property
+    def nodes(self):
+        """A copy of the node positions, an (n, 3) float64 array (m)."""
+        handle = self._require_handle("sh_mesh_get_nodes")
+        out = np.empty((self.node_count, 3), dtype=np.float64)
+        check(
+            lib.sh_mesh_get_nodes(handle, _arrays.double_ptr(out), out.size), "sh_mesh_get_nodes"
+        )
+        return out
+
+    def _int_table(self, function_name, rows, columns):
+        handle = self._require_handle(function_name)
+        out = np.empty((rows, columns), dtype=np.int32)
+        check(getattr(lib, function_name)(handle, _arrays.int32_ptr(out), out.size), function_name)
+        return out
+
+    @property
+    def tets(self):
+        """A copy of the tets, an (m, 4) int32 array of node indices (positive orientation)."""
+        return self._int_table("sh_mesh_get_tets", self.tet_count, 4)
+
+    @property
+    def surface_triangles(self):
+        """A copy of the boundary triangles, a (k, 3) int32 array, counter-clockwise seen from
+        outside (normals point outward)."""
+        return self._int_table(
+            "sh_mesh_get_surface_triangles", self.info["surface_triangle_count"], 3
+        )
+
+    @property
+    def edges(self):
+        """A copy of the unique tet edges, an (e, 2) int32 array, smaller index first, sorted."""
+        return self._int_table("sh_mesh_get_edges", self.info["edge_count"], 2)
+
+    def write_vtu(self, path):
+        """Write the mesh as an ASCII VTK XML unstructured grid (.vtu) file."""
+        handle = self._require_handle("sh_mesh_write_vtu")
+        check(lib.sh_mesh_write_vtu(handle, _arrays.path_bytes(path)), "sh_mesh_write_vtu")

@@ -1,0 +1,587 @@
+"""softhap.World (sh_world) and softhap.Body (an sh_body_id in a world)."""
+
+import ctypes
+
+import numpy as np
+
+from . import _arrays
+from ._errors import Error
+from ._lib import (
+    INTEGRATORS,
+    MATERIAL_MODELS,
+    SH_WARN_COUNT,
+    SPRING_LAWS,
+    UNSTABLE_POLICIES,
+    Status,
+    WarningKind,
+    sh_body_id,
+    sh_body_info,
+    sh_fem_body_def,
+    sh_spring_body_def,
+    sh_step_report,
+    sh_world_def,
+)
+from ._loaded import check, closed_error, last_error_message, lib, status_string
+from ._record import BodyInfo, StepReport
+from .mesh import Mesh
+
+# Which sh_spring_params fields each law reads (damping is read by every law).
+_SPRING_LAW_PARAMETERS = {
+    "linear": ("stiffness", "damping"),
+    "cubic": ("lambda1", "lambda2", "damping"),
+    "hyperbolic": ("a", "b", "damping"),
+    "table": ("table", "damping"),
+}
+
+
+def _choose(value, choices, parameter):
+    """Map a name such as "rk4" to its C enum value; unknown names raise ValueError."""
+    if isinstance(value, str) and value in choices:
+        return choices[value]
+    raise ValueError(
+        "%s must be one of %s, got %r" % (parameter, ", ".join(repr(c) for c in choices), value)
+    )
+
+
+def _warning_names(bits):
+    return frozenset(kind.name for kind in WarningKind if bits & (1 << int(kind)))
+
+
+def _step_report(raw):
+    return StepReport(
+        wall_seconds=raw.wall_seconds,
+        substeps=raw.substeps,
+        dt_critical=raw.dt_critical,
+        kinetic_energy=raw.kinetic_energy,
+        elastic_energy=raw.elastic_energy,
+        potential_energy=raw.potential_energy,
+        warnings=_warning_names(raw.warnings),
+        warning_bits=int(raw.warnings),
+        unstable_body_count=raw.unstable_body_count,
+    )
+
+
+def _default_material():
+    """The material sh_fem_body_def_default chooses (StVK, 3 kPa, 0.45, 1000 kg/m^3)."""
+    definition = sh_fem_body_def()
+    lib.sh_fem_body_def_default(ctypes.byref(definition))
+    return definition.material
+
+
+class World:
+    """A simulation world (sh_world): owns bodies and steps them.
+
+    World(gravity=(0, 0, -9.81)) creates one. The C world and all its bodies are freed by
+    close(), at the end of a ``with`` block, or when the World is garbage collected (a Body
+    keeps its World alive).
+    """
+
+    def __init__(self, gravity=(0.0, 0.0, -9.81)):
+        """Create a world with the given gravitational acceleration (3 floats, m/s^2)."""
+        self._handle = None
+        gravity = _arrays.float_array(gravity, "gravity", (3,))
+        definition = sh_world_def()
+        lib.sh_world_def_default(ctypes.byref(definition))
+        for k in range(3):
+            definition.gravity[k] = gravity[k]
+        handle = ctypes.c_void_p()
+        check(lib.sh_world_create(ctypes.byref(definition), ctypes.byref(handle)), "sh_world_create")
+        self._handle = handle.value
+        self._gravity = tuple(float(g) for g in gravity)
+
+    # -- lifetime --------------------------------------------------------------------------
+
+    def close(self):
+        """Destroy the C world and all its bodies now. Safe to call more than once; later use of
+        the world or of its Body objects raises softhap.Error (SH_ERR_INVALID_HANDLE)."""
+        handle, self._handle = self._handle, None
+        if handle is not None:
+            check(lib.sh_world_destroy(handle), "sh_world_destroy")
+
+    @property
+    def closed(self):
+        """True once close() has been called."""
+        return self._handle is None
+
+    def __enter__(self):
+        """Use the world in a ``with`` block; it is closed at the end."""
+        return self
+
+    def __exit__(self, *exc_info):
+        """Close the world at the end of a ``with`` block."""
+        self.close()
+        return False
+
+    def __del__(self):
+        """Free the C world if close() was not called."""
+        handle = getattr(self, "_handle", None)
+        if handle is not None:
+            self._handle = None
+            try:
+                lib.sh_world_destroy(handle)
+            except Exception:  # interpreter shutdown: ctypes may already be torn down
+                pass
+
+    def _require_handle(self, function=None):
+        if self._handle is None:
+            raise closed_error("world", function)
+        return self._handle
+
+    def __repr__(self):
+        state = "closed" if self._handle is None else "gravity=%r" % (self._gravity,)
+        return "<softhap.World %s>" % state
+
+    # -- settings and state ----------------------------------------------------------------
+
+    @property
+    def gravity(self):
+        """Gravitational acceleration (m/s^2) as a tuple; assigning calls sh_world_set_gravity."""
+        return self._gravity
+
+    @gravity.setter
+    def gravity(self, value):
+        self.set_gravity(value)
+
+    def set_gravity(self, gravity):
+        """Set the gravitational acceleration (3 floats, m/s^2)."""
+        handle = self._require_handle("sh_world_set_gravity")
+        gravity = _arrays.float_array(gravity, "gravity", (3,))
+        check(lib.sh_world_set_gravity(handle, _arrays.double_ptr(gravity)), "sh_world_set_gravity")
+        self._gravity = tuple(float(g) for g in gravity)
+
+    @property
+    def warnings(self):
+        """The world's warning counters as a dict {"SH_WARN_UNSTABLE": count, ...}."""
+        handle = self._require_handle("sh_world_get_warnings")
+        counters = (ctypes.c_uint64 * SH_WARN_COUNT)()
+        check(lib.sh_world_get_warnings(handle, counters), "sh_world_get_warnings")
+        return {kind.name: int(counters[int(kind)]) for kind in WarningKind}
+
+    def step(self, dt):
+        """Advance every body by dt seconds and return the StepReport (a dict with attribute
+        access: wall_seconds, substeps, dt_critical, kinetic_energy, elastic_energy,
+        potential_energy, warnings (set of names), warning_bits, unstable_body_count).
+
+        If a body's step was rejected or rolled back (SH_ERR_UNSTABLE) the other bodies still
+        advanced; the raised softhap.Error then carries the step's report as ``err.report``.
+        """
+        handle = self._require_handle("sh_world_step")
+        raw = sh_step_report()
+        status = lib.sh_world_step(handle, float(dt), ctypes.byref(raw))
+        if status == Status.SH_OK:
+            return _step_report(raw)
+        message = last_error_message() or status_string(status)
+        report = _step_report(raw) if status == Status.SH_ERR_UNSTABLE else None
+        raise Error(status, message, "sh_world_step", report=report)
+
+    # -- bodies ----------------------------------------------------------------------------
+
+    def add_fem_body(
+        self,
+        mesh,
+        model=None,
+        young=None,
+        poisson=None,
+        density=None,
+        integrator=None,
+        damping_mass=None,
+        damping_stiffness=None,
+        on_unstable=None,
+        runaway_speed=None,
+    ):
+        """Add a tetrahedral FEM body whose rest shape is mesh (copied) and return its Body.
+
+        Arguments left as None keep the C defaults of sh_fem_body_def_default:
+          model: "stvk" (default), "linear", "corotational" or "neohookean";
+          young: Young's modulus (Pa), default 3000; poisson: Poisson's ratio, default 0.45;
+          density: kg/m^3, default 1000;
+          integrator: "symplectic_euler" (default), "forward_euler", "rk2" or "rk4";
+          damping_mass: Rayleigh alpha (1/s), default 0; damping_stiffness: Rayleigh beta (s),
+          default 0;
+          on_unstable: "substep" (default) or "reject" for steps above the critical step;
+          runaway_speed: a node faster than this (m/s) rolls the step back, default 1e4.
+        Unknown names raise ValueError; invalid values raise softhap.Error
+        (SH_ERR_INVALID_ARGUMENT).
+        """
+        handle = self._require_handle("sh_world_add_fem_body")
+        if not isinstance(mesh, Mesh):
+            raise TypeError("mesh must be a softhap.Mesh, got %s" % type(mesh).__name__)
+        definition = sh_fem_body_def()
+        lib.sh_fem_body_def_default(ctypes.byref(definition))
+        definition.mesh = mesh._require_handle("sh_world_add_fem_body")
+        if model is not None:
+            definition.material.model = _choose(model, MATERIAL_MODELS, "model")
+        if young is not None:
+            definition.material.young = float(young)
+        if poisson is not None:
+            definition.material.poisson = float(poisson)
+        if density is not None:
+            definition.material.density = float(density)
+        if integrator is not None:
+            definition.integrator = _choose(integrator, INTEGRATORS, "integrator")
+        if on_unstable is not None:
+            definition.on_unstable = _choose(on_unstable, UNSTABLE_POLICIES, "on_unstable")
+        if damping_mass is not None:
+            definition.damping_mass = float(damping_mass)
+        if damping_stiffness is not None:
+            definition.damping_stiffness = float(damping_stiffness)
+        if runaway_speed is not None:
+            definition.runaway_speed = float(runaway_speed)
+        body = sh_body_id()
+        check(
+            lib.sh_world_add_fem_body(handle, ctypes.byref(definition), ctypes.byref(body)),
+            "sh_world_add_fem_body",
+        )
+        return Body(self, body.value)
+
+    def add_spring_body(
+        self,
+        nodes,
+        springs=None,
+        law="linear",
+        mass=None,
+        integrator=None,
+        on_unstable=None,
+        damping_mass=None,
+        runaway_speed=None,
+        stiffness=None,
+        damping=None,
+        lambda1=None,
+        lambda2=None,
+        a=None,
+        b=None,
+        table=None,
+    ):
+        """Add a mass-spring body and return its Body. Rest lengths are the initial lengths.
+
+        nodes: an (n, 3) array of positions (m), or a softhap.Mesh whose nodes are used (and,
+            when springs is None, whose edges become the springs).
+        springs: an (s, 2) array of node index pairs, or None (no springs for an array of
+            nodes: one node and no spring is a particle).
+        law and its parameters (only the chosen law's are accepted; None keeps the C default):
+            "linear": stiffness k (N/m, default 100), damping c (N s/m, default 0);
+            "cubic": T = lambda1 d^3 + lambda2 d with d the strain, lambda1, lambda2 (N);
+            "hyperbolic": T = dx / (a |dx| + b), a (1/N), b (m/N);
+            "table": table, rows of (strain, force N), strain strictly increasing;
+            every law also takes damping c (N s/m).
+        mass: a scalar mass per node (kg, default 1e-3) or an array of n masses.
+        integrator, on_unstable, damping_mass (1/s), runaway_speed (m/s): as add_fem_body.
+        Unknown names raise ValueError; invalid values raise softhap.Error.
+        """
+        handle = self._require_handle("sh_world_add_spring_body")
+        definition = sh_spring_body_def()
+        lib.sh_spring_body_def_default(ctypes.byref(definition))
+
+        # Arrays referenced by the def must stay alive until the create call returns.
+        keep_alive = []
+        if isinstance(nodes, Mesh):
+            definition.mesh = nodes._require_handle("sh_world_add_spring_body")
+            node_count = nodes.node_count
+        else:
+            node_array = _arrays.float_array(nodes, "nodes", (None, 3))
+            keep_alive.append(node_array)
+            definition.nodes = _arrays.double_ptr(node_array)
+            definition.node_count = _arrays.count(node_array.shape[0], "node count")
+            node_count = node_array.shape[0]
+        if springs is not None:
+            spring_array = _arrays.index_array(springs, "springs", (None, 2))
+            keep_alive.append(spring_array)
+            definition.springs = _arrays.int32_ptr(spring_array)
+            definition.spring_count = _arrays.count(spring_array.shape[0], "spring count")
+
+        definition.params.law = _choose(law, SPRING_LAWS, "law")
+        given = {
+            "stiffness": stiffness,
+            "damping": damping,
+            "lambda1": lambda1,
+            "lambda2": lambda2,
+            "a": a,
+            "b": b,
+            "table": table,
+        }
+        accepted = _SPRING_LAW_PARAMETERS[law]
+        for name, value in given.items():
+            if value is not None and name not in accepted:
+                raise ValueError(
+                    "%s= is not a parameter of the %r spring law (it takes: %s)"
+                    % (name, law, ", ".join(accepted))
+                )
+        for name in ("stiffness", "damping", "lambda1", "lambda2", "a", "b"):
+            if given[name] is not None:
+                setattr(definition.params, name, float(given[name]))
+        if table is not None:
+            table_array = _arrays.float_array(table, "table", (None, 2))
+            keep_alive.append(table_array)
+            definition.params.table = _arrays.double_ptr(table_array)
+            definition.params.table_rows = _arrays.count(table_array.shape[0], "table rows")
+
+        if mass is not None:
+            if np.ndim(mass) == 0:
+                definition.node_mass = float(mass)
+            else:
+                mass_array = _arrays.float_array(mass, "mass", (node_count,))
+                keep_alive.append(mass_array)
+                definition.node_masses = _arrays.double_ptr(mass_array)
+        if integrator is not None:
+            definition.integrator = _choose(integrator, INTEGRATORS, "integrator")
+        if on_unstable is not None:
+            definition.on_unstable = _choose(on_unstable, UNSTABLE_POLICIES, "on_unstable")
+        if damping_mass is not None:
+            definition.damping_mass = float(damping_mass)
+        if runaway_speed is not None:
+            definition.runaway_speed = float(runaway_speed)
+
+        body = sh_body_id()
+        status = lib.sh_world_add_spring_body(handle, ctypes.byref(definition), ctypes.byref(body))
+        del keep_alive
+        check(status, "sh_world_add_spring_body")
+        return Body(self, body.value)
+
+    def remove_body(self, body):
+        """Destroy body; its id becomes stale (using the Body afterwards raises softhap.Error with
+        status SH_ERR_INVALID_HANDLE)."""
+        handle = self._require_handle("sh_world_remove_body")
+        if not isinstance(body, Body):
+            raise TypeError("body must be a softhap.Body, got %s" % type(body).__name__)
+        if body.world is not self:
+            raise ValueError("%r belongs to another world" % (body,))
+        check(lib.sh_world_remove_body(handle, body.id), "sh_world_remove_body")
+
+
+class Body:
+    """A body of a World (an sh_body_id): an FEM body or a mass-spring network.
+
+    Made by World.add_fem_body or World.add_spring_body. The World owns the body's data; a
+    Body keeps its World alive. After World.remove_body the id is stale and every call raises
+    softhap.Error (SH_ERR_INVALID_HANDLE); so does every call after the World is closed.
+    Arrays read from a body are copies.
+    """
+
+    def __init__(self, world, body_id):
+        """Wrap the id body_id of world (use World.add_*_body rather than calling this)."""
+        self._world = world
+        self._id = int(body_id)
+
+    def __repr__(self):
+        return "<softhap.Body id=%#x>" % self._id
+
+    @property
+    def world(self):
+        """The World this body belongs to."""
+        return self._world
+
+    @property
+    def id(self):
+        """The generation-checked sh_body_id (an int; 0 is the null id)."""
+        return self._id
+
+    @property
+    def is_valid(self):
+        """True while the body is a live body of an open world (sh_body_is_valid)."""
+        if self._world.closed:
+            return False
+        return bool(lib.sh_body_is_valid(self._world._handle, self._id))
+
+    def _world_handle(self, function):
+        if self._world.closed:
+            raise closed_error("world of this body", function)
+        return self._world._handle
+
+    # -- facts ------------------------------------------------------------------------------
+
+    @property
+    def info(self):
+        """Facts about the body as a BodyInfo (dict with attribute access): node_count,
+        element_count, is_fem, fixed_node_count, total_mass (kg), dt_critical (s)."""
+        handle = self._world_handle("sh_body_get_info")
+        raw = sh_body_info()
+        check(lib.sh_body_get_info(handle, self._id, ctypes.byref(raw)), "sh_body_get_info")
+        return BodyInfo(
+            node_count=raw.node_count,
+            element_count=raw.element_count,
+            is_fem=bool(raw.is_fem),
+            fixed_node_count=raw.fixed_node_count,
+            total_mass=raw.total_mass,
+            dt_critical=raw.dt_critical,
+        )
+
+    @property
+    def node_count(self):
+        """Number of nodes (including orphans)."""
+        return self.info["node_count"]
+
+    @property
+    def critical_dt(self):
+        """Critical explicit time step of the body's integrator (s); inf if there is none."""
+        return self.info["dt_critical"]
+
+    # -- state ------------------------------------------------------------------------------
+
+    def _read(self, function_name, columns):
+        handle = self._world_handle(function_name)
+        n = self.node_count
+        out = np.empty((n, columns) if columns else (n,), dtype=np.float64)
+        check(
+            getattr(lib, function_name)(handle, self._id, _arrays.double_ptr(out), out.size),
+            function_name,
+        )
+        return out
+
+    def _node_vectors(self, value, name):
+        return _arrays.float_array(value, name, (self.node_count, 3))
+
+    @property
+    def positions(self):
+        """Node positions, an (n, 3) array (m). Reading returns a copy; assigning an (n, 3)
+        array sets every position (sh_body_set_positions)."""
+        return self._read("sh_body_get_positions", 3)
+
+    @positions.setter
+    def positions(self, value):
+        handle = self._world_handle("sh_body_set_positions")
+        array = self._node_vectors(value, "positions")
+        check(
+            lib.sh_body_set_positions(handle, self._id, _arrays.double_ptr(array), array.shape[0]),
+            "sh_body_set_positions",
+        )
+
+    @property
+    def velocities(self):
+        """Node velocities, an (n, 3) array (m/s). Reading returns a copy; assigning an (n, 3)
+        array sets every velocity (fixed and orphan nodes keep zero velocity)."""
+        return self._read("sh_body_get_velocities", 3)
+
+    @velocities.setter
+    def velocities(self, value):
+        handle = self._world_handle("sh_body_set_velocities")
+        array = self._node_vectors(value, "velocities")
+        check(
+            lib.sh_body_set_velocities(
+                handle, self._id, _arrays.double_ptr(array), array.shape[0]
+            ),
+            "sh_body_set_velocities",
+        )
+
+    @property
+    def masses(self):
+        """A copy of the lumped nodal masses, an (n,) array (kg; 0 for orphan nodes)."""
+        return self._read("sh_body_get_masses", 0)
+
+    def elastic_forces(self):
+        """Internal elastic nodal forces at the current positions, an (n, 3) array (N)."""
+        return self._read("sh_body_get_elastic_forces", 3)
+
+    def elastic_energy(self):
+        """Elastic energy stored at the current positions (J)."""
+        handle = self._world_handle("sh_body_get_elastic_energy")
+        energy = ctypes.c_double()
+        check(
+            lib.sh_body_get_elastic_energy(handle, self._id, ctypes.byref(energy)),
+            "sh_body_get_elastic_energy",
+        )
+        return energy.value
+
+    # -- boundary conditions and loads ------------------------------------------------------
+
+    def _node_list(self, function_name, indices):
+        handle = self._world_handle(function_name)
+        nodes = _arrays.index_array(np.atleast_1d(np.asarray(indices)), "indices", (None,))
+        check(
+            getattr(lib, function_name)(handle, self._id, _arrays.int32_ptr(nodes), nodes.size),
+            function_name,
+        )
+
+    def fix_nodes(self, indices):
+        """Fix the listed nodes (an int or a sequence of indices) at their current positions."""
+        self._node_list("sh_body_fix_nodes", indices)
+
+    def release_nodes(self, indices):
+        """Release fixed or prescribed nodes so that they move freely again."""
+        self._node_list("sh_body_release_nodes", indices)
+
+    def prescribe_positions(self, indices, positions):
+        """Prescribe target positions ((k, 3), m) of k nodes: each moves linearly to its target
+        over the next step and is then held there."""
+        handle = self._world_handle("sh_body_prescribe_positions")
+        nodes = _arrays.index_array(np.atleast_1d(np.asarray(indices)), "indices", (None,))
+        targets = _arrays.float_array(positions, "positions", (nodes.size, 3))
+        check(
+            lib.sh_body_prescribe_positions(
+                handle,
+                self._id,
+                _arrays.int32_ptr(nodes),
+                _arrays.double_ptr(targets),
+                nodes.size,
+            ),
+            "sh_body_prescribe_positions",
+        )
+
+    def apply_forces(self, forces):
+        """Set external nodal forces ((n, 3), N), held until changed; None clears them."""
+        handle = self._world_handle("sh_body_set_external_forces")
+        if forces is None:
+            status = lib.sh_body_set_external_forces(handle, self._id, None, 0)
+        else:
+            array = self._node_vectors(forces, "forces")
+            status = lib.sh_body_set_external_forces(
+                handle, self._id, _arrays.double_ptr(array), array.shape[0]
+            )
+        check(status, "sh_body_set_external_forces")
+
+    def set_node_damping(self, coefficients):
+        """Set per-node viscous damping c_i (1/s): f_i = -c_i m_i v_i, added to the body's mass
+        damping. coefficients is a scalar (every node), an (n,) array, or None to clear."""
+        handle = self._world_handle("sh_body_set_node_damping")
+        if coefficients is None:
+            status = lib.sh_body_set_node_damping(handle, self._id, None, 0)
+        else:
+            n = self.node_count
+            if np.ndim(coefficients) == 0:
+                array = np.full(n, float(coefficients))
+            else:
+                array = _arrays.float_array(coefficients, "coefficients", (n,))
+            status = lib.sh_body_set_node_damping(handle, self._id, _arrays.double_ptr(array), n)
+        check(status, "sh_body_set_node_damping")
+
+    def set_material(self, element_indices, model=None, young=None, poisson=None, density=None):
+        """Set the material of the listed elements (a region of an FEM body). Masses are
+        recomputed from the new density.
+
+        The C API has no per-element material getter, so a field left as None takes the
+        sh_fem_body_def_default value (StVK, 3000 Pa, 0.45, 1000 kg/m^3), not the element's
+        current value. Invalid values raise softhap.Error (SH_ERR_INVALID_ARGUMENT).
+        """
+        handle = self._world_handle("sh_body_set_material")
+        elements = _arrays.index_array(
+            np.atleast_1d(np.asarray(element_indices)), "element_indices", (None,)
+        )
+        material = _default_material()
+        if model is not None:
+            material.model = _choose(model, MATERIAL_MODELS, "model")
+        if young is not None:
+            material.young = float(young)
+        if poisson is not None:
+            material.poisson = float(poisson)
+        if density is not None:
+            material.density = float(density)
+        check(
+            lib.sh_body_set_material(
+                handle, self._id, _arrays.int32_ptr(elements), elements.size, ctypes.byref(material)
+            ),
+            "sh_body_set_material",
+        )
+
+    # -- output -----------------------------------------------------------------------------
+
+    def write_vtu(self, path):
+        """Write the body's current shape as an ASCII .vtu file (FEM: tets; springs: lines)
+        with point data "velocity"."""
+        handle = self._world_handle("sh_body_write_vtu")
+        check(
+            lib.sh_body_write_vtu(handle, self._id, _arrays.path_bytes(path)), "sh_body_write_vtu"
+        )
+
+    def remove(self):
+        """Remove this body from its world (same as world.remove_body(body))."""
+        self._world.remove_body(self)
+

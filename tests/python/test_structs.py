@@ -1,0 +1,89 @@
+"""The ctypes structs mirror the C structs exactly: every field's offset and every struct's size
+are compared with what the C compiler computes from include/softhap/softhap.h."""
+
+import ctypes
+import importlib.util
+import re
+import subprocess
+
+import pytest
+
+from conftest import BINDINGS_DIR, INCLUDE_DIR, compile_c
+
+
+def _load_lib_module():
+    # softhap/_lib.py on its own (it loads no library at import), so that the layout is checked
+    # even when libsofthap cannot be built or loaded.
+    spec = importlib.util.spec_from_file_location(
+        "softhap_lib_layout_only", BINDINGS_DIR / "softhap" / "_lib.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+_lib = _load_lib_module()
+
+
+def _layout_program():
+    lines = [
+        "#include <stddef.h>",
+        "#include <stdio.h>",
+        '#include "softhap/softhap.h"',
+        "int main(void) {",
+    ]
+    for name, struct in _lib.STRUCTS.items():
+        lines.append('    printf("%s sizeof %%zu\\n", sizeof(%s));' % (name, name))
+        for field, _type in struct._fields_:
+            lines.append(
+                '    printf("%s %s %%zu\\n", offsetof(%s, %s));' % (name, field, name, field)
+            )
+    lines.append("    return 0;")
+    lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+@pytest.fixture(scope="module")
+def c_layout(cc, tmp_path_factory):
+    """{(struct, field or "sizeof"): bytes} as the C compiler lays the structs out."""
+    workdir = tmp_path_factory.mktemp("layout")
+    program = compile_c(cc, _layout_program(), workdir / "layout")
+    output = subprocess.run([str(program)], capture_output=True, text=True, check=True).stdout
+    layout = {}
+    for line in output.splitlines():
+        struct, field, value = line.split()
+        layout[(struct, field)] = int(value)
+    return layout
+
+
+@pytest.mark.parametrize("name", sorted(_lib.STRUCTS))
+def test_struct_size_matches_c(c_layout, name):
+    assert ctypes.sizeof(_lib.STRUCTS[name]) == c_layout[(name, "sizeof")]
+
+
+@pytest.mark.parametrize("name", sorted(_lib.STRUCTS))
+def test_field_offsets_match_c(c_layout, name):
+    struct = _lib.STRUCTS[name]
+    for field, _type in struct._fields_:
+        assert getattr(struct, field).offset == c_layout[(name, field)], field
+
+
+def test_sizes_computed_by_hand():
+    # Independent of any compiler: the x86-64/aarch64 SysV layout worked out from the header.
+    assert ctypes.sizeof(_lib.sh_world_def) == 32  # u32, pad 4, 3 doubles
+    assert ctypes.sizeof(_lib.sh_step_report) == 56
+    assert ctypes.sizeof(_lib.sh_mesh_info) == 88  # 7 int32, pad 4, 7 doubles
+    assert ctypes.sizeof(_lib.sh_material) == 32
+    assert ctypes.sizeof(_lib.sh_fem_body_def) == 80
+    assert ctypes.sizeof(_lib.sh_spring_params) == 72
+    assert ctypes.sizeof(_lib.sh_spring_body_def) == 160
+    assert ctypes.sizeof(_lib.sh_body_info) == 32
+    assert _lib.sh_spring_body_def.params.offset == 48
+    assert _lib.sh_step_report.warnings.offset == 48
+
+
+def test_every_header_function_is_declared():
+    # Every SH_API function of the header has a prototype in the bindings (and nothing else).
+    text = (INCLUDE_DIR / "softhap" / "softhap.h").read_text()
+    declared = set(re.findall(r"SH_API\s+[^;(]*?\b(sh_\w+)\s*\(", text))
+    assert declared == set(_lib.PROTOTYPES)

@@ -1,0 +1,214 @@
+// C API: body state, boundary conditions, loads and queries.
+#include "capi/guard.hpp"
+#include "capi/world_handle.hpp"
+#include "material/material_params.hpp"
+#include "model/fem_body.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+using namespace sh;
+
+namespace {
+
+Body& body_of(const sh_world* world, sh_body_id id) { return capi::world_of(world).body(id); }
+
+void require_node_count(const Body& body, int32_t node_count) {
+    require(node_count == body.node_count(), SH_ERR_INVALID_ARGUMENT,
+            format("node_count = %d, the body has %d nodes", node_count, body.node_count()));
+}
+
+void require_all_finite(const double* values, size_t count, const char* name) {
+    capi::require_pointer(values, name);
+    for (size_t i = 0; i < count; ++i)
+        require(std::isfinite(values[i]), SH_ERR_INVALID_ARGUMENT,
+                format("%s[%zu] (node %zu) is not finite", name, i, i / 3));
+}
+
+void require_node_indices(const Body& body, const int32_t* nodes, int32_t count) {
+    require(count >= 0, SH_ERR_INVALID_ARGUMENT, format("count = %d, must be >= 0", count));
+    if (count > 0) capi::require_pointer(nodes, "nodes");
+    for (int32_t k = 0; k < count; ++k)
+        require(nodes[k] >= 0 && nodes[k] < body.node_count(), SH_ERR_INVALID_ARGUMENT,
+                format("nodes[%d] = %d is not a node index in [0, %d)", k, nodes[k], body.node_count()));
+}
+
+void copy_out(const vec<double>& source, double* out, int64_t capacity) {
+    capi::require_pointer(out, "out");
+    capi::require_capacity(capacity, static_cast<int64_t>(source.size()), "out");
+    std::copy(source.begin(), source.end(), out);
+}
+
+}  // namespace
+
+extern "C" {
+
+SH_API sh_status sh_body_set_material(sh_world* world, sh_body_id body, const int32_t* elements, int32_t element_count,
+                                      const sh_material* material) {
+    return capi::guard([&] {
+        Body& b = body_of(world, body);
+        require(b.is_fem(), SH_ERR_UNSUPPORTED, "sh_body_set_material needs an FEM body; this is a mass-spring body");
+        capi::require_pointer(material, "material");
+        validate_material(*material, "sh_body_set_material");
+        require(element_count >= 0, SH_ERR_INVALID_ARGUMENT, format("element_count = %d, must be >= 0", element_count));
+        if (element_count > 0) capi::require_pointer(elements, "elements");
+        static_cast<FemBody&>(b).set_material(elements, element_count, *material);
+    });
+}
+
+SH_API sh_status sh_world_remove_body(sh_world* world, sh_body_id body) {
+    return capi::guard([&] { capi::world_of(world).remove_body(body); });
+}
+
+SH_API int32_t sh_body_is_valid(const sh_world* world, sh_body_id body) {
+    int32_t valid = 0;
+    capi::guard([&] { valid = capi::world_of(world).is_valid(body) ? 1 : 0; });
+    return valid;
+}
+
+SH_API sh_status sh_body_get_info(const sh_world* world, sh_body_id body, sh_body_info* out_info) {
+    return capi::guard([&] {
+        const Body& b = body_of(world, body);
+        capi::require_pointer(out_info, "out_info");
+        sh_body_info info{};
+        info.node_count = b.node_count();
+        info.element_count = b.element_count();
+        info.is_fem = b.is_fem() ? 1 : 0;
+        for (int32_t i = 0; i < b.node_count(); ++i) {
+            info.fixed_node_count += b.kinematic[static_cast<size_t>(i)] ? 1 : 0;
+            info.total_mass += b.mass[static_cast<size_t>(i)];
+        }
+        info.dt_critical = b.critical_dt();
+        *out_info = info;
+    });
+}
+
+SH_API sh_status sh_body_get_positions(const sh_world* world, sh_body_id body, double* out, int64_t capacity) {
+    return capi::guard([&] { copy_out(body_of(world, body).x, out, capacity); });
+}
+
+SH_API sh_status sh_body_get_velocities(const sh_world* world, sh_body_id body, double* out, int64_t capacity) {
+    return capi::guard([&] { copy_out(body_of(world, body).v, out, capacity); });
+}
+
+SH_API sh_status sh_body_get_masses(const sh_world* world, sh_body_id body, double* out, int64_t capacity) {
+    return capi::guard([&] { copy_out(body_of(world, body).mass, out, capacity); });
+}
+
+SH_API sh_status sh_body_set_positions(sh_world* world, sh_body_id body, const double* positions, int32_t node_count) {
+    return capi::guard([&] {
+        Body& b = body_of(world, body);
+        require_node_count(b, node_count);
+        require_all_finite(positions, b.x.size(), "positions");
+        std::copy(positions, positions + b.x.size(), b.x.begin());
+        for (size_t i = 0; i < b.kinematic.size(); ++i)  // fixed nodes stay fixed where they are put
+            if (b.kinematic[i])
+                for (int k = 0; k < 3; ++k) b.target[3 * i + k] = b.x[3 * i + k];
+    });
+}
+
+SH_API sh_status sh_body_set_velocities(sh_world* world, sh_body_id body, const double* velocities, int32_t node_count) {
+    return capi::guard([&] {
+        Body& b = body_of(world, body);
+        require_node_count(b, node_count);
+        require_all_finite(velocities, b.v.size(), "velocities");
+        for (size_t i = 0; i < b.mass.size(); ++i)
+            for (int k = 0; k < 3; ++k) b.v[3 * i + k] = b.inverse_mass[i] > 0.0 ? velocities[3 * i + k] : 0.0;
+    });
+}
+
+SH_API sh_status sh_body_fix_nodes(sh_world* world, sh_body_id body, const int32_t* nodes, int32_t count) {
+    return capi::guard([&] {
+        Body& b = body_of(world, body);
+        require_node_indices(b, nodes, count);
+        for (int32_t k = 0; k < count; ++k) {
+            const size_t i = static_cast<size_t>(nodes[k]);
+            b.kinematic[i] = 1;
+            for (int c = 0; c < 3; ++c) {
+                b.target[3 * i + c] = b.x[3 * i + c];
+                b.v[3 * i + c] = 0.0;
+            }
+        }
+        b.update_inverse_mass();
+    });
+}
+
+SH_API sh_status sh_body_release_nodes(sh_world* world, sh_body_id body, const int32_t* nodes, int32_t count) {
+    return capi::guard([&] {
+        Body& b = body_of(world, body);
+        require_node_indices(b, nodes, count);
+        for (int32_t k = 0; k < count; ++k) b.kinematic[static_cast<size_t>(nodes[k])] = 0;
+        b.update_inverse_mass();
+    });
+}
+
+SH_API sh_status sh_body_prescribe_positions(sh_world* world, sh_body_id body, const int32_t* nodes,
+                                             const double* positions, int32_t count) {
+    return capi::guard([&] {
+        Body& b = body_of(world, body);
+        require_node_indices(b, nodes, count);
+        if (count > 0) require_all_finite(positions, 3 * static_cast<size_t>(count), "positions");
+        for (int32_t k = 0; k < count; ++k) {
+            const size_t i = static_cast<size_t>(nodes[k]);
+            b.kinematic[i] = 1;
+            for (int c = 0; c < 3; ++c) b.target[3 * i + c] = positions[3 * k + c];
+        }
+        b.update_inverse_mass();
+    });
+}
+
+SH_API sh_status sh_body_set_external_forces(sh_world* world, sh_body_id body, const double* forces, int32_t node_count) {
+    return capi::guard([&] {
+        Body& b = body_of(world, body);
+        if (!forces) {
+            std::fill(b.external_force.begin(), b.external_force.end(), 0.0);
+            return;
+        }
+        require_node_count(b, node_count);
+        require_all_finite(forces, b.external_force.size(), "forces");
+        std::copy(forces, forces + b.external_force.size(), b.external_force.begin());
+    });
+}
+
+SH_API sh_status sh_body_set_node_damping(sh_world* world, sh_body_id body, const double* coefficients, int32_t node_count) {
+    return capi::guard([&] {
+        Body& b = body_of(world, body);
+        if (!coefficients) {
+            b.node_damping = vec<double>();
+            return;
+        }
+        require_node_count(b, node_count);
+        for (int32_t i = 0; i < node_count; ++i)
+            require(std::isfinite(coefficients[i]) && coefficients[i] >= 0.0, SH_ERR_INVALID_ARGUMENT,
+                    format("coefficients[%d] = %g 1/s, must be finite and >= 0", i, coefficients[i]));
+        b.node_damping.assign(coefficients, coefficients + node_count);
+    });
+}
+
+SH_API sh_status sh_body_get_elastic_forces(const sh_world* world, sh_body_id body, double* out, int64_t capacity) {
+    return capi::guard([&] {
+        const Body& b = body_of(world, body);
+        capi::require_pointer(out, "out");
+        capi::require_capacity(capacity, static_cast<int64_t>(b.x.size()), "out");
+        std::fill(out, out + b.x.size(), 0.0);
+        b.add_internal_forces(b.x.data(), nullptr, out);
+    });
+}
+
+SH_API sh_status sh_body_get_elastic_energy(const sh_world* world, sh_body_id body, double* out_energy) {
+    return capi::guard([&] {
+        const Body& b = body_of(world, body);
+        capi::require_pointer(out_energy, "out_energy");
+        *out_energy = b.elastic_energy(b.x.data());
+    });
+}
+
+SH_API sh_status sh_body_write_vtu(const sh_world* world, sh_body_id body, const char* path) {
+    return capi::guard([&] {
+        const Body& b = body_of(world, body);
+        capi::require_pointer(path, "path");
+        b.write_vtu(path);
+    });
+}
+
+}  // extern "C"

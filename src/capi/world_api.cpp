@@ -1,0 +1,180 @@
+// C API: worlds, body creation and stepping.
+#include "capi/guard.hpp"
+#include "capi/handles.hpp"
+#include "capi/world_handle.hpp"
+#include "material/material_params.hpp"
+#include "mesh/tet_mesh.hpp"
+#include "model/fem_body.hpp"
+#include "model/spring_body.hpp"
+
+using namespace sh;
+using capi::HandleKind;
+
+namespace sh::capi {
+const TetMesh& mesh_of(const sh_mesh* mesh);
+
+World& world_of(const sh_world* world) {
+    require_handle(HandleKind::World, world, "world");
+    return const_cast<sh_world*>(world)->world;
+}
+}  // namespace sh::capi
+
+namespace {
+
+IntegrationSettings integration_settings(sh_integrator integrator, sh_unstable_policy policy, double damping_mass,
+                                         double runaway_speed) {
+    require(integrator >= SH_INTEGRATOR_FORWARD_EULER && integrator <= SH_INTEGRATOR_RK4, SH_ERR_INVALID_ARGUMENT,
+            format("def->integrator = %d is not a sh_integrator", static_cast<int>(integrator)));
+    require(policy == SH_UNSTABLE_REJECT || policy == SH_UNSTABLE_SUBSTEP, SH_ERR_INVALID_ARGUMENT,
+            format("def->on_unstable = %d is not a sh_unstable_policy", static_cast<int>(policy)));
+    require(std::isfinite(damping_mass) && damping_mass >= 0.0, SH_ERR_INVALID_ARGUMENT,
+            format("def->damping_mass = %g 1/s, must be finite and >= 0", damping_mass));
+    require(runaway_speed > 0.0, SH_ERR_INVALID_ARGUMENT,
+            format("def->runaway_speed = %g m/s, must be > 0", runaway_speed));
+    IntegrationSettings s;
+    s.integrator = integrator;
+    s.on_unstable = policy;
+    s.damping_mass = damping_mass;
+    s.runaway_speed = runaway_speed;
+    return s;
+}
+
+}  // namespace
+
+extern "C" {
+
+SH_API void sh_world_def_default(sh_world_def* def) {
+    if (!def) return;
+    *def = sh_world_def{};
+    def->internal_init = capi::kDefInitialised;
+    def->gravity[2] = -9.81;
+}
+
+SH_API sh_status sh_world_create(const sh_world_def* def, sh_world** out_world) {
+    return capi::guard([&] {
+        capi::require_pointer(out_world, "out_world");
+        *out_world = nullptr;
+        capi::require_initialised(def, "def");
+        for (int k = 0; k < 3; ++k) capi::require_finite(def->gravity[k], "def->gravity");
+        sh_world* world = sh::create<sh_world>(*def);
+        try {
+            capi::register_handle(HandleKind::World, world);
+        } catch (...) {
+            sh::destroy(world);
+            throw;
+        }
+        *out_world = world;
+    });
+}
+
+SH_API sh_status sh_world_destroy(sh_world* world) {
+    return capi::guard([&] {
+        if (!world) return;
+        require(capi::unregister_handle(HandleKind::World, world), SH_ERR_INVALID_HANDLE,
+                "world is not a live object (destroyed twice or never created)");
+        sh::destroy(world);
+    });
+}
+
+SH_API sh_status sh_world_set_gravity(sh_world* world, const double gravity[3]) {
+    return capi::guard([&] {
+        World& w = capi::world_of(world);
+        capi::require_pointer(gravity, "gravity");
+        for (int k = 0; k < 3; ++k) capi::require_finite(gravity[k], "gravity");
+        for (int k = 0; k < 3; ++k) w.gravity[k] = gravity[k];
+    });
+}
+
+SH_API sh_status sh_world_get_warnings(const sh_world* world, uint64_t out[SH_WARN_COUNT]) {
+    return capi::guard([&] {
+        const World& w = capi::world_of(world);
+        capi::require_pointer(out, "out");
+        for (int k = 0; k < SH_WARN_COUNT; ++k) out[k] = w.warnings[k];
+    });
+}
+
+SH_API sh_status sh_world_step(sh_world* world, double dt, sh_step_report* report) {
+    return capi::guard([&] { capi::world_of(world).step(dt, report); });
+}
+
+SH_API void sh_fem_body_def_default(sh_fem_body_def* def) {
+    if (!def) return;
+    *def = sh_fem_body_def{};
+    def->internal_init = capi::kDefInitialised;
+    def->material.model = SH_MATERIAL_STVK;
+    def->material.young = 3000.0;
+    def->material.poisson = 0.45;
+    def->material.density = 1000.0;
+    def->integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
+    def->on_unstable = SH_UNSTABLE_SUBSTEP;
+    def->runaway_speed = 1e4;
+}
+
+SH_API sh_status sh_world_add_fem_body(sh_world* world, const sh_fem_body_def* def, sh_body_id* out_body) {
+    return capi::guard([&] {
+        World& w = capi::world_of(world);
+        capi::require_pointer(out_body, "out_body");
+        *out_body = SH_NULL_BODY;
+        capi::require_initialised(def, "def");
+        if (!def->mesh) throw Error(SH_ERR_INVALID_ARGUMENT, "def->mesh is NULL");
+        const TetMesh& mesh = capi::mesh_of(def->mesh);
+        validate_material(def->material, "def");
+        require(std::isfinite(def->damping_stiffness) && def->damping_stiffness >= 0.0, SH_ERR_INVALID_ARGUMENT,
+                format("def->damping_stiffness = %g s, must be finite and >= 0", def->damping_stiffness));
+        const IntegrationSettings settings =
+            integration_settings(def->integrator, def->on_unstable, def->damping_mass, def->runaway_speed);
+        *out_body = w.add_body(sh::create<FemBody>(mesh, def->material, settings, def->damping_stiffness));
+    });
+}
+
+SH_API void sh_spring_body_def_default(sh_spring_body_def* def) {
+    if (!def) return;
+    *def = sh_spring_body_def{};
+    def->internal_init = capi::kDefInitialised;
+    def->params.law = SH_SPRING_LINEAR;
+    def->params.stiffness = 100.0;
+    def->node_mass = 1e-3;
+    def->integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
+    def->on_unstable = SH_UNSTABLE_SUBSTEP;
+    def->runaway_speed = 1e4;
+}
+
+SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_def* def, sh_body_id* out_body) {
+    return capi::guard([&] {
+        World& w = capi::world_of(world);
+        capi::require_pointer(out_body, "out_body");
+        *out_body = SH_NULL_BODY;
+        capi::require_initialised(def, "def");
+        const TetMesh* mesh = def->mesh ? &capi::mesh_of(def->mesh) : nullptr;
+        vec<double> nodes;
+        if (def->nodes) {
+            require(def->node_count > 0, SH_ERR_INVALID_ARGUMENT,
+                    format("def->node_count = %d, must be > 0", def->node_count));
+            nodes.assign(def->nodes, def->nodes + 3 * static_cast<size_t>(def->node_count));
+        } else {
+            require(mesh != nullptr, SH_ERR_INVALID_ARGUMENT, "def->nodes and def->mesh are both NULL");
+            nodes = mesh->nodes;
+        }
+        const size_t node_count = nodes.size() / 3;
+        vec<int32_t> springs;
+        if (def->springs) {
+            require(def->spring_count >= 0, SH_ERR_INVALID_ARGUMENT,
+                    format("def->spring_count = %d, must be >= 0", def->spring_count));
+            springs.assign(def->springs, def->springs + 2 * static_cast<size_t>(def->spring_count));
+        } else if (mesh) {
+            require(mesh->node_count() == static_cast<int32_t>(node_count), SH_ERR_INVALID_ARGUMENT,
+                    "springs from def->mesh need the mesh's nodes (def->nodes NULL or the same count)");
+            springs = mesh->edges;
+        }
+        vec<double> masses(node_count, def->node_mass);
+        if (def->node_masses) masses.assign(def->node_masses, def->node_masses + node_count);
+        else if (mesh && !def->nodes)
+            for (size_t i = 0; i < node_count; ++i)
+                if (!mesh->node_used[i]) masses[i] = 0.0;  // orphans stay out of the dynamics
+        const IntegrationSettings settings =
+            integration_settings(def->integrator, def->on_unstable, def->damping_mass, def->runaway_speed);
+        *out_body = w.add_body(sh::create<SpringBody>(std::move(nodes), std::move(springs), def->params, masses, settings));
+    });
+}
+
+}  // extern "C"

@@ -1,0 +1,26 @@
+#include "material/material_params.hpp"
+
+#include "core/error.hpp"
+
+#include <cmath>
+
+namespace sh {
+
+void validate_material(const sh_material& m, const char* context) {
+    require(m.model >= SH_MATERIAL_LINEAR && m.model <= SH_MATERIAL_NEOHOOKEAN, SH_ERR_INVALID_ARGUMENT,
+            format("%s: material.model %d is not a sh_material_model", context, static_cast<int>(m.model)));
+    require(std::isfinite(m.young) && m.young > 0.0, SH_ERR_INVALID_ARGUMENT,
+            format("%s: material.young = %g Pa, must be finite and > 0", context, m.young));
+    require(std::isfinite(m.poisson) && m.poisson > -1.0 && m.poisson < 0.5, SH_ERR_INVALID_ARGUMENT,
+            format("%s: material.poisson = %g, must lie in (-1, 0.5)", context, m.poisson));
+    require(std::isfinite(m.density) && m.density > 0.0, SH_ERR_INVALID_ARGUMENT,
+            format("%s: material.density = %g kg/m^3, must be finite and > 0", context, m.density));
+}
+
+double lame_lambda(const sh_material& m) {
+    return m.young * m.poisson / ((1.0 + m.poisson) * (1.0 - 2.0 * m.poisson));
+}
+
+double lame_mu(const sh_material& m) { return m.young / (2.0 * (1.0 + m.poisson)); }
+
+}  // namespace sh

@@ -1,0 +1,36 @@
+#include "model/body.hpp"
+
+namespace sh {
+
+Body::Body(IntegrationSettings s, vec<double> rest_positions) : settings(s), x(std::move(rest_positions)) {
+    const size_t n = x.size() / 3;
+    v.assign(3 * n, 0.0);
+    mass.assign(n, 0.0);
+    inverse_mass.assign(n, 0.0);
+    kinematic.assign(n, 0);
+    target = x;
+    external_force.assign(3 * n, 0.0);
+    IntegratorWorkspace& w = workspace;
+    w.x0.resize(3 * n);
+    w.v0.resize(3 * n);
+    w.kinematic_velocity.assign(3 * n, 0.0);
+    w.xs.resize(3 * n);
+    w.vs.resize(3 * n);
+    for (auto& a : w.a) a.resize(3 * n);
+    w.dx.resize(3 * n);
+}
+
+void Body::update_inverse_mass() {
+    for (size_t i = 0; i < mass.size(); ++i)
+        inverse_mass[i] = (mass[i] > 0.0 && !kinematic[i]) ? 1.0 / mass[i] : 0.0;
+}
+
+double Body::critical_dt() const {
+    // Stability limits on the imaginary axis relative to leapfrog's 2/omega: RK4 reaches
+    // 2*sqrt(2)/omega. Forward Euler and RK2 have no undamped stable step at all (their energy
+    // grows at every dt); they get the leapfrog limit, beyond which growth is explosive.
+    const double factor = settings.integrator == SH_INTEGRATOR_RK4 ? 1.4142135623730951 : 1.0;
+    return factor * stable_step(x.data());
+}
+
+}  // namespace sh

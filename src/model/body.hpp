@@ -1,0 +1,80 @@
+// Body: a deformable object's node state, boundary conditions and loads, and the interface
+// the integrators use (internal forces, energy, critical step).
+#pragma once
+
+#include "core/memory.hpp"
+
+#include <softhap/softhap.h>
+
+#include <cstdint>
+#include <string>
+
+namespace sh {
+
+/// Per-body integration settings shared by FEM and mass-spring bodies.
+struct IntegrationSettings {
+    sh_integrator integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
+    sh_unstable_policy on_unstable = SH_UNSTABLE_SUBSTEP;
+    double damping_mass = 0.0;   ///< alpha (1/s)
+    double runaway_speed = 1e4;  ///< m/s
+};
+
+/// Scratch arrays of the integrators, sized once when the body is built.
+struct IntegratorWorkspace {
+    vec<double> x0, v0;                 ///< state at the start of the step (rollback)
+    vec<double> kinematic_velocity;     ///< 3 per node, prescribed-node velocity in this step
+    vec<double> xs, vs;                 ///< stage state
+    vec<double> a[4];                   ///< stage accelerations
+    vec<double> dx;                     ///< RK4 accumulated velocity
+};
+
+/// A deformable body. Orphan nodes have zero mass and are never integrated.
+class Body {
+public:
+    Body(IntegrationSettings settings, vec<double> rest_positions);
+    virtual ~Body() = default;
+    Body(const Body&) = delete;
+    Body& operator=(const Body&) = delete;
+
+    /// Adds internal forces at (x, v) into f (3 per node): elastic forces, plus the body's
+    /// internal damping (stiffness-proportional or spring dashpots) when v is not null.
+    virtual void add_internal_forces(const double* x, const double* v, double* f) const = 0;
+
+    /// Elastic energy at positions x (J).
+    virtual double elastic_energy(const double* x) const = 0;
+
+    /// Largest stable step of an undamped leapfrog step, 2 / omega_max, at state x (s).
+    virtual double stable_step(const double* x) const = 0;
+
+    /// Tets or springs.
+    virtual int32_t element_count() const = 0;
+
+    /// True for FEM bodies.
+    virtual bool is_fem() const = 0;
+
+    /// Writes the current shape as .vtu.
+    virtual void write_vtu(const std::string& path) const = 0;
+
+    /// Critical step of this body's integrator at the current state (s).
+    double critical_dt() const;
+
+    /// True if node i is integrated (has mass, not fixed or prescribed).
+    bool is_free(int32_t i) const { return inverse_mass[static_cast<size_t>(i)] > 0.0; }
+
+    /// Recomputes inverse_mass from mass and kinematic.
+    void update_inverse_mass();
+
+    int32_t node_count() const { return static_cast<int32_t>(mass.size()); }
+
+    IntegrationSettings settings;
+    vec<double> x, v;            ///< 3 per node (m, m/s)
+    vec<double> mass;            ///< lumped mass per node (kg); 0 for orphans
+    vec<double> inverse_mass;    ///< 1/m for free nodes, 0 for fixed, prescribed and orphans
+    vec<uint8_t> kinematic;      ///< 1 if the node's position is fixed or prescribed
+    vec<double> target;          ///< 3 per node, where kinematic nodes go in the next step
+    vec<double> external_force;  ///< 3 per node (N), held
+    vec<double> node_damping;    ///< per-node viscous coefficient (1/s); empty if unused
+    IntegratorWorkspace workspace;
+};
+
+}  // namespace sh

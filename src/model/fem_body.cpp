@@ -1,0 +1,138 @@
+#include "model/fem_body.hpp"
+
+#include "core/error.hpp"
+#include "material/material_params.hpp"
+#include "material/tet_materials.hpp"
+#include "mesh/io/mesh_io.hpp"
+#include "model/fem_kernel.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+
+namespace sh {
+
+FemBody::FemBody(const TetMesh& mesh, const sh_material& material, IntegrationSettings s, double damping_stiffness)
+    : Body(s, mesh.nodes), tets_(mesh.tets), damping_stiffness_(damping_stiffness) {
+    const size_t tet_count = tets_.size() / 4;
+    inverse_rest_.resize(9 * tet_count);
+    volume_.resize(tet_count);
+    materials_.assign(tet_count, material);
+    for (size_t t = 0; t < tet_count; ++t) {
+        const int32_t* tet = &tets_[4 * t];
+        Eigen::Matrix3d dm;
+        for (int a = 0; a < 3; ++a)
+            for (int i = 0; i < 3; ++i) dm(i, a) = x[3 * tet[a + 1] + i] - x[3 * tet[0] + i];
+        volume_[t] = dm.determinant() / 6.0;
+        const Eigen::Matrix3d bm = dm.inverse();
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) inverse_rest_[9 * t + 3 * i + j] = bm(i, j);
+    }
+    rebuild();
+}
+
+void FemBody::set_material(const int32_t* elements, int32_t count, const sh_material& material) {
+    for (int32_t k = 0; k < count; ++k)
+        require(elements[k] >= 0 && elements[k] < element_count(), SH_ERR_INVALID_ARGUMENT,
+                format("elements[%d] = %d is not an element index in [0, %d)", k, elements[k], element_count()));
+    for (int32_t k = 0; k < count; ++k) materials_[static_cast<size_t>(elements[k])] = material;
+    rebuild();
+}
+
+void FemBody::rebuild() {
+    const size_t tet_count = volume_.size();
+    std::fill(mass.begin(), mass.end(), 0.0);
+    for (size_t t = 0; t < tet_count; ++t)
+        for (int a = 0; a < 4; ++a) mass[static_cast<size_t>(tets_[4 * t + a])] += materials_[t].density * volume_[t] / 4.0;
+    update_inverse_mass();
+
+    for (int model = 0; model < 4; ++model) {
+        vec<size_t> members;
+        for (size_t t = 0; t < tet_count; ++t)
+            if (materials_[t].model == model) members.push_back(t);
+        vec<TetBlock>& blocks = blocks_[model];
+        blocks.assign((members.size() + kLanes - 1) / kLanes, TetBlock{});
+        for (size_t k = 0; k < members.size(); k += kLanes) {
+            TetBlock& b = blocks[k / kLanes];
+            for (int l = 0; l < kLanes; ++l) {
+                const bool used = k + l < members.size();
+                const size_t t = members[used ? k + l : k];  // unused lanes repeat a real tet
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 3; ++j) b.Bm.m[i][j][l] = inverse_rest_[9 * t + 3 * i + j];
+                b.volume[l] = used ? volume_[t] : 0.0;
+                b.lambda[l] = lame_lambda(materials_[t]);
+                b.mu[l] = lame_mu(materials_[t]);
+                for (int a = 0; a < 4; ++a) b.node[a][l] = tets_[4 * t + a];
+            }
+        }
+    }
+
+    double omega2 = 0.0;
+    for (size_t t = 0; t < tet_count; ++t) omega2 = std::max(omega2, element_max_frequency_squared(t));
+    const double omega = std::sqrt(omega2);
+    // Central-difference limit with stiffness damping ratio xi = beta omega / 2.
+    const double xi = 0.5 * damping_stiffness_ * omega;
+    stable_step_ = omega > 0.0 ? 2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi) : INFINITY;
+}
+
+double FemBody::element_max_frequency_squared(size_t t) const {
+    // Largest eigenvalue of M_e^-1 K_e with the rest (small-strain) stiffness and the element's
+    // share of the lumped mass: an upper bound of the assembled system's (Irons-Treharne).
+    const double* bm = &inverse_rest_[9 * t];
+    Eigen::Vector3d g[4];
+    for (int a = 0; a < 3; ++a) g[a + 1] = Eigen::Vector3d(bm[3 * a], bm[3 * a + 1], bm[3 * a + 2]);
+    g[0] = -(g[1] + g[2] + g[3]);
+    const double lambda = lame_lambda(materials_[t]), mu = lame_mu(materials_[t]), v0 = volume_[t];
+    Eigen::Matrix<double, 12, 12> k;
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+            k.block<3, 3>(3 * a, 3 * b) = v0 * (lambda * g[a] * g[b].transpose() + mu * g[b] * g[a].transpose() +
+                                                 mu * g[a].dot(g[b]) * Eigen::Matrix3d::Identity());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> eigen(k, Eigen::EigenvaluesOnly);  // ascending
+    return eigen.eigenvalues()(11) * 4.0 / (materials_[t].density * v0);
+}
+
+namespace {
+
+// Calls visit(material_tag, blocks) for the block list of each material model.
+template <class Visit>
+void for_each_model(const vec<TetBlock>* blocks, Visit&& visit) {
+    visit(LinearMaterial{}, blocks[SH_MATERIAL_LINEAR]);
+    visit(StvkMaterial{}, blocks[SH_MATERIAL_STVK]);
+    visit(CorotationalMaterial{}, blocks[SH_MATERIAL_COROTATIONAL]);
+    visit(NeoHookeanMaterial{}, blocks[SH_MATERIAL_NEOHOOKEAN]);
+}
+
+}  // namespace
+
+void FemBody::add_internal_forces(const double* xs, const double* vs, double* f) const {
+    const double* damped_v = damping_stiffness_ > 0.0 ? vs : nullptr;
+    for_each_model(blocks_, [&](auto material, const vec<TetBlock>& blocks) {
+        add_fem_forces<decltype(material)>(blocks.data(), blocks.size(), xs, damped_v, damping_stiffness_, f);
+    });
+}
+
+double FemBody::elastic_energy(const double* xs) const {
+    double energy = 0.0;
+    for_each_model(blocks_, [&](auto material, const vec<TetBlock>& blocks) {
+        energy += fem_energy<decltype(material)>(blocks.data(), blocks.size(), xs);
+    });
+    return energy;
+}
+
+double FemBody::stable_step(const double*) const { return stable_step_; }
+
+void FemBody::write_vtu(const std::string& path) const {
+    VtuFrame frame;
+    frame.points = x.data();
+    frame.point_count = node_count();
+    frame.cells = tets_.data();
+    frame.cell_count = element_count();
+    frame.nodes_per_cell = 4;
+    frame.point_vectors = v.data();
+    frame.point_vectors_name = "velocity";
+    sh::write_vtu(path, frame);
+}
+
+}  // namespace sh

@@ -1,0 +1,41 @@
+// FemBody: a tetrahedral FEM body with per-element materials, lumped mass and Rayleigh damping.
+#pragma once
+
+#include "mesh/tet_mesh.hpp"
+#include "model/body.hpp"
+#include "model/tet_block.hpp"
+
+namespace sh {
+
+/// Explicit tetrahedral FEM body. Elements are grouped by material model into TetBlocks.
+class FemBody final : public Body {
+public:
+    /// Builds the body from mesh's rest shape with one material everywhere. damping_stiffness
+    /// is Rayleigh beta (s).
+    FemBody(const TetMesh& mesh, const sh_material& material, IntegrationSettings settings,
+            double damping_stiffness);
+
+    /// Sets the material of the listed elements; recomputes masses, blocks and the stable step.
+    void set_material(const int32_t* elements, int32_t count, const sh_material& material);
+
+    void add_internal_forces(const double* x, const double* v, double* f) const override;
+    double elastic_energy(const double* x) const override;
+    double stable_step(const double* x) const override;
+    int32_t element_count() const override { return static_cast<int32_t>(volume_.size()); }
+    bool is_fem() const override { return true; }
+    void write_vtu(const std::string& path) const override;
+
+private:
+    void rebuild();
+    double element_max_frequency_squared(size_t element) const;
+
+    vec<int32_t> tets_;          ///< 4 per tet
+    vec<double> inverse_rest_;   ///< Bm = Dm^-1, 9 per tet, row-major
+    vec<double> volume_;         ///< V0 per tet
+    vec<sh_material> materials_; ///< per tet
+    vec<TetBlock> blocks_[4];    ///< per sh_material_model
+    double damping_stiffness_;
+    double stable_step_ = 0.0;   ///< 2/omega_max at rest, with stiffness damping
+};
+
+}  // namespace sh

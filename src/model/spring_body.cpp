@@ -1,0 +1,119 @@
+#include "model/spring_body.hpp"
+
+#include "core/error.hpp"
+#include "mesh/io/mesh_io.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sh {
+
+SpringBody::SpringBody(vec<double> nodes, vec<int32_t> springs, const sh_spring_params& params,
+                       const vec<double>& masses, IntegrationSettings s)
+    : Body(s, std::move(nodes)), springs_(std::move(springs)), law_(params) {
+    const int32_t n = node_count();
+    const size_t spring_count = springs_.size() / 2;
+    vec<uint8_t> on_spring(static_cast<size_t>(n), 0);
+    for (size_t s_i = 0; s_i < 2 * spring_count; ++s_i)
+        if (springs_[s_i] >= 0 && springs_[s_i] < n) on_spring[static_cast<size_t>(springs_[s_i])] = 1;
+    for (int32_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k)
+            require(std::isfinite(x[3 * static_cast<size_t>(i) + k]), SH_ERR_INVALID_ARGUMENT,
+                    format("node %d has a non-finite coordinate", i));
+        const double m = masses[static_cast<size_t>(i)];
+        // Zero mass is allowed only for a node no spring uses: it is left out of the dynamics.
+        const bool ok = std::isfinite(m) && (m > 0.0 || (m == 0.0 && spring_count > 0 && !on_spring[static_cast<size_t>(i)]));
+        require(ok, SH_ERR_INVALID_ARGUMENT, format("node %d: mass %g kg, must be finite and > 0", i, m));
+        mass[static_cast<size_t>(i)] = m;
+    }
+    rest_length_.resize(spring_count);
+    for (size_t s_i = 0; s_i < spring_count; ++s_i) {
+        const int32_t a = springs_[2 * s_i], b = springs_[2 * s_i + 1];
+        require(a >= 0 && a < n && b >= 0 && b < n, SH_ERR_INVALID_ARGUMENT,
+                format("spring %zu: node index (%d, %d) out of range [0, %d)", s_i, a, b, n));
+        require(a != b, SH_ERR_INVALID_ARGUMENT, format("spring %zu joins node %d to itself", s_i, a));
+        double l2 = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            const double d = x[3 * static_cast<size_t>(b) + k] - x[3 * static_cast<size_t>(a) + k];
+            l2 += d * d;
+        }
+        require(l2 > 0.0, SH_ERR_INVALID_ARGUMENT,
+                format("spring %zu (nodes %d, %d) has zero rest length", s_i, a, b));
+        rest_length_[s_i] = std::sqrt(l2);
+    }
+    row_bound_.resize(static_cast<size_t>(n));
+    update_inverse_mass();
+}
+
+void SpringBody::add_internal_forces(const double* xs, const double* vs, double* f) const {
+    const double c = vs ? law_.damping() : 0.0;
+    for (size_t s = 0; s < rest_length_.size(); ++s) {
+        const size_t a = static_cast<size_t>(springs_[2 * s]), b = static_cast<size_t>(springs_[2 * s + 1]);
+        double d[3], l2 = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            d[k] = xs[3 * b + k] - xs[3 * a + k];
+            l2 += d[k] * d[k];
+        }
+        const double l = std::sqrt(l2);
+        if (!(l > 0.0)) continue;  // coincident ends have no direction: no force
+        double t = law_.tension(l, rest_length_[s]);
+        if (c > 0.0) {
+            double rate = 0.0;
+            for (int k = 0; k < 3; ++k) rate += (vs[3 * b + k] - vs[3 * a + k]) * d[k];
+            t += c * rate / l;
+        }
+        for (int k = 0; k < 3; ++k) {
+            const double fk = t * d[k] / l;
+            f[3 * a + k] += fk;
+            f[3 * b + k] -= fk;
+        }
+    }
+}
+
+double SpringBody::elastic_energy(const double* xs) const {
+    double energy = 0.0;
+    for (size_t s = 0; s < rest_length_.size(); ++s) {
+        const size_t a = static_cast<size_t>(springs_[2 * s]), b = static_cast<size_t>(springs_[2 * s + 1]);
+        double l2 = 0.0;
+        for (int k = 0; k < 3; ++k) l2 += (xs[3 * b + k] - xs[3 * a + k]) * (xs[3 * b + k] - xs[3 * a + k]);
+        energy += law_.energy(std::sqrt(l2), rest_length_[s]);
+    }
+    return energy;
+}
+
+double SpringBody::stable_step(const double* xs) const {
+    // Block Gershgorin bound of omega_max^2 for M^-1/2 K M^-1/2 at the current state: a
+    // spring's 3x3 block k n n^T + (T/l)(I - n n^T) has norm max(k, |T|/l).
+    std::fill(row_bound_.begin(), row_bound_.end(), 0.0);
+    double damping_ratio_per_omega = 0.0;
+    for (size_t s = 0; s < rest_length_.size(); ++s) {
+        const size_t a = static_cast<size_t>(springs_[2 * s]), b = static_cast<size_t>(springs_[2 * s + 1]);
+        double l2 = 0.0;
+        for (int k = 0; k < 3; ++k) l2 += (xs[3 * b + k] - xs[3 * a + k]) * (xs[3 * b + k] - xs[3 * a + k]);
+        const double l = std::sqrt(l2), l0 = rest_length_[s];
+        double k_eff = std::fabs(law_.stiffness(l, l0));
+        if (l > 0.0) k_eff = std::max(k_eff, std::fabs(law_.tension(l, l0)) / l);
+        const double ia = inverse_mass[a], ib = inverse_mass[b];
+        row_bound_[a] += k_eff * (ia + std::sqrt(ia * ib));
+        row_bound_[b] += k_eff * (ib + std::sqrt(ia * ib));
+        if (k_eff > 0.0) damping_ratio_per_omega = std::max(damping_ratio_per_omega, 0.5 * law_.damping() / k_eff);
+    }
+    const double omega2 = *std::max_element(row_bound_.begin(), row_bound_.end());
+    if (!(omega2 > 0.0)) return INFINITY;
+    const double omega = std::sqrt(omega2), xi = damping_ratio_per_omega * omega;
+    return 2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi);
+}
+
+void SpringBody::write_vtu(const std::string& path) const {
+    VtuFrame frame;
+    frame.points = x.data();
+    frame.point_count = node_count();
+    frame.cells = springs_.data();
+    frame.cell_count = element_count();
+    frame.nodes_per_cell = 2;
+    frame.point_vectors = v.data();
+    frame.point_vectors_name = "velocity";
+    sh::write_vtu(path, frame);
+}
+
+}  // namespace sh

@@ -1,0 +1,31 @@
+// SpringBody: a mass-spring network with one spring law for all its springs.
+#pragma once
+
+#include "material/spring_laws.hpp"
+#include "model/body.hpp"
+
+namespace sh {
+
+/// Mass-spring body. Rest lengths are the initial lengths.
+class SpringBody final : public Body {
+public:
+    /// nodes: 3 per node; springs: 2 node indices per spring; masses: one per node (> 0).
+    /// Throws SH_ERR_INVALID_ARGUMENT naming the spring or node that is invalid.
+    SpringBody(vec<double> nodes, vec<int32_t> springs, const sh_spring_params& params, const vec<double>& masses,
+               IntegrationSettings settings);
+
+    void add_internal_forces(const double* x, const double* v, double* f) const override;
+    double elastic_energy(const double* x) const override;
+    double stable_step(const double* x) const override;
+    int32_t element_count() const override { return static_cast<int32_t>(rest_length_.size()); }
+    bool is_fem() const override { return false; }
+    void write_vtu(const std::string& path) const override;
+
+private:
+    vec<int32_t> springs_;      ///< 2 per spring
+    vec<double> rest_length_;   ///< l0 per spring (m)
+    SpringLaw law_;
+    mutable vec<double> row_bound_;  ///< stable_step scratch: Gershgorin row sums per node
+};
+
+}  // namespace sh

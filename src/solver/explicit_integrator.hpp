@@ -1,0 +1,26 @@
+// Explicit time stepping of one body: forward Euler, symplectic Euler, RK2, RK4, with the
+// critical-step policy (reject or sub-step) and rollback of non-finite or runaway states.
+#pragma once
+
+#include "model/body.hpp"
+
+#include <cstdint>
+
+namespace sh {
+
+/// What step_explicit did.
+struct BodyStepResult {
+    bool stable = true;       ///< false: the body was left exactly as before the call
+    bool rejected = false;    ///< dt exceeded dt_crit under SH_UNSTABLE_REJECT
+    int32_t substeps = 1;     ///< sub-steps taken
+    double dt_critical = 0.0; ///< the body's critical step at the start (s)
+};
+
+/// Advances body by dt (s) under gravity (m/s^2). Allocation-free.
+BodyStepResult step_explicit(Body& body, double dt, const double gravity[3]);
+
+/// Accelerations a (3 per node) at state (x, v): internal, external and gravity forces over
+/// mass, minus viscous damping; zero for fixed, prescribed and orphan nodes.
+void compute_accelerations(const Body& body, const double* x, const double* v, const double gravity[3], double* a);
+
+}  // namespace sh

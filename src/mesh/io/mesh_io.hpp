@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 namespace sh {
 
@@ -14,6 +15,21 @@ namespace sh {
 /// skipped and counted. Throws SH_ERR_IO (cannot open/read), SH_ERR_PARSE ("file:line: what"),
 /// SH_ERR_UNSUPPORTED (binary or unknown format). Does not validate geometry.
 MeshData load_mesh_file(const std::string& path);
+
+/// Per-format readers behind load_mesh_file. text is the file's content; path names it in
+/// messages. Same errors as load_mesh_file.
+
+/// Gmsh .msh: version 1 ($NOD/$ELM), 2.x ASCII and 4.1 ASCII; node tags map to file order.
+MeshData read_gmsh(const std::string& path, std::string_view text);
+
+/// Legacy VTK ASCII UNSTRUCTURED_GRID (classic CELLS and the 5.1 OFFSETS/CONNECTIVITY form).
+MeshData read_vtk_legacy(const std::string& path, std::string_view text);
+
+/// VTK XML UnstructuredGrid with ascii DataArrays; header counts must match the data.
+MeshData read_vtu(const std::string& path, std::string_view text);
+
+/// TetGen .node + .ele: path is either file (text its content); the other is read beside it.
+MeshData read_tetgen(const std::string& path, std::string_view text);
 
 /// What write_vtu writes: points and cells of one kind, plus optional per-point 3-vectors.
 struct VtuFrame {

@@ -1,6 +1,7 @@
 """Loading the C library: lookup order, version check, status names, Error, freeing handles."""
 
 import os
+import pickle
 import shutil
 
 import pytest
@@ -133,6 +134,8 @@ def test_error_carries_status_name_and_message(meshes):
     assert error.message  # the C library's detail
     assert "SH_ERR_IO" in str(error) and error.message in str(error)
     assert error.report is None
+    copy = pickle.loads(pickle.dumps(error))  # e.g. across multiprocessing
+    assert (copy.status, copy.message, copy.function) == (error.status, error.message, error.function)
 
 
 _HANDLE_FREEING = r"""

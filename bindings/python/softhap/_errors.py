@@ -36,6 +36,10 @@ class Error(Exception):
         self.report = report
         super().__init__(self._describe())
 
+    def __reduce__(self):
+        """Pickle support (for multiprocessing): rebuild from the same fields."""
+        return (type(self), (int(self.status), self.message, self.function, self.report))
+
     def _describe(self):
         where = "%s: " % self.function if self.function else ""
         if self.message:

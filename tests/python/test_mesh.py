@@ -213,3 +213,32 @@ def test_closed_mesh_raises_instead_of_crashing(meshes):
     with softhap.World() as world, pytest.raises(softhap.Error):
         world.add_fem_body(mesh)
     assert "closed" in repr(mesh)
+
+
+def test_gmsh4_unit_cube_has_unit_volume(meshes):
+    info = softhap.Mesh.load(meshes / "msh4_cube.msh").info
+    assert info.volume == pytest.approx(1.0, rel=1e-9)
+    assert info.bounds_min == pytest.approx((0.0, 0.0, 0.0), abs=1e-12)
+    assert info.bounds_max == pytest.approx((1.0, 1.0, 1.0), abs=1e-12)
+
+
+def test_single_tetra_volume_by_hand(meshes):
+    # nodes (5,5,0) (0,5,0) (0,0,0) (2.5,3.5,-3): |det[(-5,0,0), (-5,-5,0), (-2.5,-1.5,-3)]| / 6
+    info = softhap.Mesh.load(meshes / "single_tetra.msh").info
+    assert info.volume == pytest.approx(75.0 / 6.0, rel=1e-14)
+
+
+def test_legacy_vtk_and_tetgen_files(tmp_path):
+    vtk = tmp_path / "tet.vtk"
+    vtk.write_text(
+        "# vtk DataFile Version 3.0\none tet\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+        "POINTS 4 double\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+        "CELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n10\n"
+    )
+    node = tmp_path / "tet.node"
+    node.write_text("4 3 0 0\n1 0 0 0\n2 2 0 0\n3 0 2 0\n4 0 0 2\n")
+    (tmp_path / "tet.ele").write_text("1 4 0\n1 1 2 3 4\n")
+    for path, volume in [(vtk, 1.0 / 6.0), (node, 8.0 / 6.0), (tmp_path / "tet.ele", 8.0 / 6.0)]:
+        info = softhap.Mesh.load(path).info
+        assert (info.node_count, info.tet_count) == (4, 1), path
+        assert info.volume == pytest.approx(volume, rel=1e-14), path

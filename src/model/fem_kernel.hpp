@@ -38,21 +38,21 @@ void add_fem_forces(const TetBlock* blocks, size_t block_count, const double* x,
             const Mat3L dF = mul(gather_edges(b, v), b.Bm);
             P = combine(splat(1.0), P, splat(beta), Material::differential(F, state, dF, b.lambda, b.mu));
         }
-        const Mat3L H = mul_nt(P, b.Bm);  // H[i][a]: component i of the force on node a+1, / -V0
-        for (int l = 0; l < kLanes; ++l) {
-            const double w = -b.volume[l];
-            double f0[3] = {0, 0, 0};
+        const Mat3L H = mul_nt(P, b.Bm);
+        const Lanes w = -b.volume;
+        Lanes node_force[4][3];
+        for (int i = 0; i < 3; ++i) {
+            node_force[0][i] = Lanes{};
             for (int a = 1; a < 4; ++a) {
-                double* fa = f + 3 * b.node[a][l];
-                for (int i = 0; i < 3; ++i) {
-                    const double h = w * H.m[i][a - 1][l];
-                    fa[i] += h;
-                    f0[i] -= h;
-                }
+                node_force[a][i] = w * H.m[i][a - 1];
+                node_force[0][i] -= node_force[a][i];
             }
-            double* fn0 = f + 3 * b.node[0][l];
-            for (int i = 0; i < 3; ++i) fn0[i] += f0[i];
         }
+        for (int l = 0; l < kLanes; ++l)
+            for (int a = 0; a < 4; ++a) {
+                double* fa = f + 3 * b.node[a][l];
+                for (int i = 0; i < 3; ++i) fa[i] += node_force[a][i][l];
+            }
     }
 }
 

@@ -412,3 +412,58 @@ def test_steps_below_the_critical_dt_stay_bounded():
             assert report.substeps == 1
             worst = max(worst, np.abs(body.positions - start).max())
         assert worst < 1e-2  # bounded oscillation, not exponential growth
+
+
+def test_neohookean_matches_linear_elasticity_at_small_strain():
+    strain = 1e-6
+    expected, _ = uniaxial_forces("linear", 1e4, 0.3, strain)
+    with softhap.World() as world:
+        body = world.add_fem_body(unit_tet_mesh(), model="neohookean", young=1e4, poisson=0.3)
+        stretched = UNIT_TET.copy()
+        stretched[:, 0] *= 1.0 + strain
+        body.positions = stretched
+        np.testing.assert_allclose(body.elastic_forces(), expected, rtol=1e-4, atol=1e-6 * np.abs(expected).max())
+
+
+def test_stiffness_damping_lowers_the_critical_dt():
+    # Central differences with damping ratio xi = beta omega / 2 are stable up to
+    # dt = 2 / omega (sqrt(1 + xi^2) - xi) (Belytschko, Liu & Moran, Nonlinear FE, 6.3).
+    beta = 0.02
+    omega = linear_tet_frequency_max(UNIT_TET, 1e4, 0.3, 1000.0)
+    xi = beta * omega / 2.0
+    with softhap.World() as world:
+        body = world.add_fem_body(unit_tet_mesh(), young=1e4, poisson=0.3, damping_stiffness=beta)
+        assert body.critical_dt == pytest.approx(2.0 / omega * (math.sqrt(1 + xi * xi) - xi), rel=1e-9)
+
+
+def total_energy_after(beta, steps=200):
+    with softhap.World(gravity=(0.0, 0.0, 0.0)) as world:
+        body = world.add_fem_body(
+            unit_tet_mesh(), model="corotational", young=1e4, poisson=0.3, damping_stiffness=beta
+        )
+        stretched = UNIT_TET.copy()
+        stretched[1, 0] += 0.01
+        body.positions = stretched
+        initial = body.elastic_energy()
+        dt = 0.5 * body.critical_dt
+        for _ in range(steps):
+            report = world.step(dt)
+        return (report.kinetic_energy + report.elastic_energy) / initial
+
+
+def test_stiffness_damping_dissipates_vibration():
+    assert total_energy_after(0.0) > 0.5  # symplectic Euler: no dissipation
+    assert total_energy_after(0.05) < 0.05
+
+
+def test_inverted_element_raises_a_warning():
+    with softhap.World(gravity=(0.0, 0.0, 0.0)) as world:
+        body = world.add_fem_body(unit_tet_mesh(), model="neohookean", young=1e4, poisson=0.3)
+        inverted = UNIT_TET.copy()
+        inverted[3, 2] = -0.2  # node 3 pushed through the opposite face
+        body.positions = inverted
+        report = world.step(0.1 * body.critical_dt)
+        assert "SH_WARN_INVERTED" in report.warnings
+        assert report.warning_bits & (1 << softhap.WarningKind.SH_WARN_INVERTED)
+        assert world.warnings["SH_WARN_INVERTED"] >= 1
+        assert np.all(np.isfinite(body.positions))

@@ -25,6 +25,7 @@ class Error(Exception):
     """
 
     def __init__(self, status, message, function=None, report=None):
+        """Make an error for status (an sh_status value) with the given detail message."""
         try:
             status = Status(status)
         except ValueError:

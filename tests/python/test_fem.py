@@ -467,3 +467,23 @@ def test_inverted_element_raises_a_warning():
         assert report.warning_bits & (1 << softhap.WarningKind.SH_WARN_INVERTED)
         assert world.warnings["SH_WARN_INVERTED"] >= 1
         assert np.all(np.isfinite(body.positions))
+
+
+def test_defaults_are_the_documented_c_defaults():
+    # sh_fem_body_def_default: StVK, E = 3 kPa, nu = 0.45, rho = 1000 kg/m^3, symplectic Euler
+    stretched = UNIT_TET.copy()
+    stretched[:, 0] *= 1.1
+    with softhap.World() as world:
+        default = world.add_fem_body(unit_tet_mesh())
+        explicit = world.add_fem_body(
+            unit_tet_mesh(), model="stvk", young=3000.0, poisson=0.45, density=1000.0,
+            integrator="symplectic_euler", on_unstable="substep", damping_mass=0.0,
+            damping_stiffness=0.0, runaway_speed=1e4,
+        )
+        assert default.info.total_mass == pytest.approx(1000.0 / 6.0, rel=1e-14)
+        assert default.critical_dt == explicit.critical_dt
+        default.positions = stretched
+        explicit.positions = stretched
+        np.testing.assert_array_equal(default.elastic_forces(), explicit.elastic_forces())
+        expected, _ = uniaxial_forces("stvk", 3000.0, 0.45, 0.1)
+        np.testing.assert_allclose(default.elastic_forces(), expected, rtol=1e-10)

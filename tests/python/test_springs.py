@@ -335,3 +335,11 @@ def test_spring_body_shape_errors_are_value_errors():
             world.add_spring_body([[0, 0, 0], [1, 0, 0]], springs=[0, 1])
         with pytest.raises(ValueError):
             world.add_spring_body([[0, 0, 0], [1, 0, 0]], springs=[[0, 1]], law="table", table=[1, 2, 3])
+
+
+def test_spring_defaults_are_the_documented_c_defaults():
+    # sh_spring_body_def_default: linear springs k = 100 N/m, node mass 1 g
+    with softhap.World() as world:
+        body = spring_pair(world, 0.1, l0=0.2)
+        assert_tension(body, 100.0 * 0.02)
+        np.testing.assert_array_equal(body.masses, [1e-3, 1e-3])

@@ -4,6 +4,7 @@
 #include "solver/explicit_integrator.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -12,6 +13,16 @@ namespace {
 
 uint32_t slot_of(sh_body_id id) { return static_cast<uint32_t>(id & 0xffffffffu) - 1u; }
 uint32_t generation_of(sh_body_id id) { return static_cast<uint32_t>(id >> 32); }
+
+// Generations come from one counter shared by all worlds, so an id is never valid in a world
+// other than the one that issued it.
+std::atomic<uint32_t> g_next_generation{1};
+
+uint32_t next_generation() {
+    uint32_t g = g_next_generation.fetch_add(1);
+    while (g == 0) g = g_next_generation.fetch_add(1);
+    return g;
+}
 
 }  // namespace
 
@@ -39,7 +50,7 @@ sh_body_id World::add_body(Body* body) {
     }
     Slot& slot = slots_[index];
     slot.body = body;
-    slot.generation = slot.generation + 1 == 0 ? 1 : slot.generation + 1;
+    slot.generation = next_generation();
     return (static_cast<uint64_t>(slot.generation) << 32) | (static_cast<uint64_t>(index) + 1);
 }
 

@@ -1,0 +1,1223 @@
+/* API misuse through the public C API: every misuse returns its exact status code, the
+ * last-error message names the culprit, and a failed call changes nothing. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+
+#include "test_support.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------------------------ */
+/* Helpers                                                                                      */
+
+/* Asserts that expr returns status and that the last-error message contains needle. */
+#define assert_error(expr, status, needle) \
+    check_error((expr), (status), (needle), #expr, __FILE__, __LINE__)
+
+static void check_error(sh_status got, sh_status expected, const char* needle, const char* expr,
+                        const char* file, int line) {
+    sh_test_assert_status(got, expected, expr, file, line);
+    const char* message = sh_last_error_message();
+    if (!message || !strstr(message, needle)) {
+        print_error("%s:%d: %s: last error \"%s\" does not mention \"%s\"\n", file, line, expr,
+                    message ? message : "(NULL)", needle);
+        _fail(file, line);
+    }
+}
+
+/* Asserts the last-error message is the empty string (the previous call succeeded). */
+static void assert_no_error_message(void) {
+    const char* message = sh_last_error_message();
+    assert_non_null(message);
+    assert_string_equal(message, "");
+}
+
+/* A world with default gravity. */
+static sh_world* make_world(void) {
+    sh_world_def def;
+    sh_world_def_default(&def);
+    sh_world* world = NULL;
+    assert_ok(sh_world_create(&def, &world));
+    assert_non_null(world);
+    return world;
+}
+
+/* An FEM body from mesh with default def. */
+static sh_body_id add_fem(sh_world* world, const sh_mesh* mesh) {
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    sh_body_id id = SH_NULL_BODY;
+    assert_ok(sh_world_add_fem_body(world, &def, &id));
+    assert_true(id != SH_NULL_BODY);
+    return id;
+}
+
+/* A spring body of two nodes 1 cm apart joined by one spring. */
+static sh_body_id add_two_node_spring(sh_world* world) {
+    static const double nodes[6] = {0, 0, 0, 0.01, 0, 0};
+    static const int32_t springs[2] = {0, 1};
+    sh_spring_body_def def;
+    sh_spring_body_def_default(&def);
+    def.nodes = nodes;
+    def.node_count = 2;
+    def.springs = springs;
+    def.spring_count = 1;
+    sh_body_id id = SH_NULL_BODY;
+    assert_ok(sh_world_add_spring_body(world, &def, &id));
+    assert_true(id != SH_NULL_BODY);
+    return id;
+}
+
+static int32_t node_count_of(const sh_world* world, sh_body_id body) {
+    sh_body_info info;
+    assert_ok(sh_body_get_info(world, body, &info));
+    return info.node_count;
+}
+
+/* Heap copy of a body's positions (3n doubles); the caller frees it. */
+static double* copy_positions(const sh_world* world, sh_body_id body) {
+    const int32_t n = node_count_of(world, body);
+    double* x = malloc(sizeof(double) * 3 * (size_t)n);
+    assert_non_null(x);
+    assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)n));
+    return x;
+}
+
+static double* copy_velocities(const sh_world* world, sh_body_id body) {
+    const int32_t n = node_count_of(world, body);
+    double* v = malloc(sizeof(double) * 3 * (size_t)n);
+    assert_non_null(v);
+    assert_ok(sh_body_get_velocities(world, body, v, 3 * (int64_t)n));
+    return v;
+}
+
+/* Asserts the body's positions and velocities are bitwise equal to x and v. */
+static void assert_state_is(const sh_world* world, sh_body_id body, const double* x, const double* v) {
+    const int32_t n = node_count_of(world, body);
+    double* x_now = copy_positions(world, body);
+    double* v_now = copy_velocities(world, body);
+    assert_memory_equal(x_now, x, sizeof(double) * 3 * (size_t)n);
+    assert_memory_equal(v_now, v, sizeof(double) * 3 * (size_t)n);
+    free(x_now);
+    free(v_now);
+}
+
+/* Steps a few times so positions and velocities are non-trivial (not the rest state). */
+static void move_a_bit(sh_world* world) {
+    for (int i = 0; i < 5; ++i) assert_ok(sh_world_step(world, 1e-4, NULL));
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Version, status strings, last error                                                          */
+
+static void test_version_matches_header(void** state) {
+    (void)state;
+    assert_int_equal(sh_version(), SH_VERSION);
+    assert_int_equal(SH_VERSION, SH_VERSION_MAJOR * 1000000 + SH_VERSION_MINOR * 1000 + SH_VERSION_PATCH);
+}
+
+static void test_status_strings_non_null_and_distinct(void** state) {
+    (void)state;
+    static const struct {
+        sh_status status;
+        const char* name;
+    } codes[] = {
+        {SH_OK, "SH_OK"},
+        {SH_ERR_INVALID_ARGUMENT, "SH_ERR_INVALID_ARGUMENT"},
+        {SH_ERR_INVALID_HANDLE, "SH_ERR_INVALID_HANDLE"},
+        {SH_ERR_UNINITIALIZED_DEF, "SH_ERR_UNINITIALIZED_DEF"},
+        {SH_ERR_OUT_OF_MEMORY, "SH_ERR_OUT_OF_MEMORY"},
+        {SH_ERR_IO, "SH_ERR_IO"},
+        {SH_ERR_PARSE, "SH_ERR_PARSE"},
+        {SH_ERR_DEGENERATE_MESH, "SH_ERR_DEGENERATE_MESH"},
+        {SH_ERR_UNSTABLE, "SH_ERR_UNSTABLE"},
+        {SH_ERR_UNSUPPORTED, "SH_ERR_UNSUPPORTED"},
+        {SH_ERR_SOLVER, "SH_ERR_SOLVER"},
+        {SH_ERR_NOT_CONVERGED, "SH_ERR_NOT_CONVERGED"},
+        {SH_ERR_CAPACITY, "SH_ERR_CAPACITY"},
+        {SH_ERR_BUSY, "SH_ERR_BUSY"},
+        {SH_ERR_INTERNAL, "SH_ERR_INTERNAL"},
+    };
+    const size_t count = sizeof codes / sizeof codes[0];
+    for (size_t i = 0; i < count; ++i) {
+        assert_int_equal((int)codes[i].status, (int)i); /* the codes are 0..14, no gap */
+        const char* text = sh_status_string(codes[i].status);
+        assert_non_null(text);
+        assert_true(strlen(text) > 0);
+        /* "SH_ERR_PARSE: ...": the text starts with the code's name followed by ':' */
+        assert_int_equal(strncmp(text, codes[i].name, strlen(codes[i].name)), 0);
+        assert_int_equal(text[strlen(codes[i].name)], ':');
+        for (size_t j = 0; j < i; ++j) assert_string_not_equal(text, sh_status_string(codes[j].status));
+    }
+    /* A value outside the enum still gives static text, never NULL. */
+    assert_non_null(sh_status_string((sh_status)99));
+    assert_non_null(sh_status_string((sh_status)-1));
+}
+
+static void test_last_error_cleared_by_success(void** state) {
+    (void)state;
+    assert_error(sh_world_step(NULL, 1e-3, NULL), SH_ERR_INVALID_HANDLE, "world");
+    assert_true(strlen(sh_last_error_message()) > 0);
+    assert_int_equal(sh_version(), SH_VERSION); /* not a fallible call: does not matter */
+
+    sh_world* world = make_world();
+    assert_no_error_message();
+    assert_error(sh_world_step(world, -1.0, NULL), SH_ERR_INVALID_ARGUMENT, "dt");
+    assert_ok(sh_world_step(world, 1e-3, NULL));
+    assert_no_error_message();
+    assert_ok(sh_world_destroy(world));
+    assert_no_error_message();
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* NULL pointers                                                                                */
+
+static void test_null_out_pointers(void** state) {
+    (void)state;
+    sh_world_def world_def;
+    sh_world_def_default(&world_def);
+    assert_error(sh_world_create(&world_def, NULL), SH_ERR_INVALID_ARGUMENT, "out_world");
+
+    static const double nodes[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const int32_t tets[4] = {0, 1, 2, 3};
+    assert_error(sh_mesh_create(nodes, 4, tets, 1, NULL), SH_ERR_INVALID_ARGUMENT, "out_mesh");
+    assert_error(sh_mesh_load(SH_TEST_MESH("single_tetra.msh"), NULL), SH_ERR_INVALID_ARGUMENT, "out_mesh");
+
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    sh_fem_body_def fem;
+    sh_fem_body_def_default(&fem);
+    fem.mesh = mesh;
+    assert_error(sh_world_add_fem_body(world, &fem, NULL), SH_ERR_INVALID_ARGUMENT, "out_body");
+    sh_spring_body_def spring;
+    sh_spring_body_def_default(&spring);
+    spring.mesh = mesh;
+    assert_error(sh_world_add_spring_body(world, &spring, NULL), SH_ERR_INVALID_ARGUMENT, "out_body");
+
+    const sh_body_id body = add_fem(world, mesh);
+    assert_error(sh_mesh_get_info(mesh, NULL), SH_ERR_INVALID_ARGUMENT, "out_info");
+    assert_error(sh_mesh_get_nodes(mesh, NULL, 12), SH_ERR_INVALID_ARGUMENT, "out");
+    assert_error(sh_mesh_get_tets(mesh, NULL, 4), SH_ERR_INVALID_ARGUMENT, "out");
+    assert_error(sh_mesh_get_edges(mesh, NULL, 12), SH_ERR_INVALID_ARGUMENT, "out");
+    assert_error(sh_mesh_get_surface_triangles(mesh, NULL, 12), SH_ERR_INVALID_ARGUMENT, "out");
+    assert_error(sh_mesh_write_vtu(mesh, NULL), SH_ERR_INVALID_ARGUMENT, "path");
+    assert_error(sh_world_get_warnings(world, NULL), SH_ERR_INVALID_ARGUMENT, "out");
+    assert_error(sh_world_set_gravity(world, NULL), SH_ERR_INVALID_ARGUMENT, "gravity");
+    assert_error(sh_body_get_info(world, body, NULL), SH_ERR_INVALID_ARGUMENT, "out_info");
+    assert_error(sh_body_get_positions(world, body, NULL, 12), SH_ERR_INVALID_ARGUMENT, "out");
+    assert_error(sh_body_get_velocities(world, body, NULL, 12), SH_ERR_INVALID_ARGUMENT, "out");
+    assert_error(sh_body_get_masses(world, body, NULL, 4), SH_ERR_INVALID_ARGUMENT, "out");
+    assert_error(sh_body_get_elastic_forces(world, body, NULL, 12), SH_ERR_INVALID_ARGUMENT, "out");
+    assert_error(sh_body_get_elastic_energy(world, body, NULL), SH_ERR_INVALID_ARGUMENT, "out_energy");
+    assert_error(sh_body_write_vtu(world, body, NULL), SH_ERR_INVALID_ARGUMENT, "path");
+    /* NULL input arrays */
+    assert_error(sh_body_set_positions(world, body, NULL, 4), SH_ERR_INVALID_ARGUMENT, "positions");
+    assert_error(sh_body_set_velocities(world, body, NULL, 4), SH_ERR_INVALID_ARGUMENT, "velocities");
+    assert_error(sh_body_fix_nodes(world, body, NULL, 1), SH_ERR_INVALID_ARGUMENT, "nodes");
+    assert_error(sh_body_release_nodes(world, body, NULL, 1), SH_ERR_INVALID_ARGUMENT, "nodes");
+    const int32_t node0 = 0;
+    assert_error(sh_body_prescribe_positions(world, body, &node0, NULL, 1), SH_ERR_INVALID_ARGUMENT, "positions");
+    assert_error(sh_body_set_material(world, body, NULL, 1, &fem.material), SH_ERR_INVALID_ARGUMENT, "elements");
+    assert_error(sh_body_set_material(world, body, &node0, 1, NULL), SH_ERR_INVALID_ARGUMENT, "material");
+    /* count 0 with a NULL array is a valid empty request */
+    assert_ok(sh_body_fix_nodes(world, body, NULL, 0));
+    /* NULL external forces and node damping are documented as "clear" */
+    assert_ok(sh_body_set_external_forces(world, body, NULL, 0));
+    assert_ok(sh_body_set_node_damping(world, body, NULL, 0));
+
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+static void test_null_defs(void** state) {
+    (void)state;
+    sh_world* out_world = (sh_world*)&out_world; /* non-NULL garbage: must be reset to NULL */
+    assert_error(sh_world_create(NULL, &out_world), SH_ERR_INVALID_ARGUMENT, "def");
+    assert_null(out_world);
+
+    sh_world* world = make_world();
+    sh_body_id id = 42;
+    assert_error(sh_world_add_fem_body(world, NULL, &id), SH_ERR_INVALID_ARGUMENT, "def");
+    assert_true(id == SH_NULL_BODY);
+    id = 42;
+    assert_error(sh_world_add_spring_body(world, NULL, &id), SH_ERR_INVALID_ARGUMENT, "def");
+    assert_true(id == SH_NULL_BODY);
+
+    /* A def without its mesh: the capi reports a NULL def->mesh as an invalid argument. */
+    sh_fem_body_def fem;
+    sh_fem_body_def_default(&fem);
+    id = 42;
+    assert_error(sh_world_add_fem_body(world, &fem, &id), SH_ERR_INVALID_ARGUMENT, "mesh");
+    assert_true(id == SH_NULL_BODY);
+
+    /* A spring body with neither nodes nor mesh. */
+    sh_spring_body_def spring;
+    sh_spring_body_def_default(&spring);
+    assert_error(sh_world_add_spring_body(world, &spring, &id), SH_ERR_INVALID_ARGUMENT, "NULL");
+    assert_true(id == SH_NULL_BODY);
+    assert_ok(sh_world_destroy(world));
+
+    /* sh_*_def_default(NULL) must not crash. */
+    sh_world_def_default(NULL);
+    sh_fem_body_def_default(NULL);
+    sh_spring_body_def_default(NULL);
+}
+
+static void test_null_handles(void** state) {
+    (void)state;
+    sh_fem_body_def fem;
+    sh_fem_body_def_default(&fem);
+    sh_spring_body_def spring;
+    sh_spring_body_def_default(&spring);
+    double buffer[12];
+    int32_t ibuffer[12];
+    uint64_t warnings[SH_WARN_COUNT];
+    sh_body_info info;
+    sh_mesh_info mesh_info;
+    sh_step_report report;
+    double energy;
+    const double gravity[3] = {0, 0, -9.81};
+    const sh_body_id body = ((uint64_t)1 << 32) | 1; /* what a first body id would look like */
+    sh_body_id id = 42;
+
+    assert_error(sh_world_step(NULL, 1e-3, &report), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_step(NULL, 1e-3, NULL), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_set_gravity(NULL, gravity), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_get_warnings(NULL, warnings), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_add_fem_body(NULL, &fem, &id), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_add_spring_body(NULL, &spring, &id), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_remove_body(NULL, body), SH_ERR_INVALID_HANDLE, "world");
+    assert_int_equal(sh_body_is_valid(NULL, body), 0);
+    assert_error(sh_body_get_info(NULL, body, &info), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_get_positions(NULL, body, buffer, 12), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_get_velocities(NULL, body, buffer, 12), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_get_masses(NULL, body, buffer, 12), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_set_positions(NULL, body, buffer, 4), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_get_elastic_energy(NULL, body, &energy), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_write_vtu(NULL, body, "x.vtu"), SH_ERR_INVALID_HANDLE, "world");
+
+    assert_error(sh_mesh_get_info(NULL, &mesh_info), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_mesh_get_nodes(NULL, buffer, 12), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_mesh_get_tets(NULL, ibuffer, 12), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_mesh_get_edges(NULL, ibuffer, 12), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_mesh_get_surface_triangles(NULL, ibuffer, 12), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_mesh_write_vtu(NULL, "x.vtu"), SH_ERR_INVALID_HANDLE, "mesh");
+
+    /* Destroying NULL is a documented no-op. */
+    assert_ok(sh_world_destroy(NULL));
+    assert_ok(sh_mesh_destroy(NULL));
+}
+
+/* A pointer that was never returned by softhap (a stack object cast to the opaque type) is
+ * rejected by the handle registry without being dereferenced. */
+static void test_foreign_pointers(void** state) {
+    (void)state;
+    double fake[64];
+    memset(fake, 0, sizeof fake);
+    sh_mesh_info info;
+    assert_error(sh_world_step((sh_world*)fake, 1e-3, NULL), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_mesh_get_info((const sh_mesh*)fake, &info), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_world_destroy((sh_world*)fake), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_mesh_destroy((sh_mesh*)fake), SH_ERR_INVALID_HANDLE, "mesh");
+
+    /* A world passed where a mesh is expected (and vice versa) is the wrong kind of handle. */
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    assert_error(sh_mesh_get_info((const sh_mesh*)world, &info), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_world_step((sh_world*)mesh, 1e-3, NULL), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_mesh_destroy((sh_mesh*)world), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_world_destroy((sh_world*)mesh), SH_ERR_INVALID_HANDLE, "world");
+    assert_ok(sh_world_step(world, 1e-3, NULL)); /* both still alive */
+    assert_ok(sh_mesh_get_info(mesh, &info));
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Destroyed objects (the pointers are only passed back to softhap, never dereferenced)         */
+
+static void test_destroyed_world(void** state) {
+    (void)state;
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    sh_world* world = make_world();
+    const sh_body_id body = add_fem(world, mesh);
+    assert_ok(sh_world_destroy(world));
+
+    sh_fem_body_def fem;
+    sh_fem_body_def_default(&fem);
+    fem.mesh = mesh;
+    sh_body_id id = 42;
+    double buffer[12];
+    const double gravity[3] = {0, 0, -1};
+    assert_error(sh_world_destroy(world), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_step(world, 1e-3, NULL), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_set_gravity(world, gravity), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_add_fem_body(world, &fem, &id), SH_ERR_INVALID_HANDLE, "world");
+    assert_int_equal(sh_body_is_valid(world, body), 0);
+    assert_error(sh_body_get_positions(world, body, buffer, 12), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_world_remove_body(world, body), SH_ERR_INVALID_HANDLE, "world");
+    assert_ok(sh_mesh_destroy(mesh));
+}
+
+static void test_destroyed_mesh(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    /* A body copies what it needs: the mesh may be destroyed after the body is made. */
+    const sh_body_id body = add_fem(world, mesh);
+    assert_ok(sh_mesh_destroy(mesh));
+
+    sh_mesh_info info;
+    double nodes[12];
+    assert_error(sh_mesh_destroy(mesh), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_mesh_get_info(mesh, &info), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_mesh_get_nodes(mesh, nodes, 12), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_error(sh_mesh_write_vtu(mesh, "never_written.vtu"), SH_ERR_INVALID_HANDLE, "mesh");
+
+    sh_fem_body_def fem;
+    sh_fem_body_def_default(&fem);
+    fem.mesh = mesh;
+    sh_body_id id = 42;
+    assert_error(sh_world_add_fem_body(world, &fem, &id), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_true(id == SH_NULL_BODY);
+    sh_spring_body_def spring;
+    sh_spring_body_def_default(&spring);
+    spring.mesh = mesh;
+    id = 42;
+    assert_error(sh_world_add_spring_body(world, &spring, &id), SH_ERR_INVALID_HANDLE, "mesh");
+    assert_true(id == SH_NULL_BODY);
+
+    /* The body made from it still works. */
+    for (int i = 0; i < 10; ++i) assert_ok(sh_world_step(world, 1e-3, NULL));
+    assert_ok(sh_body_get_positions(world, body, nodes, 12));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Body ids                                                                                     */
+
+static void test_stale_body_ids(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    const sh_body_id keeper = add_fem(world, mesh); /* another body that must stay untouched */
+    sh_body_id old_ids[8];
+    sh_body_id body = add_fem(world, mesh);
+    double buffer[12];
+    sh_body_info info;
+    const int32_t node0 = 0;
+
+    for (int round = 0; round < 8; ++round) {
+        assert_int_equal(sh_body_is_valid(world, body), 1);
+        assert_ok(sh_world_remove_body(world, body));
+        assert_int_equal(sh_body_is_valid(world, body), 0);
+        assert_error(sh_world_remove_body(world, body), SH_ERR_INVALID_HANDLE, "body");
+        assert_error(sh_body_get_info(world, body, &info), SH_ERR_INVALID_HANDLE, "body");
+        assert_error(sh_body_get_positions(world, body, buffer, 12), SH_ERR_INVALID_HANDLE, "body");
+        assert_error(sh_body_set_positions(world, body, buffer, 4), SH_ERR_INVALID_HANDLE, "body");
+        assert_error(sh_body_fix_nodes(world, body, &node0, 1), SH_ERR_INVALID_HANDLE, "body");
+        assert_error(sh_body_write_vtu(world, body, "never_written.vtu"), SH_ERR_INVALID_HANDLE, "body");
+        old_ids[round] = body;
+
+        /* A new body goes into the freed slot, with a new id; every old id stays invalid. */
+        body = add_fem(world, mesh);
+        assert_int_equal(sh_body_is_valid(world, body), 1);
+        for (int k = 0; k <= round; ++k) {
+            assert_true(body != old_ids[k]);
+            assert_int_equal(sh_body_is_valid(world, old_ids[k]), 0);
+            assert_error(sh_body_get_info(world, old_ids[k], &info), SH_ERR_INVALID_HANDLE, "body");
+        }
+        assert_true(body != keeper);
+        assert_int_equal(sh_body_is_valid(world, keeper), 1);
+    }
+    assert_ok(sh_world_step(world, 1e-3, NULL));
+    assert_ok(sh_body_get_info(world, keeper, &info));
+    assert_int_equal(info.node_count, 4);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+static void test_null_and_garbage_body_ids(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    const sh_body_id body = add_fem(world, mesh);
+    double buffer[12];
+    sh_body_info info;
+
+    assert_int_equal(sh_body_is_valid(world, SH_NULL_BODY), 0);
+    assert_error(sh_body_get_info(world, SH_NULL_BODY, &info), SH_ERR_INVALID_HANDLE, "body");
+    assert_error(sh_body_get_positions(world, SH_NULL_BODY, buffer, 12), SH_ERR_INVALID_HANDLE, "body");
+    assert_error(sh_world_remove_body(world, SH_NULL_BODY), SH_ERR_INVALID_HANDLE, "body");
+
+    const sh_body_id garbage[] = {
+        body + 1,                         /* next slot, never used */
+        body ^ ((uint64_t)1 << 32),       /* same slot, other generation */
+        body + ((uint64_t)1 << 32),       /* same slot, future generation */
+        body & 0xffffffffu,               /* same slot, generation 0 */
+        UINT64_MAX,
+        (uint64_t)1 << 63,
+        0xffffffffu,
+    };
+    for (size_t i = 0; i < sizeof garbage / sizeof garbage[0]; ++i) {
+        if (garbage[i] == body) continue;
+        assert_int_equal(sh_body_is_valid(world, garbage[i]), 0);
+        assert_error(sh_body_get_info(world, garbage[i], &info), SH_ERR_INVALID_HANDLE, "body");
+        assert_error(sh_world_remove_body(world, garbage[i]), SH_ERR_INVALID_HANDLE, "body");
+    }
+    assert_int_equal(sh_body_is_valid(world, body), 1);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* The id of a body of world A names no body of an empty world B. */
+static void test_body_id_of_another_empty_world(void** state) {
+    (void)state;
+    sh_world* a = make_world();
+    sh_world* b = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    const sh_body_id body_a = add_fem(a, mesh);
+    double buffer[12];
+    sh_body_info info;
+    assert_int_equal(sh_body_is_valid(b, body_a), 0);
+    assert_error(sh_body_get_info(b, body_a, &info), SH_ERR_INVALID_HANDLE, "body");
+    assert_error(sh_body_get_positions(b, body_a, buffer, 12), SH_ERR_INVALID_HANDLE, "body");
+    assert_error(sh_world_remove_body(b, body_a), SH_ERR_INVALID_HANDLE, "body");
+    assert_int_equal(sh_body_is_valid(a, body_a), 1);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(a));
+    assert_ok(sh_world_destroy(b));
+}
+
+/* The id of a body of world A names no body of world B either when B has bodies of its own:
+ * sh_body_is_valid is "1 if body is a live body of world", and a removed-from-B call must
+ * not remove B's own body. */
+static void test_body_id_of_another_populated_world(void** state) {
+    (void)state;
+    sh_world* a = make_world();
+    sh_world* b = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    const sh_body_id body_a = add_fem(a, mesh);
+    const sh_body_id body_b = add_fem(b, mesh);
+    sh_body_info info;
+    assert_int_equal(sh_body_is_valid(b, body_b), 1);
+    assert_int_equal(sh_body_is_valid(b, body_a), 0);
+    assert_error(sh_body_get_info(b, body_a, &info), SH_ERR_INVALID_HANDLE, "body");
+    assert_error(sh_world_remove_body(b, body_a), SH_ERR_INVALID_HANDLE, "body");
+    assert_int_equal(sh_body_is_valid(b, body_b), 1);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(a));
+    assert_ok(sh_world_destroy(b));
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Uninitialised defs                                                                           */
+
+static void test_uninitialized_defs(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    static const double nodes[6] = {0, 0, 0, 0.01, 0, 0};
+    static const int32_t springs[2] = {0, 1};
+    const unsigned char fills[] = {0x00, 0xab, 0xff, 0x53};
+
+    for (size_t f = 0; f < sizeof fills; ++f) {
+        sh_world_def world_def;
+        memset(&world_def, fills[f], sizeof world_def);
+        sh_world* out_world = (sh_world*)&out_world;
+        assert_error(sh_world_create(&world_def, &out_world), SH_ERR_UNINITIALIZED_DEF, "def");
+        assert_null(out_world);
+
+        /* Every other field valid: only the missing default call is wrong. */
+        sh_fem_body_def fem;
+        memset(&fem, fills[f], sizeof fem);
+        fem.mesh = mesh;
+        fem.material.model = SH_MATERIAL_STVK;
+        fem.material.young = 1e4;
+        fem.material.poisson = 0.3;
+        fem.material.density = 1000;
+        fem.integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
+        fem.on_unstable = SH_UNSTABLE_SUBSTEP;
+        fem.damping_mass = 0;
+        fem.damping_stiffness = 0;
+        fem.runaway_speed = 1e4;
+        sh_body_id id = 42;
+        assert_error(sh_world_add_fem_body(world, &fem, &id), SH_ERR_UNINITIALIZED_DEF, "def");
+        assert_true(id == SH_NULL_BODY);
+
+        sh_spring_body_def spring;
+        memset(&spring, fills[f], sizeof spring);
+        spring.nodes = nodes;
+        spring.node_count = 2;
+        spring.springs = springs;
+        spring.spring_count = 1;
+        spring.mesh = NULL;
+        memset(&spring.params, 0, sizeof spring.params);
+        spring.params.law = SH_SPRING_LINEAR;
+        spring.params.stiffness = 100;
+        spring.node_mass = 1e-3;
+        spring.node_masses = NULL;
+        spring.integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
+        spring.on_unstable = SH_UNSTABLE_SUBSTEP;
+        spring.damping_mass = 0;
+        spring.runaway_speed = 1e4;
+        id = 42;
+        assert_error(sh_world_add_spring_body(world, &spring, &id), SH_ERR_UNINITIALIZED_DEF, "def");
+        assert_true(id == SH_NULL_BODY);
+    }
+    /* A def copied from a defaulted one is initialised (create copies, keeps no pointer). */
+    sh_fem_body_def a, b;
+    sh_fem_body_def_default(&a);
+    a.mesh = mesh;
+    b = a;
+    sh_body_id id;
+    assert_ok(sh_world_add_fem_body(world, &b, &id));
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Materials                                                                                    */
+
+typedef struct bad_material {
+    double young, poisson, density;
+    const char* needle;
+} bad_material;
+
+static const bad_material k_bad_materials[] = {
+    {0.0, 0.3, 1000, "young"},
+    {-1e4, 0.3, 1000, "young"},
+    {NAN, 0.3, 1000, "young"},
+    {INFINITY, 0.3, 1000, "young"},
+    {-INFINITY, 0.3, 1000, "young"},
+    {1e4, 0.5, 1000, "poisson"},
+    {1e4, 0.6, 1000, "poisson"},
+    {1e4, -1.0, 1000, "poisson"},
+    {1e4, -1.5, 1000, "poisson"},
+    {1e4, NAN, 1000, "poisson"},
+    {1e4, INFINITY, 1000, "poisson"},
+    {1e4, 0.3, 0.0, "density"},
+    {1e4, 0.3, -1000, "density"},
+    {1e4, 0.3, NAN, "density"},
+    {1e4, 0.3, INFINITY, "density"},
+};
+
+static void test_material_validation_in_def(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    for (size_t i = 0; i < sizeof k_bad_materials / sizeof k_bad_materials[0]; ++i) {
+        const bad_material* m = &k_bad_materials[i];
+        for (int model = SH_MATERIAL_LINEAR; model <= SH_MATERIAL_NEOHOOKEAN; ++model) {
+            sh_fem_body_def def;
+            sh_fem_body_def_default(&def);
+            def.mesh = mesh;
+            def.material.model = (sh_material_model)model;
+            def.material.young = m->young;
+            def.material.poisson = m->poisson;
+            def.material.density = m->density;
+            sh_body_id id = 42;
+            assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, m->needle);
+            assert_true(id == SH_NULL_BODY);
+        }
+    }
+    /* Boundary values just inside the admissible ranges are accepted. */
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.material.poisson = 0.4999;
+    sh_body_id id;
+    assert_ok(sh_world_add_fem_body(world, &def, &id));
+    def.material.poisson = -0.9999;
+    assert_ok(sh_world_add_fem_body(world, &def, &id));
+
+    /* Unknown model, integrator, policy; bad damping and runaway speed. */
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.material.model = (sh_material_model)17;
+    assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, "model");
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.integrator = (sh_integrator)9;
+    assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, "integrator");
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.on_unstable = (sh_unstable_policy)5;
+    assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, "on_unstable");
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.damping_mass = -1.0;
+    assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, "damping_mass");
+    def.damping_mass = NAN;
+    assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, "damping_mass");
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.damping_stiffness = -1.0;
+    assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, "damping_stiffness");
+    def.damping_stiffness = INFINITY;
+    assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, "damping_stiffness");
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.runaway_speed = 0.0;
+    assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, "runaway_speed");
+    def.runaway_speed = NAN;
+    assert_error(sh_world_add_fem_body(world, &def, &id), SH_ERR_INVALID_ARGUMENT, "runaway_speed");
+
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+static void test_material_validation_in_set_material(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1); /* 6 tets */
+    const sh_body_id body = add_fem(world, mesh);
+    move_a_bit(world);
+    const int32_t n = node_count_of(world, body);
+    double masses_before[8], masses_after[8];
+    assert_int_equal(n, 8);
+    assert_ok(sh_body_get_masses(world, body, masses_before, n));
+    double* x = copy_positions(world, body);
+    double* v = copy_velocities(world, body);
+    double energy_before, energy_after;
+    assert_ok(sh_body_get_elastic_energy(world, body, &energy_before));
+
+    const int32_t all[6] = {0, 1, 2, 3, 4, 5};
+    for (size_t i = 0; i < sizeof k_bad_materials / sizeof k_bad_materials[0]; ++i) {
+        const sh_material m = {SH_MATERIAL_STVK, k_bad_materials[i].young, k_bad_materials[i].poisson,
+                               k_bad_materials[i].density};
+        assert_error(sh_body_set_material(world, body, all, 6, &m), SH_ERR_INVALID_ARGUMENT,
+                     k_bad_materials[i].needle);
+    }
+    const sh_material good = {SH_MATERIAL_NEOHOOKEAN, 2e4, 0.4, 2000};
+    const sh_material bad_model = {(sh_material_model)-1, 2e4, 0.4, 2000};
+    assert_error(sh_body_set_material(world, body, all, 6, &bad_model), SH_ERR_INVALID_ARGUMENT, "model");
+    /* Element indices out of range: nothing changes, even for the valid indices before it. */
+    const int32_t out_of_range_high[3] = {0, 1, 6};
+    const int32_t out_of_range_low[2] = {2, -1};
+    const int32_t huge[1] = {INT32_MAX};
+    assert_error(sh_body_set_material(world, body, out_of_range_high, 3, &good), SH_ERR_INVALID_ARGUMENT, "elements[2]");
+    assert_error(sh_body_set_material(world, body, out_of_range_low, 2, &good), SH_ERR_INVALID_ARGUMENT, "elements[1]");
+    assert_error(sh_body_set_material(world, body, huge, 1, &good), SH_ERR_INVALID_ARGUMENT, "elements[0]");
+    assert_error(sh_body_set_material(world, body, all, -1, &good), SH_ERR_INVALID_ARGUMENT, "element_count");
+
+    /* Failed calls changed neither masses nor the state nor the stiffness. */
+    assert_ok(sh_body_get_masses(world, body, masses_after, n));
+    assert_memory_equal(masses_after, masses_before, sizeof(double) * (size_t)n);
+    assert_state_is(world, body, x, v);
+    assert_ok(sh_body_get_elastic_energy(world, body, &energy_after));
+    assert_memory_equal(&energy_after, &energy_before, sizeof(double));
+
+    /* The valid call does change the masses (density doubled on every element). */
+    assert_ok(sh_body_set_material(world, body, all, 6, &good));
+    assert_ok(sh_body_get_masses(world, body, masses_after, n));
+    for (int32_t i = 0; i < n; ++i) assert_close(masses_after[i], 2.0 * masses_before[i], 1e-12);
+
+    /* sh_body_set_material on a mass-spring body is unsupported. */
+    const sh_body_id spring = add_two_node_spring(world);
+    const int32_t zero = 0;
+    assert_error(sh_body_set_material(world, spring, &zero, 1, &good), SH_ERR_UNSUPPORTED, "spring");
+
+    free(x);
+    free(v);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Spring bodies                                                                                */
+
+/* Tries def (two nodes 1 cm apart unless the caller changed them) and expects the failure. */
+static void expect_spring_error(sh_world* world, const sh_spring_body_def* def, sh_status status,
+                                const char* needle, int line) {
+    sh_body_id id = 42;
+    const sh_status got = sh_world_add_spring_body(world, def, &id);
+    check_error(got, status, needle, "sh_world_add_spring_body", __FILE__, line);
+    if (id != SH_NULL_BODY) {
+        print_error("%s:%d: out_body not reset to SH_NULL_BODY on failure\n", __FILE__, line);
+        _fail(__FILE__, line);
+    }
+}
+
+#define EXPECT_SPRING_ERROR(def, status, needle) expect_spring_error(world, (def), (status), (needle), __LINE__)
+
+static void two_node_def(sh_spring_body_def* def, const double* nodes, const int32_t* springs) {
+    sh_spring_body_def_default(def);
+    def->nodes = nodes;
+    def->node_count = 2;
+    def->springs = springs;
+    def->spring_count = 1;
+}
+
+static void test_spring_def_errors(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    const double nodes[9] = {0, 0, 0, 0.01, 0, 0, 0, 0.01, 0};
+    const double same_place[6] = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
+    const double nan_node[6] = {0, 0, 0, NAN, 0, 0};
+    const int32_t one_spring[2] = {0, 1};
+    const int32_t self_spring[2] = {1, 1};
+    const int32_t out_of_range[2] = {0, 2};
+    const int32_t negative_index[2] = {-1, 1};
+    const double negative_masses[2] = {1e-3, -1e-3};
+    const double nan_masses[2] = {1e-3, NAN};
+    const double decreasing[6] = {0.0, 0.0, 0.2, 1.0, 0.1, 2.0};
+    const double repeated[6] = {0.0, 0.0, 0.1, 1.0, 0.1, 2.0};
+    const double good_table[6] = {-0.1, -1.0, 0.0, 0.0, 0.1, 1.0};
+    const double nan_table[4] = {0.0, 0.0, NAN, 1.0};
+    sh_spring_body_def def;
+
+    two_node_def(&def, same_place, one_spring);
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "zero rest length");
+    two_node_def(&def, nodes, self_spring);
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "itself");
+    two_node_def(&def, nodes, out_of_range);
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "out of range");
+    two_node_def(&def, nodes, negative_index);
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "out of range");
+    two_node_def(&def, nan_node, one_spring);
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node 1");
+
+    two_node_def(&def, nodes, one_spring);
+    def.node_mass = -1e-3;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "mass");
+    def.node_mass = 0.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "mass");
+    def.node_mass = NAN;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "mass");
+    two_node_def(&def, nodes, one_spring);
+    def.node_masses = negative_masses;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node 1");
+    def.node_masses = nan_masses;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node 1");
+
+    two_node_def(&def, nodes, one_spring);
+    def.params.stiffness = 0.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "stiffness");
+    def.params.stiffness = -100.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "stiffness");
+    def.params.stiffness = NAN;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "stiffness");
+    def.params.stiffness = INFINITY;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "stiffness");
+    two_node_def(&def, nodes, one_spring);
+    def.params.damping = -1.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "damping");
+
+    two_node_def(&def, nodes, one_spring);
+    def.params.law = SH_SPRING_CUBIC;
+    def.params.lambda1 = 1.0;
+    def.params.lambda2 = 0.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "lambda2");
+    def.params.lambda2 = 1.0;
+    def.params.lambda1 = -1.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "lambda1");
+
+    two_node_def(&def, nodes, one_spring);
+    def.params.law = SH_SPRING_HYPERBOLIC;
+    def.params.a = 1.0;
+    def.params.b = 0.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "params.b");
+    def.params.b = 1e-3;
+    def.params.a = -1.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "params.a");
+
+    two_node_def(&def, nodes, one_spring);
+    def.params.law = SH_SPRING_TABLE;
+    def.params.table = decreasing;
+    def.params.table_rows = 3;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "table");
+    def.params.table = repeated;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "table");
+    def.params.table = nan_table;
+    def.params.table_rows = 2;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "table");
+    def.params.table = good_table;
+    def.params.table_rows = 1;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "table_rows");
+    def.params.table_rows = 0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "table_rows");
+    def.params.table_rows = -3;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "table_rows");
+    def.params.table = NULL;
+    def.params.table_rows = 3;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "table");
+
+    two_node_def(&def, nodes, one_spring);
+    def.params.law = (sh_spring_law)42;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "law");
+    def.params.law = (sh_spring_law)-1;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "law");
+
+    two_node_def(&def, nodes, one_spring);
+    def.node_count = 0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node_count");
+    def.node_count = -2;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node_count");
+    two_node_def(&def, nodes, one_spring);
+    def.spring_count = -1;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "spring_count");
+    two_node_def(&def, nodes, one_spring);
+    def.integrator = (sh_integrator)4;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "integrator");
+    two_node_def(&def, nodes, one_spring);
+    def.runaway_speed = -1.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "runaway_speed");
+
+    /* And the good ones: the valid table, and a single particle with no spring. */
+    two_node_def(&def, nodes, one_spring);
+    def.params.law = SH_SPRING_TABLE;
+    def.params.table = good_table;
+    def.params.table_rows = 3;
+    sh_body_id id;
+    assert_ok(sh_world_add_spring_body(world, &def, &id));
+    sh_spring_body_def_default(&def);
+    def.nodes = nodes;
+    def.node_count = 1;
+    assert_ok(sh_world_add_spring_body(world, &def, &id));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Stepping and state                                                                           */
+
+static void test_step_rejects_bad_dt(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
+    const sh_body_id body = add_fem(world, mesh);
+    const sh_body_id spring = add_two_node_spring(world);
+    move_a_bit(world);
+    double* x = copy_positions(world, body);
+    double* v = copy_velocities(world, body);
+    double* xs = copy_positions(world, spring);
+    double* vs = copy_velocities(world, spring);
+    uint64_t warnings_before[SH_WARN_COUNT], warnings_after[SH_WARN_COUNT];
+    assert_ok(sh_world_get_warnings(world, warnings_before));
+
+    const double bad[] = {0.0, -0.0, -1e-3, NAN, -NAN, INFINITY, -INFINITY};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        sh_step_report report;
+        assert_error(sh_world_step(world, bad[i], &report), SH_ERR_INVALID_ARGUMENT, "dt");
+        assert_error(sh_world_step(world, bad[i], NULL), SH_ERR_INVALID_ARGUMENT, "dt");
+    }
+    assert_state_is(world, body, x, v);
+    assert_state_is(world, spring, xs, vs);
+    assert_ok(sh_world_get_warnings(world, warnings_after));
+    assert_memory_equal(warnings_after, warnings_before, sizeof warnings_before);
+
+    free(x);
+    free(v);
+    free(xs);
+    free(vs);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+static void test_set_state_rejects_non_finite_and_wrong_counts(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
+    const sh_body_id body = add_fem(world, mesh);
+    move_a_bit(world);
+    const int32_t n = node_count_of(world, body);
+    double* x = copy_positions(world, body);
+    double* v = copy_velocities(world, body);
+    double* input = malloc(sizeof(double) * 3 * (size_t)n);
+    assert_non_null(input);
+    const double non_finite[] = {NAN, INFINITY, -INFINITY};
+
+    for (size_t k = 0; k < sizeof non_finite / sizeof non_finite[0]; ++k) {
+        /* One bad value at the last entry: nothing may have been copied before the check. */
+        memcpy(input, x, sizeof(double) * 3 * (size_t)n);
+        for (int32_t i = 0; i < 3 * n; ++i) input[i] += 1e-3;
+        input[3 * n - 1] = non_finite[k];
+        assert_error(sh_body_set_positions(world, body, input, n), SH_ERR_INVALID_ARGUMENT, "positions");
+        assert_error(sh_body_set_velocities(world, body, input, n), SH_ERR_INVALID_ARGUMENT, "velocities");
+        assert_error(sh_body_set_external_forces(world, body, input, n), SH_ERR_INVALID_ARGUMENT, "forces");
+        const int32_t node = 3;
+        const double target[3] = {0.0, non_finite[k], 0.0};
+        assert_error(sh_body_prescribe_positions(world, body, &node, target, 1), SH_ERR_INVALID_ARGUMENT,
+                     "positions");
+        assert_state_is(world, body, x, v);
+    }
+    /* Wrong node counts. */
+    memcpy(input, x, sizeof(double) * 3 * (size_t)n);
+    const int32_t wrong[] = {n - 1, n + 1, 0, -1, INT32_MIN};
+    for (size_t k = 0; k < sizeof wrong / sizeof wrong[0]; ++k) {
+        assert_error(sh_body_set_positions(world, body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT, "node_count");
+        assert_error(sh_body_set_velocities(world, body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT, "node_count");
+        assert_error(sh_body_set_external_forces(world, body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT,
+                     "node_count");
+        assert_error(sh_body_set_node_damping(world, body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT, "node_count");
+    }
+    /* Bad node damping coefficients. */
+    double coefficients[8] = {1, 1, 1, 1, 1, 1, 1, -1};
+    assert_int_equal(n, 8);
+    assert_error(sh_body_set_node_damping(world, body, coefficients, n), SH_ERR_INVALID_ARGUMENT, "coefficients[7]");
+    coefficients[7] = NAN;
+    assert_error(sh_body_set_node_damping(world, body, coefficients, n), SH_ERR_INVALID_ARGUMENT, "coefficients[7]");
+    /* Bad gravity. */
+    const double bad_gravity[3] = {0, NAN, 0};
+    assert_error(sh_world_set_gravity(world, bad_gravity), SH_ERR_INVALID_ARGUMENT, "gravity");
+
+    assert_state_is(world, body, x, v);
+
+    /* A good set_positions does change them (so the comparisons above are meaningful). */
+    for (int32_t i = 0; i < 3 * n; ++i) input[i] = x[i] + 1e-3;
+    assert_ok(sh_body_set_positions(world, body, input, n));
+    double* x_after = copy_positions(world, body);
+    assert_memory_equal(x_after, input, sizeof(double) * 3 * (size_t)n);
+
+    free(x_after);
+    free(input);
+    free(x);
+    free(v);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+static void test_get_capacity_too_small(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
+    const sh_body_id body = add_fem(world, mesh);
+    move_a_bit(world);
+    const int32_t n = node_count_of(world, body);
+    sh_mesh_info info;
+    assert_ok(sh_mesh_get_info(mesh, &info));
+    enum { SENTINEL_COUNT = 256 };
+    double out[SENTINEL_COUNT], sentinel[SENTINEL_COUNT];
+    int32_t iout[SENTINEL_COUNT], isentinel[SENTINEL_COUNT];
+    for (int i = 0; i < SENTINEL_COUNT; ++i) {
+        sentinel[i] = -12345.0;
+        isentinel[i] = -777;
+    }
+    const int64_t too_small[] = {-1, 0, 1};
+#define CHECK_D(call_with_cap, needed)                                                          \
+    do {                                                                                        \
+        for (size_t k_ = 0; k_ < sizeof too_small / sizeof too_small[0]; ++k_) {                \
+            const int64_t cap = too_small[k_] <= 0 ? too_small[k_] : (needed) - 1;              \
+            memcpy(out, sentinel, sizeof out);                                                  \
+            assert_error(call_with_cap, SH_ERR_INVALID_ARGUMENT, "capacity");                   \
+            assert_memory_equal(out, sentinel, sizeof out);                                     \
+        }                                                                                       \
+        {                                                                                       \
+            const int64_t cap = (needed);                                                       \
+            assert_ok(call_with_cap);                                                           \
+            assert_memory_equal(out + (needed), sentinel, sizeof(double) * (SENTINEL_COUNT - (needed))); \
+        }                                                                                       \
+    } while (0)
+#define CHECK_I(call_with_cap, needed)                                                          \
+    do {                                                                                        \
+        for (size_t k_ = 0; k_ < sizeof too_small / sizeof too_small[0]; ++k_) {                \
+            const int64_t cap = too_small[k_] <= 0 ? too_small[k_] : (needed) - 1;              \
+            memcpy(iout, isentinel, sizeof iout);                                               \
+            assert_error(call_with_cap, SH_ERR_INVALID_ARGUMENT, "capacity");                   \
+            assert_memory_equal(iout, isentinel, sizeof iout);                                  \
+        }                                                                                       \
+        {                                                                                       \
+            const int64_t cap = (needed) + 5; /* larger than needed is fine */                  \
+            memcpy(iout, isentinel, sizeof iout);                                               \
+            assert_ok(call_with_cap);                                                           \
+            assert_memory_equal(iout + (needed), isentinel, sizeof(int32_t) * (SENTINEL_COUNT - (needed))); \
+        }                                                                                       \
+    } while (0)
+
+    CHECK_D(sh_body_get_positions(world, body, out, cap), 3 * n);
+    CHECK_D(sh_body_get_velocities(world, body, out, cap), 3 * n);
+    CHECK_D(sh_body_get_masses(world, body, out, cap), n);
+    CHECK_D(sh_body_get_elastic_forces(world, body, out, cap), 3 * n);
+    CHECK_D(sh_mesh_get_nodes(mesh, out, cap), 3 * info.node_count);
+    CHECK_I(sh_mesh_get_tets(mesh, iout, cap), 4 * info.tet_count);
+    CHECK_I(sh_mesh_get_edges(mesh, iout, cap), 2 * info.edge_count);
+    CHECK_I(sh_mesh_get_surface_triangles(mesh, iout, cap), 3 * info.surface_triangle_count);
+#undef CHECK_D
+#undef CHECK_I
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+static void test_fix_nodes_out_of_range_changes_nothing(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
+    const sh_body_id body = add_fem(world, mesh);
+    move_a_bit(world);
+    double* x = copy_positions(world, body);
+    double* v = copy_velocities(world, body);
+    sh_body_info info;
+
+    const int32_t high[3] = {0, 1, 8};
+    const int32_t negative[2] = {0, -1};
+    assert_error(sh_body_fix_nodes(world, body, high, 3), SH_ERR_INVALID_ARGUMENT, "nodes[2]");
+    assert_error(sh_body_fix_nodes(world, body, negative, 2), SH_ERR_INVALID_ARGUMENT, "nodes[1]");
+    assert_error(sh_body_fix_nodes(world, body, high, -1), SH_ERR_INVALID_ARGUMENT, "count");
+    const double targets[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    assert_error(sh_body_prescribe_positions(world, body, high, targets, 3), SH_ERR_INVALID_ARGUMENT, "nodes[2]");
+    assert_ok(sh_body_get_info(world, body, &info));
+    assert_int_equal(info.fixed_node_count, 0); /* nodes 0 and 1 were not fixed either */
+    assert_state_is(world, body, x, v);          /* their velocities were not zeroed */
+
+    /* The valid part alone fixes them; out-of-range release changes nothing. */
+    assert_ok(sh_body_fix_nodes(world, body, high, 2));
+    assert_ok(sh_body_get_info(world, body, &info));
+    assert_int_equal(info.fixed_node_count, 2);
+    assert_error(sh_body_release_nodes(world, body, high, 3), SH_ERR_INVALID_ARGUMENT, "nodes[2]");
+    assert_ok(sh_body_get_info(world, body, &info));
+    assert_int_equal(info.fixed_node_count, 2);
+
+    free(x);
+    free(v);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* A battery of failing calls on a moving body: none of them changes its state or the other
+ * body's, and a subsequent step is identical to the step of an untouched twin world. */
+static void test_failed_calls_leave_state_intact(void** state) {
+    (void)state;
+    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 2, 1, 1);
+    sh_world* worlds[2];
+    sh_body_id bodies[2];
+    for (int w = 0; w < 2; ++w) {
+        worlds[w] = make_world();
+        bodies[w] = add_fem(worlds[w], mesh);
+        const int32_t fixed[2] = {0, 3};
+        assert_ok(sh_body_fix_nodes(worlds[w], bodies[w], fixed, 2));
+        move_a_bit(worlds[w]);
+    }
+    sh_world* world = worlds[0];
+    const sh_body_id body = bodies[0];
+    const int32_t n = node_count_of(world, body);
+    double* x = copy_positions(world, body);
+    double* v = copy_velocities(world, body);
+    double* buffer = malloc(sizeof(double) * 3 * (size_t)(n + 1));
+    assert_non_null(buffer);
+    memcpy(buffer, x, sizeof(double) * 3 * (size_t)n);
+    buffer[5] = NAN;
+    const int32_t bad_nodes[2] = {1, n};
+    const sh_material bad = {SH_MATERIAL_STVK, -1.0, 0.3, 1000};
+    const int32_t all[1] = {0};
+    sh_fem_body_def bad_def;
+    sh_fem_body_def_default(&bad_def);
+    bad_def.mesh = mesh;
+    bad_def.material.poisson = 0.5;
+    sh_body_id id;
+
+    assert_status(sh_world_step(world, NAN, NULL), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_body_set_positions(world, body, buffer, n), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_body_set_velocities(world, body, buffer, n), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_body_set_positions(world, body, x, n + 1), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_body_set_external_forces(world, body, buffer, n), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_body_fix_nodes(world, body, bad_nodes, 2), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_body_release_nodes(world, body, bad_nodes, 2), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_body_prescribe_positions(world, body, bad_nodes, buffer, 2), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_body_set_material(world, body, all, 1, &bad), SH_ERR_INVALID_ARGUMENT);
+    const sh_material good = {SH_MATERIAL_COROTATIONAL, 1e5, 0.3, 3000};
+    assert_status(sh_body_set_material(world, body, bad_nodes, 2, &good), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_body_get_positions(world, body, buffer, 3 * n - 1), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_world_add_fem_body(world, &bad_def, &id), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_world_remove_body(world, body + 1), SH_ERR_INVALID_HANDLE);
+    assert_state_is(world, body, x, v);
+
+    /* Same next step as the twin that saw no failed call: no hidden state was touched. */
+    for (int i = 0; i < 20; ++i) {
+        assert_ok(sh_world_step(worlds[0], 1e-4, NULL));
+        assert_ok(sh_world_step(worlds[1], 1e-4, NULL));
+    }
+    double* x0 = copy_positions(worlds[0], bodies[0]);
+    double* x1 = copy_positions(worlds[1], bodies[1]);
+    double* v0 = copy_velocities(worlds[0], bodies[0]);
+    double* v1 = copy_velocities(worlds[1], bodies[1]);
+    assert_memory_equal(x0, x1, sizeof(double) * 3 * (size_t)n);
+    assert_memory_equal(v0, v1, sizeof(double) * 3 * (size_t)n);
+
+    free(x0);
+    free(x1);
+    free(v0);
+    free(v1);
+    free(buffer);
+    free(x);
+    free(v);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(worlds[0]));
+    assert_ok(sh_world_destroy(worlds[1]));
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Mesh creation misuse                                                                         */
+
+static void test_mesh_create_misuse(void** state) {
+    (void)state;
+    const double nodes[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const int32_t tets[4] = {0, 1, 2, 3};
+    const int32_t bad_index[4] = {0, 1, 2, 4};
+    const int32_t repeated[4] = {0, 1, 2, 2};
+    const double nan_nodes[12] = {0, 0, 0, 1, 0, 0, 0, NAN, 0, 0, 0, 1};
+    const double flat[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    sh_mesh* mesh = (sh_mesh*)&mesh;
+
+    assert_error(sh_mesh_create(NULL, 4, tets, 1, &mesh), SH_ERR_INVALID_ARGUMENT, "nodes");
+    assert_null(mesh);
+    assert_error(sh_mesh_create(nodes, 4, NULL, 1, &mesh), SH_ERR_INVALID_ARGUMENT, "tets");
+    assert_error(sh_mesh_create(nodes, 0, tets, 1, &mesh), SH_ERR_INVALID_ARGUMENT, "node_count");
+    assert_error(sh_mesh_create(nodes, -4, tets, 1, &mesh), SH_ERR_INVALID_ARGUMENT, "node_count");
+    assert_error(sh_mesh_create(nodes, 4, tets, 0, &mesh), SH_ERR_INVALID_ARGUMENT, "tet_count");
+    assert_error(sh_mesh_create(nodes, 4, tets, -1, &mesh), SH_ERR_INVALID_ARGUMENT, "tet_count");
+    assert_error(sh_mesh_create(nodes, 4, bad_index, 1, &mesh), SH_ERR_DEGENERATE_MESH, "out of range");
+    assert_error(sh_mesh_create(nodes, 4, repeated, 1, &mesh), SH_ERR_DEGENERATE_MESH, "node 2");
+    assert_error(sh_mesh_create(nan_nodes, 4, tets, 1, &mesh), SH_ERR_DEGENERATE_MESH, "node 2");
+    assert_error(sh_mesh_create(flat, 4, tets, 1, &mesh), SH_ERR_DEGENERATE_MESH, "zero volume");
+    assert_null(mesh);
+    assert_error(sh_mesh_load(NULL, &mesh), SH_ERR_INVALID_ARGUMENT, "path");
+    assert_null(mesh);
+}
+
+static void test_write_vtu_to_unwritable_path(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    const sh_body_id body = add_fem(world, mesh);
+    assert_error(sh_body_write_vtu(world, body, "/nonexistent-softhap-dir/frame.vtu"), SH_ERR_IO,
+                 "nonexistent-softhap-dir");
+    assert_error(sh_mesh_write_vtu(mesh, "/nonexistent-softhap-dir/mesh.vtu"), SH_ERR_IO, "nonexistent-softhap-dir");
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_version_matches_header),
+        cmocka_unit_test(test_status_strings_non_null_and_distinct),
+        cmocka_unit_test(test_last_error_cleared_by_success),
+        cmocka_unit_test(test_null_out_pointers),
+        cmocka_unit_test(test_null_defs),
+        cmocka_unit_test(test_null_handles),
+        cmocka_unit_test(test_foreign_pointers),
+        cmocka_unit_test(test_destroyed_world),
+        cmocka_unit_test(test_destroyed_mesh),
+        cmocka_unit_test(test_stale_body_ids),
+        cmocka_unit_test(test_null_and_garbage_body_ids),
+        cmocka_unit_test(test_body_id_of_another_empty_world),
+        cmocka_unit_test(test_body_id_of_another_populated_world),
+        cmocka_unit_test(test_uninitialized_defs),
+        cmocka_unit_test(test_material_validation_in_def),
+        cmocka_unit_test(test_material_validation_in_set_material),
+        cmocka_unit_test(test_spring_def_errors),
+        cmocka_unit_test(test_step_rejects_bad_dt),
+        cmocka_unit_test(test_set_state_rejects_non_finite_and_wrong_counts),
+        cmocka_unit_test(test_get_capacity_too_small),
+        cmocka_unit_test(test_fix_nodes_out_of_range_changes_nothing),
+        cmocka_unit_test(test_failed_calls_leave_state_intact),
+        cmocka_unit_test(test_mesh_create_misuse),
+        cmocka_unit_test(test_write_vtu_to_unwritable_path),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

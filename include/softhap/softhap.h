@@ -42,6 +42,16 @@ extern "C" {
  *  Thread: any. Alloc: none. */
 SH_API int32_t sh_version(void);
 
+/** Optional components a build may include (CMake SOFTHAP_WITH_CHOLMOD, SOFTHAP_WITH_CCD). */
+typedef enum sh_feature {
+    SH_FEATURE_CHOLMOD = 1, /**< SuiteSparse CHOLMOD sparse Cholesky (implicit and static solves) */
+    SH_FEATURE_CCD = 2      /**< libccd convex collision shapes */
+} sh_feature;
+
+/** Bit mask of the sh_feature values compiled into the loaded library.
+ *  Thread: any. Alloc: none. */
+SH_API uint32_t sh_build_features(void);
+
 /* ------------------------------------------------------------------------------------------ */
 /* Status and errors                                                                            */
 

@@ -24,6 +24,17 @@ extern "C" {
 
 SH_API int32_t sh_version(void) { return SH_VERSION; }
 
+SH_API uint32_t sh_build_features(void) {
+    uint32_t features = 0;
+#if SOFTHAP_WITH_CHOLMOD
+    features |= SH_FEATURE_CHOLMOD;
+#endif
+#if SOFTHAP_WITH_CCD
+    features |= SH_FEATURE_CCD;
+#endif
+    return features;
+}
+
 SH_API const char* sh_status_string(sh_status status) {
     switch (status) {
         case SH_OK: return "SH_OK: success";

@@ -1,0 +1,446 @@
+/*
+ * softhap_bench: per-step timings of the explicit full-model step, one JSON line per case.
+ *
+ *   softhap_bench [FILTER] [--steps N] [--meshes DIR]      FEM materials and springs
+ *   softhap_bench integrators [FILTER] [--steps N]          forward/symplectic Euler, RK2, RK4
+ *
+ * Each case builds a world with one body from a mesh in ../shared/meshes (scaled so its largest
+ * extent is kMeshSize), gravity on, the highest 1% of the nodes fixed, dt = kDtFraction * dt_crit
+ * so the step never sub-steps (the JSON "substeps" field is the largest count seen, and the
+ * SH_WARN_SUBSTEPPED counter is checked). After a warm-up every sh_world_step is timed on its own
+ * with clock_gettime(CLOCK_MONOTONIC); the times are sorted for the median, p99 and p99.9.
+ * A case is timed twice: with report NULL ("case": "<material>/<mesh>") and with a step report,
+ * which adds the kinetic, potential and elastic energy passes ("<material>+report/<mesh>").
+ * ns_per_tet_step = median step time / tets (also for springs, whose "springs" field gives the
+ * spring count). FILTER keeps the cases whose name contains it.
+ *
+ * Public API only; C99 (plus POSIX clocks and, on Linux, pinning to the current CPU).
+ */
+#define _GNU_SOURCE
+#include <softhap/softhap.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#ifdef __linux__
+#include <sched.h>
+#endif
+
+#ifndef SOFTHAP_BENCH_MESH_DIR
+#define SOFTHAP_BENCH_MESH_DIR "../shared/meshes"
+#endif
+
+static const double kMeshSize = 0.15;      /* largest extent after scaling (m): organ-sized */
+static const double kYoung = 3.0e4;        /* Pa: soft tissue */
+static const double kPoisson = 0.45;
+static const double kDensity = 1000.0;     /* kg/m^3 */
+static const double kDtFraction = 0.5;     /* dt = kDtFraction * dt_crit: no sub-stepping */
+static const double kFixedFraction = 0.01; /* the highest 1% of the nodes are fixed */
+static const double kCaseSeconds = 1.0;    /* timed budget of a case without report */
+static const double kReportSeconds = 0.5;  /* timed budget of a case with report */
+static const int kMinSteps = 500, kMaxSteps = 2000, kWarmupSteps = 30;
+
+static const char* const kMeshes[] = {"Armadillo_Tetra_4406", "raptorTetra_8418", "raptorTetra_19409"};
+static const char* g_mesh_dir = NULL;
+static int g_steps = 0; /* --steps N; 0 = adaptive */
+
+#define CHECK(expr)                                                                                 \
+    do {                                                                                            \
+        sh_status s_ = (expr);                                                                      \
+        if (s_ != SH_OK) {                                                                          \
+            fprintf(stderr, "softhap_bench: %s failed: %s (%s)\n", #expr, sh_status_string(s_),     \
+                    sh_last_error_message());                                                       \
+            exit(1);                                                                                \
+        }                                                                                           \
+    } while (0)
+
+static double now_ns(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
+}
+
+static void* xmalloc(size_t size) {
+    void* p = malloc(size ? size : 1);
+    if (!p) {
+        fprintf(stderr, "softhap_bench: out of memory\n");
+        exit(1);
+    }
+    return p;
+}
+
+static int cmp_double(const void* a, const void* b) {
+    const double x = *(const double*)a, y = *(const double*)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Value at quantile q of sorted[0..n): the smallest value with at least q*n values at or below. */
+static double quantile(const double* sorted, int n, double q) {
+    int k = (int)ceil(q * n) - 1;
+    if (k < 0) k = 0;
+    if (k > n - 1) k = n - 1;
+    return sorted[k];
+}
+
+static double median(const double* sorted, int n) {
+    return n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Scenes                                                                                       */
+
+typedef struct {
+    const char* name;
+    sh_mesh* mesh;       /* scaled copy */
+    sh_mesh_info info;
+    double* rest;        /* node_count x 3 */
+    int32_t* fixed;      /* highest nodes */
+    int32_t fixed_count;
+    int32_t edge_count;
+    double mean_edge;    /* m */
+} bench_mesh;
+
+/* Heights of nodes for the sort below (qsort has no context argument in C99). */
+static const double* g_sort_nodes;
+static int cmp_node_height(const void* a, const void* b) {
+    const double za = g_sort_nodes[3 * *(const int32_t*)a + 2], zb = g_sort_nodes[3 * *(const int32_t*)b + 2];
+    return za > zb ? -1 : za < zb;
+}
+
+static int load_mesh(const char* name, bench_mesh* m) {
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.vtu", g_mesh_dir, name);
+    sh_mesh* raw = NULL;
+    if (sh_mesh_load(path, &raw) != SH_OK) {
+        fprintf(stderr, "softhap_bench: cannot load %s: %s\n", path, sh_last_error_message());
+        return 0;
+    }
+    sh_mesh_info info;
+    CHECK(sh_mesh_get_info(raw, &info));
+    const int32_t n = info.node_count, t = info.tet_count;
+    double* nodes = (double*)xmalloc(sizeof(double) * 3 * (size_t)n);
+    int32_t* tets = (int32_t*)xmalloc(sizeof(int32_t) * 4 * (size_t)t);
+    CHECK(sh_mesh_get_nodes(raw, nodes, 3 * (int64_t)n));
+    CHECK(sh_mesh_get_tets(raw, tets, 4 * (int64_t)t));
+    double extent = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        const double e = info.bounds_max[k] - info.bounds_min[k];
+        if (e > extent) extent = e;
+    }
+    const double scale = kMeshSize / extent;
+    for (int32_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) nodes[3 * i + k] = (nodes[3 * i + k] - info.bounds_min[k]) * scale;
+    CHECK(sh_mesh_destroy(raw));
+    CHECK(sh_mesh_create(nodes, n, tets, t, &m->mesh));
+    free(tets);
+    CHECK(sh_mesh_get_info(m->mesh, &m->info));
+    m->name = name;
+    m->rest = nodes;
+
+    /* The highest kFixedFraction of the nodes (at least 4); orphans are skipped by the body. */
+    int32_t* order = (int32_t*)xmalloc(sizeof(int32_t) * (size_t)n);
+    for (int32_t i = 0; i < n; ++i) order[i] = i;
+    g_sort_nodes = nodes;
+    qsort(order, (size_t)n, sizeof(int32_t), cmp_node_height);
+    m->fixed_count = (int32_t)(kFixedFraction * n);
+    if (m->fixed_count < 4) m->fixed_count = 4;
+    m->fixed = order;
+
+    m->edge_count = m->info.edge_count;
+    int32_t* edges = (int32_t*)xmalloc(sizeof(int32_t) * 2 * (size_t)m->edge_count);
+    CHECK(sh_mesh_get_edges(m->mesh, edges, 2 * (int64_t)m->edge_count));
+    double sum = 0.0;
+    for (int32_t e = 0; e < m->edge_count; ++e) {
+        const double* a = &nodes[3 * edges[2 * e]];
+        const double* b = &nodes[3 * edges[2 * e + 1]];
+        sum += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+    }
+    m->mean_edge = sum / m->edge_count;
+    free(edges);
+    return 1;
+}
+
+static void free_mesh(bench_mesh* m) {
+    sh_mesh_destroy(m->mesh);
+    free(m->rest);
+    free(m->fixed);
+}
+
+/* A body kind: an FEM material (model >= 0) or springs on the mesh edges (model < 0). */
+typedef struct {
+    const char* name;
+    int model;
+} body_kind;
+
+static const body_kind kKinds[] = {{"linear", SH_MATERIAL_LINEAR},
+                                   {"stvk", SH_MATERIAL_STVK},
+                                   {"corotational", SH_MATERIAL_COROTATIONAL},
+                                   {"neohookean", SH_MATERIAL_NEOHOOKEAN},
+                                   {"springs", -1}};
+
+static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_integrator integrator) {
+    sh_body_id body = SH_NULL_BODY;
+    if (model >= 0) {
+        sh_fem_body_def def;
+        sh_fem_body_def_default(&def);
+        def.mesh = m->mesh;
+        def.material.model = (sh_material_model)model;
+        def.material.young = kYoung;
+        def.material.poisson = kPoisson;
+        def.material.density = kDensity;
+        def.integrator = integrator;
+        CHECK(sh_world_add_fem_body(world, &def, &body));
+    } else {
+        /* A rod of section l^2 and length l has axial stiffness E l; nodes share the mass. */
+        sh_spring_body_def def;
+        sh_spring_body_def_default(&def);
+        def.mesh = m->mesh;
+        def.params.law = SH_SPRING_LINEAR;
+        def.params.stiffness = kYoung * m->mean_edge;
+        def.node_mass = kDensity * m->info.volume / (m->info.node_count - m->info.orphan_node_count);
+        def.integrator = integrator;
+        CHECK(sh_world_add_spring_body(world, &def, &body));
+    }
+    CHECK(sh_body_fix_nodes(world, body, m->fixed, m->fixed_count));
+    return body;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Timing                                                                                       */
+
+typedef struct {
+    int steps;
+    double median_ns, p99_ns, p999_ns, mean_ns;
+    int substeps;     /* largest seen in reports */
+    int failed;       /* steps that did not return SH_OK */
+    sh_step_report last;
+} timing;
+
+/* Steps to time so that the case takes about budget seconds at per_step_ns. */
+static int step_count(double budget, double per_step_ns) {
+    if (g_steps > 0) return g_steps;
+    double n = budget * 1e9 / (per_step_ns > 1.0 ? per_step_ns : 1.0);
+    if (n < kMinSteps) n = kMinSteps;
+    if (n > kMaxSteps) n = kMaxSteps;
+    return (int)n;
+}
+
+/* Optional reset to rest every reset_every steps (outside the timed region); 0 = never. */
+typedef struct {
+    sh_body_id body;
+    const bench_mesh* mesh;
+    double* zeros;
+    int reset_every;
+} reset_plan;
+
+static void reset_body(sh_world* world, const reset_plan* r) {
+    CHECK(sh_body_set_positions(world, r->body, r->mesh->rest, r->mesh->info.node_count));
+    CHECK(sh_body_set_velocities(world, r->body, r->zeros, r->mesh->info.node_count));
+}
+
+static timing time_steps(sh_world* world, double dt, int with_report, double budget, const reset_plan* reset) {
+    timing t;
+    memset(&t, 0, sizeof t);
+    t.substeps = 0;
+    sh_step_report report;
+    double warm = 0.0;
+    for (int s = 0; s < kWarmupSteps; ++s) {
+        const double t0 = now_ns();
+        const sh_status st = sh_world_step(world, dt, &report); /* warm-up always reports */
+        warm = now_ns() - t0;
+        if (st != SH_OK) ++t.failed;
+        if (report.substeps > t.substeps) t.substeps = report.substeps;
+    }
+    t.steps = step_count(budget, warm);
+    double* ns = (double*)xmalloc(sizeof(double) * (size_t)t.steps);
+    for (int s = 0; s < t.steps; ++s) {
+        if (reset && reset->reset_every > 0 && s % reset->reset_every == 0) reset_body(world, reset);
+        const double t0 = now_ns();
+        const sh_status st = sh_world_step(world, dt, with_report ? &report : NULL);
+        ns[s] = now_ns() - t0;
+        if (st != SH_OK) ++t.failed;
+        if (with_report && report.substeps > t.substeps) t.substeps = report.substeps;
+    }
+    double sum = 0.0;
+    for (int s = 0; s < t.steps; ++s) sum += ns[s];
+    qsort(ns, (size_t)t.steps, sizeof(double), cmp_double);
+    t.mean_ns = sum / t.steps;
+    t.median_ns = median(ns, t.steps);
+    t.p99_ns = quantile(ns, t.steps, 0.99);
+    t.p999_ns = quantile(ns, t.steps, 0.999);
+    free(ns);
+    CHECK(sh_world_step(world, dt, &report));
+    t.last = report;
+    if (report.substeps > t.substeps) t.substeps = report.substeps;
+    return t;
+}
+
+static void print_case(const char* name, const bench_mesh* m, int springs, double dt, const timing* t,
+                       uint64_t substep_warnings, int with_report) {
+    printf("{\"case\":\"%s\",\"tets\":%d,", name, m->info.tet_count);
+    if (springs) printf("\"springs\":%d,", m->edge_count);
+    printf("\"ns_per_tet_step\":%.2f,\"median_us\":%.2f,\"p99_us\":%.2f,\"p999_us\":%.2f,\"mean_us\":%.2f,"
+           "\"steps\":%d,\"substeps\":%d,\"substep_warnings\":%llu,\"failed_steps\":%d,\"dt\":%.4g,\"dt_crit\":%.4g",
+           t->median_ns / m->info.tet_count, t->median_ns * 1e-3, t->p99_ns * 1e-3, t->p999_ns * 1e-3,
+           t->mean_ns * 1e-3, t->steps, t->substeps, (unsigned long long)substep_warnings, t->failed, dt,
+           t->last.dt_critical);
+    if (with_report)
+        printf(",\"kinetic_J\":%.6g,\"elastic_J\":%.6g,\"potential_J\":%.6g", t->last.kinetic_energy,
+               t->last.elastic_energy, t->last.potential_energy);
+    printf("}\n");
+    fflush(stdout);
+}
+
+static int matches(const char* name, const char* filter) { return !filter || strstr(name, filter) != NULL; }
+
+static double body_dt_crit(sh_world* world, sh_body_id body) {
+    sh_body_info info;
+    CHECK(sh_body_get_info(world, body, &info));
+    return info.dt_critical;
+}
+
+/* One kind on one mesh: the timing without report, then with report, each in a fresh world. */
+static void run_case(const bench_mesh* m, const body_kind* kind, const char* filter) {
+    char name[2][256];
+    snprintf(name[0], sizeof name[0], "%s/%s", kind->name, m->name);
+    snprintf(name[1], sizeof name[1], "%s+report/%s", kind->name, m->name);
+    for (int with_report = 0; with_report < 2; ++with_report) {
+        if (!matches(name[with_report], filter)) continue;
+        sh_world_def wd;
+        sh_world_def_default(&wd);
+        sh_world* world = NULL;
+        CHECK(sh_world_create(&wd, &world));
+        const sh_body_id body = add_body(world, m, kind->model, SH_INTEGRATOR_SYMPLECTIC_EULER);
+        const double dt = kDtFraction * body_dt_crit(world, body);
+        const timing t = time_steps(world, dt, with_report, with_report ? kReportSeconds : kCaseSeconds, NULL);
+        uint64_t warnings[SH_WARN_COUNT];
+        CHECK(sh_world_get_warnings(world, warnings));
+        print_case(name[with_report], m, kind->model < 0, dt, &t, warnings[SH_WARN_SUBSTEPPED], with_report);
+        CHECK(sh_world_destroy(world));
+    }
+}
+
+/* The explicit integrators on one mesh (StVK): dt = dt_crit / 10 (forward Euler and RK2 gain
+ * energy at every dt), reset to rest every 200 steps outside the timed region. */
+static void run_integrators(const char* filter) {
+    static const struct {
+        const char* name;
+        sh_integrator integrator;
+    } kIntegrators[] = {{"forward_euler", SH_INTEGRATOR_FORWARD_EULER},
+                        {"symplectic_euler", SH_INTEGRATOR_SYMPLECTIC_EULER},
+                        {"rk2", SH_INTEGRATOR_RK2},
+                        {"rk4", SH_INTEGRATOR_RK4}};
+    bench_mesh m;
+    if (!load_mesh("raptorTetra_8418", &m)) exit(1);
+    double* zeros = (double*)calloc(3 * (size_t)m.info.node_count, sizeof(double));
+    for (size_t k = 0; k < sizeof kIntegrators / sizeof kIntegrators[0]; ++k) {
+        char name[256];
+        snprintf(name, sizeof name, "integrator/%s/stvk/%s", kIntegrators[k].name, m.name);
+        if (!matches(name, filter)) continue;
+        sh_world_def wd;
+        sh_world_def_default(&wd);
+        sh_world* world = NULL;
+        CHECK(sh_world_create(&wd, &world));
+        const sh_body_id body = add_body(world, &m, SH_MATERIAL_STVK, kIntegrators[k].integrator);
+        const double dt = 0.1 * body_dt_crit(world, body);
+        const reset_plan reset = {body, &m, zeros, 200};
+        const timing t = time_steps(world, dt, 0, kCaseSeconds, &reset);
+        uint64_t warnings[SH_WARN_COUNT];
+        CHECK(sh_world_get_warnings(world, warnings));
+        print_case(name, &m, 0, dt, &t, warnings[SH_WARN_SUBSTEPPED], 0);
+        CHECK(sh_world_destroy(world));
+    }
+    free(zeros);
+    free_mesh(&m);
+}
+
+static void usage(void) {
+    fprintf(stderr,
+            "usage: softhap_bench [integrators] [FILTER] [--steps N] [--meshes DIR]\n"
+            "  FILTER  keep the cases whose name contains it (e.g. stvk/raptorTetra_19409)\n"
+            "  --steps N  timed steps per case (default: adaptive, %d..%d)\n"
+            "  --meshes DIR  mesh folder (default $SOFTHAP_MESHES, " SOFTHAP_BENCH_MESH_DIR
+            ", ../shared/meshes)\n",
+            kMinSteps, kMaxSteps);
+}
+
+static int file_exists(const char* dir, const char* name) {
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.vtu", dir, name);
+    FILE* f = fopen(path, "r");
+    if (f) fclose(f);
+    return f != NULL;
+}
+
+int main(int argc, char** argv) {
+    const char* filter = NULL;
+    int integrators = 0;
+    for (int i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
+            g_steps = atoi(argv[++i]);
+            if (g_steps < 1) {
+                usage();
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--meshes") == 0 && i + 1 < argc) {
+            g_mesh_dir = argv[++i];
+        } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            usage();
+            return 0;
+        } else if (strcmp(argv[i], "integrators") == 0 && !integrators) {
+            integrators = 1;
+        } else if (!filter && argv[i][0] != '-') {
+            filter = argv[i];
+        } else {
+            usage();
+            return 2;
+        }
+    }
+    if (!g_mesh_dir) {
+        const char* candidates[] = {getenv("SOFTHAP_MESHES"), SOFTHAP_BENCH_MESH_DIR, "../shared/meshes",
+                                    "../../shared/meshes"};
+        for (size_t k = 0; k < sizeof candidates / sizeof candidates[0] && !g_mesh_dir; ++k)
+            if (candidates[k] && file_exists(candidates[k], kMeshes[0])) g_mesh_dir = candidates[k];
+        if (!g_mesh_dir) {
+            fprintf(stderr, "softhap_bench: meshes not found; pass --meshes DIR\n");
+            return 1;
+        }
+    }
+#ifdef __linux__
+    {   /* One core: stay on the CPU we started on, so the cache and timings stay put. */
+        const int cpu = sched_getcpu();
+        if (cpu >= 0) {
+            cpu_set_t set;
+            CPU_ZERO(&set);
+            CPU_SET(cpu, &set);
+            sched_setaffinity(0, sizeof set, &set);
+        }
+    }
+#endif
+    if (sh_version() != SH_VERSION) {
+        fprintf(stderr, "softhap_bench: library version %d, header %d\n", (int)sh_version(), SH_VERSION);
+        return 1;
+    }
+    if (integrators) {
+        run_integrators(filter);
+        return 0;
+    }
+    for (size_t k = 0; k < sizeof kMeshes / sizeof kMeshes[0]; ++k) {
+        int wanted = 0;
+        for (size_t j = 0; j < sizeof kKinds / sizeof kKinds[0]; ++j) {
+            char name[256];
+            snprintf(name, sizeof name, "%s/%s", kKinds[j].name, kMeshes[k]);
+            char name_report[256];
+            snprintf(name_report, sizeof name_report, "%s+report/%s", kKinds[j].name, kMeshes[k]);
+            wanted |= matches(name, filter) || matches(name_report, filter);
+        }
+        if (!wanted) continue;
+        bench_mesh m;
+        if (!load_mesh(kMeshes[k], &m)) return 1;
+        for (size_t j = 0; j < sizeof kKinds / sizeof kKinds[0]; ++j) run_case(&m, &kKinds[j], filter);
+        free_mesh(&m);
+    }
+    return 0;
+}

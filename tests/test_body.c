@@ -6,15 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static sh_world* make_world(double gz) {
-    sh_world_def wd;
-    sh_world_def_default(&wd);
-    wd.gravity[2] = gz;
-    sh_world* world = NULL;
-    assert_ok(sh_world_create(&wd, &world));
-    return world;
-}
-
 static sh_body_id add_fem(sh_world* world, const sh_mesh* mesh, sh_material_model model, double young, double density,
                           sh_integrator integrator, sh_unstable_policy policy) {
     sh_fem_body_def def;
@@ -34,7 +25,7 @@ static sh_body_id add_fem(sh_world* world, const sh_mesh* mesh, sh_material_mode
 /* Lumped masses sum to density x volume, for a box and for the liver (volume from the mesh). */
 static void test_lumped_mass(void** state) {
     (void)state;
-    sh_world* world = make_world(-9.81);
+    sh_world* world = sh_test_world(-9.81);
     sh_mesh* box = sh_test_box(0.3, 0.2, 0.1, 3, 2, 2);
     sh_body_id body = add_fem(world, box, SH_MATERIAL_STVK, 1e4, 1070.0, SH_INTEGRATOR_SYMPLECTIC_EULER, SH_UNSTABLE_SUBSTEP);
     sh_body_info info;
@@ -64,7 +55,7 @@ static void test_lumped_mass_liver(void** state) {
     assert_ok(sh_mesh_load(SH_TEST_MESH("liver.msh"), &liver));
     sh_mesh_info mi;
     assert_ok(sh_mesh_get_info(liver, &mi));
-    sh_world* world = make_world(-9.81);
+    sh_world* world = sh_test_world(-9.81);
     sh_body_id body = add_fem(world, liver, SH_MATERIAL_STVK, 1e4, 1000.0, SH_INTEGRATOR_SYMPLECTIC_EULER, SH_UNSTABLE_SUBSTEP);
     sh_body_info info;
     assert_ok(sh_body_get_info(world, body, &info));
@@ -83,7 +74,7 @@ static void test_momentum_conserved(void** state) {
     const int n = mi.node_count;
     for (int model = 0; model < 4; ++model)
         for (int integrator = 0; integrator < 4; ++integrator) {
-            sh_world* world = make_world(0.0);
+            sh_world* world = sh_test_world(0.0);
             sh_body_id body = add_fem(world, box, (sh_material_model)model, 1e4, 1000.0, (sh_integrator)integrator, SH_UNSTABLE_SUBSTEP);
             double v[3 * 64], m[64], x[3 * 64];
             srand(7);
@@ -146,7 +137,7 @@ static void test_patch(void** state) {
 
     const sh_material_model models[2] = {SH_MATERIAL_LINEAR, SH_MATERIAL_STVK};
     for (int m = 0; m < 2; ++m) {
-        sh_world* world = make_world(0.0);
+        sh_world* world = sh_test_world(0.0);
         sh_fem_body_def def;
         sh_fem_body_def_default(&def);
         def.mesh = mesh;
@@ -177,7 +168,7 @@ static void test_patch(void** state) {
 /* Fixed nodes never move; external forces are held; gravity pulls the rest down. */
 static void test_fixed_nodes_and_loads(void** state) {
     (void)state;
-    sh_world* world = make_world(-9.81);
+    sh_world* world = sh_test_world(-9.81);
     sh_mesh* box = sh_test_box(0.2, 0.05, 0.05, 4, 1, 1);
     sh_body_id body = add_fem(world, box, SH_MATERIAL_COROTATIONAL, 1e5, 1000.0, SH_INTEGRATOR_SYMPLECTIC_EULER, SH_UNSTABLE_SUBSTEP);
     sh_body_info info;
@@ -207,18 +198,10 @@ static void test_fixed_nodes_and_loads(void** state) {
 /* A prescribed node moves linearly to its target within one step and stays there. */
 static void test_prescribed_positions(void** state) {
     (void)state;
-    sh_world* world = make_world(0.0);
-    const double nodes[6] = {0, 0, 0, 1, 0, 0};
-    const int32_t springs[2] = {0, 1};
-    sh_spring_body_def def;
-    sh_spring_body_def_default(&def);
-    def.nodes = nodes;
-    def.node_count = 2;
-    def.springs = springs;
-    def.spring_count = 1;
-    def.node_mass = 1.0;
-    sh_body_id body;
-    assert_ok(sh_world_add_spring_body(world, &def, &body));
+    sh_world* world = sh_test_world(0.0);
+    sh_spring_body_def defaults;
+    sh_spring_body_def_default(&defaults);
+    const sh_body_id body = sh_test_spring_pair(world, 1.0, &defaults.params, 1.0, SH_INTEGRATOR_SYMPLECTIC_EULER, SH_UNSTABLE_SUBSTEP);
     const int32_t node = 0;
     const double target[3] = {0.01, 0.02, -0.03};
     assert_ok(sh_body_prescribe_positions(world, body, &node, target, 1));
@@ -241,19 +224,9 @@ static void test_prescribed_positions(void** state) {
 /* Each spring law's tension against its formula, read back through the elastic forces of a
  * two-node body stretched along x; energies against the law's integral. */
 static double spring_force(const sh_spring_params* params, double stretch, double* energy) {
-    sh_world* world = make_world(0.0);
+    sh_world* world = sh_test_world(0.0);
     const double l0 = 0.5;
-    const double nodes[6] = {0, 0, 0, l0, 0, 0};
-    const int32_t springs[2] = {0, 1};
-    sh_spring_body_def def;
-    sh_spring_body_def_default(&def);
-    def.nodes = nodes;
-    def.node_count = 2;
-    def.springs = springs;
-    def.spring_count = 1;
-    def.params = *params;
-    sh_body_id body;
-    assert_ok(sh_world_add_spring_body(world, &def, &body));
+    const sh_body_id body = sh_test_spring_pair(world, l0, params, 1e-3, SH_INTEGRATOR_SYMPLECTIC_EULER, SH_UNSTABLE_SUBSTEP);
     const double x[6] = {0, 0, 0, l0 + stretch, 0, 0};
     assert_ok(sh_body_set_positions(world, body, x, 2));
     double f[6];
@@ -316,7 +289,7 @@ static void test_spring_laws(void** state) {
 static void test_stiff_policies(void** state) {
     (void)state;
     sh_mesh* box = sh_test_box(0.1, 0.05, 0.05, 4, 2, 2);
-    sh_world* world = make_world(-9.81);
+    sh_world* world = sh_test_world(-9.81);
     sh_body_id rejecting = add_fem(world, box, SH_MATERIAL_STVK, 1e9, 1000.0, SH_INTEGRATOR_SYMPLECTIC_EULER, SH_UNSTABLE_REJECT);
     sh_body_id substepping = add_fem(world, box, SH_MATERIAL_STVK, 1e9, 1000.0, SH_INTEGRATOR_SYMPLECTIC_EULER, SH_UNSTABLE_SUBSTEP);
     sh_body_info info;
@@ -353,7 +326,7 @@ static void test_stiff_policies(void** state) {
 static void test_runaway_rollback(void** state) {
     (void)state;
     sh_mesh* box = sh_test_box(0.1, 0.05, 0.05, 2, 1, 1);
-    sh_world* world = make_world(0.0);
+    sh_world* world = sh_test_world(0.0);
     sh_fem_body_def def;
     sh_fem_body_def_default(&def);
     def.mesh = box;

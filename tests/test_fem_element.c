@@ -21,10 +21,7 @@ typedef struct {
 
 static tet_scene make_tet(sh_material_model model) {
     tet_scene s;
-    sh_world_def wd;
-    sh_world_def_default(&wd);
-    wd.gravity[2] = 0.0;
-    assert_ok(sh_world_create(&wd, &s.world));
+    s.world = sh_test_world(0.0);
     s.mesh = sh_test_unit_tet(kSide);
     sh_fem_body_def def;
     sh_fem_body_def_default(&def);
@@ -60,11 +57,16 @@ static void forces_from_stress(const double P[3][3], double f[12]) {
         }
 }
 
-static void assert_forces(tet_scene* s, const double F[3][3], const double P[3][3]) {
-    double x[12], got[12], expected[12];
+/* Puts the body in the shape x = F X and reads its elastic forces. */
+static void forces_at(tet_scene* s, const double F[3][3], double x[12], double f[12]) {
     deform(F, x);
     assert_ok(sh_body_set_positions(s->world, s->body, x, 4));
-    assert_ok(sh_body_get_elastic_forces(s->world, s->body, got, 12));
+    assert_ok(sh_body_get_elastic_forces(s->world, s->body, f, 12));
+}
+
+static void assert_forces(tet_scene* s, const double F[3][3], const double P[3][3]) {
+    double x[12], got[12], expected[12];
+    forces_at(s, F, x, got);
     forces_from_stress(P, expected);
     const double scale = kYoung * kSide * kSide;
     for (int k = 0; k < 12; ++k) assert_close(got[k] / scale, expected[k] / scale, 1e-12);
@@ -128,9 +130,7 @@ static void check_rigid_invariance(sh_material_model model) {
     const double F0[3][3] = {{1.12, 0.07, -0.03}, {0.02, 0.91, 0.05}, {-0.06, 0.04, 1.04}};
     tet_scene s = make_tet(model);
     double x0[12], f0[12], e0;
-    deform(F0, x0);
-    assert_ok(sh_body_set_positions(s.world, s.body, x0, 4));
-    assert_ok(sh_body_get_elastic_forces(s.world, s.body, f0, 12));
+    forces_at(&s, F0, x0, f0);
     assert_ok(sh_body_get_elastic_energy(s.world, s.body, &e0));
     assert_true(e0 > 0.0);
     const double identity[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
@@ -178,9 +178,7 @@ static void test_small_strain_limit(void** state) {
     for (int m = 0; m < 4; ++m) {
         tet_scene s = make_tet(models[m]);
         double x[12], f[12];
-        deform(F, x);
-        assert_ok(sh_body_set_positions(s.world, s.body, x, 4));
-        assert_ok(sh_body_get_elastic_forces(s.world, s.body, f, 12));
+        forces_at(&s, F, x, f);
         if (m == 0) memcpy(reference, f, sizeof f);
         const double scale = kYoung * kSide * kSide * e;  /* size of the linear force */
         for (int k = 0; k < 12; ++k) assert_true(fabs(f[k] - reference[k]) <= 1e-4 * scale);
@@ -196,9 +194,7 @@ static void test_forces_are_energy_gradient(void** state) {
     for (int m = 0; m < 4; ++m) {
         tet_scene s = make_tet(models[m]);
         double x[12], f[12];
-        deform(F, x);
-        assert_ok(sh_body_set_positions(s.world, s.body, x, 4));
-        assert_ok(sh_body_get_elastic_forces(s.world, s.body, f, 12));
+        forces_at(&s, F, x, f);
         const double h = 1e-6 * kSide;
         for (int k = 0; k < 12; ++k) {
             double xp[12], ep, em;

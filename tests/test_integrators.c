@@ -13,24 +13,11 @@ typedef struct {
 
 static oscillator make_oscillator(sh_integrator integrator) {
     oscillator o;
-    sh_world_def wd;
-    sh_world_def_default(&wd);
-    wd.gravity[2] = 0.0;
-    assert_ok(sh_world_create(&wd, &o.world));
-    const double nodes[6] = {0, 0, 0, kRest, 0, 0};
-    const int32_t springs[2] = {0, 1};
-    sh_spring_body_def def;
-    sh_spring_body_def_default(&def);
-    def.nodes = nodes;
-    def.node_count = 2;
-    def.springs = springs;
-    def.spring_count = 1;
-    def.params.law = SH_SPRING_LINEAR;
-    def.params.stiffness = kStiffness;
-    def.node_mass = kMass;
-    def.integrator = integrator;
-    def.on_unstable = SH_UNSTABLE_REJECT; /* a test must never sub-step silently */
-    assert_ok(sh_world_add_spring_body(o.world, &def, &o.body));
+    o.world = sh_test_world(0.0);
+    sh_spring_params params = {SH_SPRING_LINEAR};
+    params.stiffness = kStiffness;
+    /* reject: a test must never sub-step silently */
+    o.body = sh_test_spring_pair(o.world, kRest, &params, kMass, integrator, SH_UNSTABLE_REJECT);
     const int32_t fixed = 0;
     assert_ok(sh_body_fix_nodes(o.world, o.body, &fixed, 1));
     const double start[6] = {0, 0, 0, kRest + kAmplitude, 0, 0};
@@ -140,10 +127,7 @@ static void test_free_particle(void** s) {
     (void)s;
     const sh_integrator integrators[3] = {SH_INTEGRATOR_SYMPLECTIC_EULER, SH_INTEGRATOR_RK2, SH_INTEGRATOR_RK4};
     for (int k = 0; k < 3; ++k) {
-        sh_world_def wd;
-        sh_world_def_default(&wd);
-        sh_world* world;
-        assert_ok(sh_world_create(&wd, &world));
+        sh_world* world = sh_test_world(-9.81);
         const double node[3] = {1.0, 2.0, 3.0};
         sh_spring_body_def def;
         sh_spring_body_def_default(&def);

@@ -20,6 +20,34 @@ void sh_test_assert_close(double a, double b, double tol, const char* expr, cons
     }
 }
 
+sh_world* sh_test_world(double gravity_z) {
+    sh_world_def def;
+    sh_world_def_default(&def);
+    def.gravity[2] = gravity_z;
+    sh_world* world = NULL;
+    sh_test_assert_status(sh_world_create(&def, &world), SH_OK, "sh_world_create", __FILE__, __LINE__);
+    return world;
+}
+
+sh_body_id sh_test_spring_pair(sh_world* world, double rest_length, const sh_spring_params* params, double mass,
+                               sh_integrator integrator, sh_unstable_policy policy) {
+    const double nodes[6] = {0, 0, 0, rest_length, 0, 0};
+    const int32_t springs[2] = {0, 1};
+    sh_spring_body_def def;
+    sh_spring_body_def_default(&def);
+    def.nodes = nodes;
+    def.node_count = 2;
+    def.springs = springs;
+    def.spring_count = 1;
+    def.params = *params;
+    def.node_mass = mass;
+    def.integrator = integrator;
+    def.on_unstable = policy;
+    sh_body_id body = SH_NULL_BODY;
+    sh_test_assert_status(sh_world_add_spring_body(world, &def, &body), SH_OK, "sh_world_add_spring_body", __FILE__, __LINE__);
+    return body;
+}
+
 sh_mesh* sh_test_unit_tet(double s) {
     const double nodes[12] = {0, 0, 0, s, 0, 0, 0, s, 0, 0, 0, s};
     const int32_t tets[4] = {0, 1, 2, 3};

@@ -28,6 +28,14 @@ void sh_test_assert_status(sh_status got, sh_status expected, const char* expr, 
 /** Implementation of assert_close. */
 void sh_test_assert_close(double a, double b, double tol, const char* expr, const char* file, int line);
 
+/** A world with gravity (0, 0, gravity_z). */
+sh_world* sh_test_world(double gravity_z);
+
+/** Adds a two-node spring body along x: node 0 at the origin, node 1 at (rest_length, 0, 0),
+ *  one spring with params, node masses `mass`, the given integrator and policy. */
+sh_body_id sh_test_spring_pair(sh_world* world, double rest_length, const sh_spring_params* params, double mass,
+                               sh_integrator integrator, sh_unstable_policy policy);
+
 /** A unit right-handed tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) scaled by s, as a mesh. */
 sh_mesh* sh_test_unit_tet(double s);
 

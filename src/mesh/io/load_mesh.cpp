@@ -38,8 +38,9 @@ MeshData load_mesh_file(const std::string& path) {
                            "first (e.g. with TetGen or Gmsh)", path.c_str(), printable(ext).c_str()));
     if (kind == Format::Unknown)
         throw Error(SH_ERR_UNSUPPORTED,
-                    format("%s: unknown mesh file extension '%s' (supported: .msh, .vtk, .vtu, .node/.ele)",
-                           path.c_str(), printable(ext).c_str()));
+                    format("%s: %s%s%s is not a mesh format softhap reads (supported: .msh, .vtk, .vtu, .node/.ele)",
+                           path.c_str(), ext.empty() ? "a file without extension" : "extension '",
+                           printable(ext).c_str(), ext.empty() ? "" : "'"));
     if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
         throw Error(SH_ERR_PARSE, format("%s:1: the file is empty", path.c_str()));
     switch (kind) {

@@ -1,0 +1,631 @@
+/* sh_set_allocator: every softhap allocation goes through the host allocator, with the
+ * alignment it asks for; everything allocated is freed; the step allocates nothing once the
+ * scene is built; allocation failures are SH_ERR_OUT_OF_MEMORY without leaks or crashes.
+ *
+ * The counting allocator stays installed from the first test on (the tests run in order):
+ * it only switches to the default allocator in test_restore_default_allocator, when nothing
+ * it allocated is alive, so no block is ever freed by the wrong allocator. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+
+#include "test_support.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------------------------ */
+/* A counting allocator                                                                         */
+
+typedef struct counter {
+    size_t allocs;            /* successful allocations */
+    size_t frees;             /* frees of our blocks */
+    size_t null_frees;        /* free(NULL) calls */
+    long live_blocks;         /* allocs - frees, never reset */
+    long long live_bytes;     /* bytes of the live blocks, never reset */
+    size_t bad_alignments;    /* requests whose alignment is not a power of two <= 64 */
+    size_t misaligned;        /* returned pointers not aligned as asked (never, by construction) */
+    size_t foreign_frees;     /* frees of a pointer we did not hand out (or a double free) */
+    size_t wrong_user;        /* callbacks called with a user pointer that is not ours */
+    size_t max_alignment;     /* largest alignment asked for */
+    long fail_after;          /* < 0: never fail; else the (fail_after+1)-th attempt and later fail */
+    size_t attempts;          /* allocation attempts since the last reset */
+    size_t failed;            /* attempts refused since the last reset */
+} counter;
+
+static counter g;
+
+#define BLOCK_MAGIC 0x5348414c4c4f43ULL /* "SHALLOC" */
+
+typedef struct block_header {
+    uint64_t magic;
+    size_t size;
+    void* raw;
+    uint64_t pad;
+} block_header; /* 32 bytes, sits just before the returned pointer */
+
+static void* counting_alloc(size_t size, size_t alignment, void* user) {
+    counter* c = (counter*)user;
+    if (c != &g) {
+        ++g.wrong_user;
+        c = &g;
+    }
+    if (alignment == 0 || (alignment & (alignment - 1)) != 0 || alignment > 64) ++c->bad_alignments;
+    if (alignment > c->max_alignment) c->max_alignment = alignment;
+    ++c->attempts;
+    if (c->fail_after >= 0 && c->attempts > (size_t)c->fail_after) {
+        ++c->failed;
+        return NULL;
+    }
+    const size_t align = alignment < 16 ? 16 : (alignment > 64 ? 64 : alignment);
+    unsigned char* raw = malloc(size + sizeof(block_header) + align);
+    if (!raw) return NULL;
+    uintptr_t p = (uintptr_t)(raw + sizeof(block_header));
+    p = (p + align - 1) & ~(uintptr_t)(align - 1);
+    if (alignment != 0 && p % alignment != 0) ++c->misaligned;
+    block_header h = {BLOCK_MAGIC, size, raw, 0};
+    memcpy((unsigned char*)p - sizeof h, &h, sizeof h);
+    ++c->allocs;
+    ++c->live_blocks;
+    c->live_bytes += (long long)size;
+    /* Scribble, so that code reading uninitialised memory is more likely to show it. */
+    memset((void*)p, 0xcd, size);
+    return (void*)p;
+}
+
+static void counting_free(void* ptr, void* user) {
+    counter* c = (counter*)user;
+    if (c != &g) {
+        ++g.wrong_user;
+        c = &g;
+    }
+    if (!ptr) {
+        ++c->null_frees;
+        return;
+    }
+    block_header h;
+    memcpy(&h, (unsigned char*)ptr - sizeof h, sizeof h);
+    if (h.magic != BLOCK_MAGIC) { /* not ours, or freed twice: leave it alone */
+        ++c->foreign_frees;
+        return;
+    }
+    h.magic = 0;
+    memcpy((unsigned char*)ptr - sizeof h, &h, sizeof h);
+    ++c->frees;
+    --c->live_blocks;
+    c->live_bytes -= (long long)h.size;
+    free(h.raw);
+}
+
+static const sh_allocator k_counting = {counting_alloc, counting_free, &g};
+
+/* Resets the per-test counters (not the live ones) and disables failure injection. */
+static void reset_counts(void) {
+    g.allocs = g.frees = g.null_frees = 0;
+    g.attempts = g.failed = 0;
+    g.fail_after = -1;
+}
+
+/* Asserts the allocator saw nothing wrong: no bad request, no foreign free, no wrong user. */
+static void assert_allocator_sane(void) {
+    assert_int_equal(g.bad_alignments, 0);
+    assert_int_equal(g.misaligned, 0);
+    assert_int_equal(g.foreign_frees, 0);
+    assert_int_equal(g.wrong_user, 0);
+}
+
+static int setup_install(void** state) {
+    (void)state;
+    memset(&g, 0, sizeof g);
+    g.fail_after = -1;
+    return sh_set_allocator(&k_counting) == SH_OK ? 0 : -1;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Scenes                                                                                       */
+
+/* Box node and tet arrays like sh_test_box, without creating the mesh (so that the creation's
+ * status can be checked under failure injection). The caller frees both. */
+static void box_arrays(double lx, double ly, double lz, int nx, int ny, int nz, double** out_nodes,
+                       int32_t* out_node_count, int32_t** out_tets, int32_t* out_tet_count) {
+    const int px = nx + 1, py = ny + 1, pz = nz + 1;
+    const int node_count = px * py * pz, tet_count = 6 * nx * ny * nz;
+    double* nodes = malloc(sizeof(double) * 3 * (size_t)node_count);
+    int32_t* tets = malloc(sizeof(int32_t) * 4 * (size_t)tet_count);
+    assert_non_null(nodes);
+    assert_non_null(tets);
+    for (int k = 0; k < pz; ++k)
+        for (int j = 0; j < py; ++j)
+            for (int i = 0; i < px; ++i) {
+                double* p = &nodes[3 * (size_t)((k * py + j) * px + i)];
+                p[0] = lx * i / nx;
+                p[1] = ly * j / ny;
+                p[2] = lz * k / nz;
+            }
+    static const int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
+    int t = 0;
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                const int c[8] = {(k * py + j) * px + i,           (k * py + j) * px + i + 1,
+                                  (k * py + j + 1) * px + i + 1,   (k * py + j + 1) * px + i,
+                                  ((k + 1) * py + j) * px + i,     ((k + 1) * py + j) * px + i + 1,
+                                  ((k + 1) * py + j + 1) * px + i + 1, ((k + 1) * py + j + 1) * px + i};
+                for (int s = 0; s < 6; ++s, ++t)
+                    for (int a = 0; a < 4; ++a) tets[4 * t + a] = c[kuhn[s][a]];
+            }
+    *out_nodes = nodes;
+    *out_node_count = node_count;
+    *out_tets = tets;
+    *out_tet_count = tet_count;
+}
+
+/* The nodes of the box with x == 0 (the first node of every row). */
+static int32_t x0_nodes(int nx, int ny, int nz, int32_t* out) {
+    int32_t count = 0;
+    for (int k = 0; k <= nz; ++k)
+        for (int j = 0; j <= ny; ++j) out[count++] = (k * (ny + 1) + j) * (nx + 1);
+    return count;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Tests                                                                                        */
+
+static void test_counting_allocator_sees_everything_freed(void** state) {
+    (void)state;
+    reset_counts();
+    const long live_blocks = g.live_blocks;
+    const long long live_bytes = g.live_bytes;
+    assert_int_equal(live_blocks, 0);
+
+    sh_world_def world_def;
+    sh_world_def_default(&world_def);
+    sh_world* world = NULL;
+    assert_ok(sh_world_create(&world_def, &world));
+    sh_mesh* mesh = sh_test_box(0.04, 0.02, 0.02, 4, 2, 2);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    sh_body_id body;
+    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    int32_t fixed[32];
+    const int32_t fixed_count = x0_nodes(4, 2, 2, fixed);
+    assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
+    sh_step_report report;
+    for (int i = 0; i < 10; ++i) assert_ok(sh_world_step(world, 1e-3, &report));
+    assert_true(g.allocs > 0);
+    assert_true(g.live_blocks > 0);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+
+    assert_int_equal(g.frees, g.allocs);
+    assert_int_equal(g.live_blocks, live_blocks);
+    assert_true(g.live_bytes == live_bytes);
+    assert_int_equal(g.failed, 0);
+    assert_true(g.max_alignment >= 8);
+    assert_allocator_sane();
+}
+
+static void test_set_allocator_busy_and_invalid(void** state) {
+    (void)state;
+    reset_counts();
+    sh_world_def world_def;
+    sh_world_def_default(&world_def);
+    sh_world* world = NULL;
+    assert_ok(sh_world_create(&world_def, &world));
+    const sh_allocator other = {counting_alloc, counting_free, &g};
+    assert_status(sh_set_allocator(&other), SH_ERR_BUSY);
+    assert_non_null(strstr(sh_last_error_message(), "alive"));
+    assert_status(sh_set_allocator(NULL), SH_ERR_BUSY);
+    assert_ok(sh_world_destroy(world));
+
+    sh_mesh* mesh = sh_test_unit_tet(0.01); /* a live mesh alone is enough to be busy */
+    assert_status(sh_set_allocator(&k_counting), SH_ERR_BUSY);
+    assert_status(sh_set_allocator(NULL), SH_ERR_BUSY);
+    assert_ok(sh_mesh_destroy(mesh));
+
+    /* Incomplete allocators are invalid arguments, busy or not. */
+    const sh_allocator no_alloc = {NULL, counting_free, &g};
+    const sh_allocator no_free = {counting_alloc, NULL, &g};
+    assert_status(sh_set_allocator(&no_alloc), SH_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(sh_last_error_message(), "alloc"));
+    assert_status(sh_set_allocator(&no_free), SH_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(sh_last_error_message(), "free"));
+
+    /* The counting allocator is still the one in use: a new world goes through it. */
+    reset_counts();
+    assert_ok(sh_world_create(&world_def, &world));
+    assert_true(g.allocs > 0);
+    assert_ok(sh_world_destroy(world));
+    assert_int_equal(g.frees, g.allocs);
+    assert_int_equal(g.live_blocks, 0);
+    assert_allocator_sane();
+}
+
+static void test_restore_default_allocator(void** state) {
+    (void)state;
+    assert_int_equal(g.live_blocks, 0); /* nothing of ours is alive: switching is safe */
+    assert_ok(sh_set_allocator(NULL));
+    reset_counts();
+    sh_world_def world_def;
+    sh_world_def_default(&world_def);
+    sh_world* world = NULL;
+    assert_ok(sh_world_create(&world_def, &world));
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    sh_body_id body;
+    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_world_step(world, 1e-3, NULL));
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+    assert_int_equal(g.attempts, 0); /* the default allocator did it all */
+    assert_int_equal(g.frees, 0);
+    assert_ok(sh_set_allocator(&k_counting)); /* and back, for the tests that follow */
+}
+
+/* Adds to world one FEM body per integrator in fem_integrators (mixed materials, stiffness and
+ * per-node damping) and one mesh-edge spring body per (integrator, law) pair, all fixed at
+ * x = 0. Creation may allocate; returns the number of bodies. */
+static int add_bodies(sh_world* world, const sh_mesh* mesh, const int32_t* fixed, int32_t fixed_count,
+                      const sh_integrator* integrators, int integrator_count, sh_body_id* out) {
+    sh_mesh_info mesh_info;
+    assert_ok(sh_mesh_get_info(mesh, &mesh_info));
+    int count = 0;
+    for (int k = 0; k < integrator_count; ++k) {
+        sh_fem_body_def def;
+        sh_fem_body_def_default(&def);
+        def.mesh = mesh;
+        def.integrator = integrators[k];
+        def.damping_mass = 1.0;
+        def.damping_stiffness = k == 0 ? 1e-4 : 0.0;
+        sh_body_id body;
+        assert_ok(sh_world_add_fem_body(world, &def, &body));
+        assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
+        const int32_t region[4] = {0, 5, 7, 12};
+        const sh_material materials[3] = {{SH_MATERIAL_LINEAR, 5e3, 0.4, 1000},
+                                          {SH_MATERIAL_COROTATIONAL, 8e3, 0.3, 1100},
+                                          {SH_MATERIAL_NEOHOOKEAN, 4e3, 0.45, 1050}};
+        assert_ok(sh_body_set_material(world, body, region, 4, &materials[k % 3]));
+        double damping[64];
+        assert_true(mesh_info.node_count <= 64);
+        for (int i = 0; i < mesh_info.node_count; ++i) damping[i] = 0.5;
+        assert_ok(sh_body_set_node_damping(world, body, damping, mesh_info.node_count)); /* Alloc: may */
+        out[count++] = body;
+
+        static const double table[8] = {-0.5, -50.0, 0.0, 0.0, 0.2, 10.0, 0.5, 60.0};
+        for (int law = 0; law < 4; ++law) {
+            sh_spring_body_def spring;
+            sh_spring_body_def_default(&spring);
+            spring.mesh = mesh;
+            spring.integrator = integrators[k];
+            spring.params.law = (sh_spring_law)law;
+            spring.params.stiffness = 50.0;
+            spring.params.damping = 0.01;
+            spring.params.lambda1 = 5.0;
+            spring.params.lambda2 = 1.0;
+            spring.params.a = 2.0;
+            spring.params.b = 0.01;
+            spring.params.table = table;
+            spring.params.table_rows = 4;
+            spring.damping_mass = 0.5;
+            assert_ok(sh_world_add_spring_body(world, &spring, &body));
+            assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
+            out[count++] = body;
+        }
+    }
+    return count;
+}
+
+/* Calls every query and setter tagged Alloc: none on each body. */
+static void touch_bodies(sh_world* world, const sh_body_id* bodies, int count, const int32_t* fixed) {
+    double buffer[3 * 64];
+    sh_body_info info;
+    double energy;
+    uint64_t warnings[SH_WARN_COUNT];
+    assert_ok(sh_world_get_warnings(world, warnings));
+    for (int b = 0; b < count; ++b) {
+        assert_ok(sh_body_get_info(world, bodies[b], &info));
+        assert_int_equal(sh_body_is_valid(world, bodies[b]), 1);
+        assert_ok(sh_body_get_positions(world, bodies[b], buffer, 3 * 64));
+        assert_ok(sh_body_set_positions(world, bodies[b], buffer, info.node_count));
+        assert_ok(sh_body_get_velocities(world, bodies[b], buffer, 3 * 64));
+        assert_ok(sh_body_set_velocities(world, bodies[b], buffer, info.node_count));
+        assert_ok(sh_body_get_masses(world, bodies[b], buffer, 3 * 64));
+        assert_ok(sh_body_get_elastic_forces(world, bodies[b], buffer, 3 * 64));
+        assert_ok(sh_body_get_elastic_energy(world, bodies[b], &energy));
+        for (int i = 0; i < 3 * info.node_count; ++i) buffer[i] = 1e-4;
+        assert_ok(sh_body_set_external_forces(world, bodies[b], buffer, info.node_count));
+        assert_ok(sh_body_release_nodes(world, bodies[b], fixed, 1));
+        assert_ok(sh_body_fix_nodes(world, bodies[b], fixed, 1));
+        const double gravity[3] = {0.0, 0.0, -9.81};
+        assert_ok(sh_world_set_gravity(world, gravity));
+    }
+}
+
+/* "Alloc: none once the scene is built": sh_world_step, with and without a report, with
+ * sub-stepping, with every material model and spring law, and the Alloc: none queries,
+ * allocate nothing through the installed allocator. Symplectic Euler and RK4 bodies. */
+static void test_step_allocates_nothing(void** state) {
+    (void)state;
+    reset_counts();
+    sh_world* world = sh_test_world(-9.81);
+    sh_mesh* mesh = sh_test_box(0.03, 0.01, 0.01, 3, 1, 1);
+    int32_t fixed[16];
+    const int32_t fixed_count = x0_nodes(3, 1, 1, fixed);
+    const sh_integrator integrators[2] = {SH_INTEGRATOR_SYMPLECTIC_EULER, SH_INTEGRATOR_RK4};
+    sh_body_id bodies[16];
+    const int count = add_bodies(world, mesh, fixed, fixed_count, integrators, 2, bodies);
+    assert_ok(sh_mesh_destroy(mesh)); /* bodies do not need it */
+
+    /* The scene is built: from here on, nothing may allocate. */
+    reset_counts();
+    const long live_blocks = g.live_blocks;
+    sh_step_report report;
+    for (int i = 0; i < 100; ++i) assert_ok(sh_world_step(world, 1e-3, NULL));
+    for (int i = 0; i < 100; ++i) assert_ok(sh_world_step(world, 1e-3, &report));
+    assert_true(report.kinetic_energy > 0.0);
+    /* A step well above dt_crit sub-steps (SH_UNSTABLE_SUBSTEP): still no allocation. */
+    assert_ok(sh_world_step(world, 20.0 * report.dt_critical, &report));
+    assert_true(report.substeps > 1);
+    touch_bodies(world, bodies, count, fixed);
+    for (int i = 0; i < 10; ++i) assert_ok(sh_world_step(world, 1e-3, &report));
+
+    if (g.attempts != 0)
+        print_error("%zu allocations (%zu frees) during steps and Alloc: none calls\n", g.attempts, g.frees);
+    assert_int_equal(g.attempts, 0);
+    assert_int_equal(g.frees, 0);
+    assert_int_equal(g.live_blocks, live_blocks);
+
+    assert_ok(sh_world_destroy(world));
+    assert_int_equal(g.live_blocks, 0);
+    assert_allocator_sane();
+}
+
+/* Same with forward Euler and RK2 bodies, which may blow up and be rolled back
+ * (SH_ERR_UNSTABLE): the rollback path allocates nothing either. */
+static void test_step_with_rollbacks_allocates_nothing(void** state) {
+    (void)state;
+    reset_counts();
+    sh_world* world = sh_test_world(-9.81);
+    sh_mesh* mesh = sh_test_box(0.03, 0.01, 0.01, 3, 1, 1);
+    int32_t fixed[16];
+    const int32_t fixed_count = x0_nodes(3, 1, 1, fixed);
+    const sh_integrator integrators[2] = {SH_INTEGRATOR_FORWARD_EULER, SH_INTEGRATOR_RK2};
+    sh_body_id bodies[16];
+    const int count = add_bodies(world, mesh, fixed, fixed_count, integrators, 2, bodies);
+    assert_ok(sh_mesh_destroy(mesh));
+
+    reset_counts();
+    const long live_blocks = g.live_blocks;
+    sh_step_report report;
+    int unstable = 0;
+    for (int i = 0; i < 200; ++i) {
+        const sh_status status = sh_world_step(world, 1e-3, i % 2 ? &report : NULL);
+        assert_true(status == SH_OK || status == SH_ERR_UNSTABLE);
+        unstable += status == SH_ERR_UNSTABLE;
+    }
+    touch_bodies(world, bodies, count, fixed);
+    if (g.attempts != 0)
+        print_error("%zu allocations (%zu frees) during steps (%d unstable) and Alloc: none calls\n", g.attempts,
+                    g.frees, unstable);
+    assert_int_equal(g.attempts, 0);
+    assert_int_equal(g.frees, 0);
+    assert_int_equal(g.live_blocks, live_blocks);
+    assert_ok(sh_world_destroy(world));
+    assert_int_equal(g.live_blocks, 0);
+    assert_allocator_sane();
+}
+
+/* sh_world_remove_body is tagged Alloc: none: removing bodies (the first removal included)
+ * allocates nothing, and so it cannot fail with SH_ERR_OUT_OF_MEMORY. */
+static void test_remove_body_allocates_nothing(void** state) {
+    (void)state;
+    reset_counts();
+    sh_world* world = sh_test_world(-9.81);
+    sh_mesh* mesh = sh_test_unit_tet(0.01);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    sh_body_id bodies[4];
+    for (int i = 0; i < 4; ++i) assert_ok(sh_world_add_fem_body(world, &def, &bodies[i]));
+    reset_counts();
+    for (int i = 0; i < 4; ++i) assert_ok(sh_world_remove_body(world, bodies[i]));
+    if (g.attempts != 0) print_error("sh_world_remove_body: %zu allocation(s) for 4 removals\n", g.attempts);
+    const size_t attempts = g.attempts;
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+    assert_int_equal(g.live_blocks, 0);
+    assert_allocator_sane();
+    assert_int_equal(attempts, 0);
+}
+
+/* A step that is rejected (SH_UNSTABLE_REJECT, dt above dt_crit) is still Alloc: none
+ * through the installed allocator. */
+static void test_rejected_step_allocates_nothing(void** state) {
+    (void)state;
+    reset_counts();
+    sh_world_def world_def;
+    sh_world_def_default(&world_def);
+    sh_world* world = NULL;
+    assert_ok(sh_world_create(&world_def, &world));
+    sh_mesh* mesh = sh_test_box(0.01, 0.01, 0.01, 1, 1, 1);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.on_unstable = SH_UNSTABLE_REJECT;
+    sh_body_id body;
+    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    sh_body_info info;
+    assert_ok(sh_body_get_info(world, body, &info));
+    reset_counts();
+    sh_step_report report;
+    for (int i = 0; i < 10; ++i) assert_status(sh_world_step(world, 10.0 * info.dt_critical, &report), SH_ERR_UNSTABLE);
+    assert_int_equal(report.unstable_body_count, 1);
+    assert_int_equal(g.attempts, 0);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+    assert_int_equal(g.live_blocks, 0);
+    assert_allocator_sane();
+}
+
+/* The scene of the failure-injection test: every creation call, each may fail with
+ * SH_ERR_OUT_OF_MEMORY. Returns the first failing status (SH_OK if all succeeded); whatever
+ * was created is destroyed before returning. */
+static char g_failure_message[1024]; /* the failing call's last-error message */
+
+static sh_status build_and_destroy_scene(const double* nodes, int32_t node_count, const int32_t* tets,
+                                         int32_t tet_count, int* out_stage) {
+    sh_world* world = NULL;
+    sh_mesh* mesh = NULL;
+    sh_status status = SH_OK;
+    int stage = 0;
+    sh_body_id body = 42;
+    sh_world_def world_def;
+    sh_world_def_default(&world_def);
+
+    world = (sh_world*)&world; /* garbage: must be NULL after a failure */
+    status = sh_world_create(&world_def, &world);
+    if (status != SH_OK) {
+        assert_null(world);
+        goto done;
+    }
+    ++stage;
+    mesh = (sh_mesh*)&mesh;
+    status = sh_mesh_create(nodes, node_count, tets, tet_count, &mesh);
+    if (status != SH_OK) {
+        assert_null(mesh);
+        goto done;
+    }
+    ++stage;
+    sh_fem_body_def fem;
+    sh_fem_body_def_default(&fem);
+    fem.mesh = mesh;
+    status = sh_world_add_fem_body(world, &fem, &body);
+    if (status != SH_OK) {
+        assert_true(body == SH_NULL_BODY);
+        goto done;
+    }
+    ++stage;
+    const int32_t region[2] = {0, 1};
+    const sh_material soft = {SH_MATERIAL_NEOHOOKEAN, 2e3, 0.45, 1000};
+    status = sh_body_set_material(world, body, region, 2, &soft);
+    if (status != SH_OK) goto done;
+    ++stage;
+    double damping[64];
+    for (int i = 0; i < node_count; ++i) damping[i] = 0.1;
+    status = sh_body_set_node_damping(world, body, damping, node_count);
+    if (status != SH_OK) goto done;
+    ++stage;
+    sh_spring_body_def spring;
+    sh_spring_body_def_default(&spring);
+    spring.mesh = mesh;
+    body = 42;
+    status = sh_world_add_spring_body(world, &spring, &body);
+    if (status != SH_OK) {
+        assert_true(body == SH_NULL_BODY);
+        goto done;
+    }
+    ++stage;
+    const double table[6] = {-0.1, -1.0, 0.0, 0.0, 0.1, 1.0};
+    spring.params.law = SH_SPRING_TABLE;
+    spring.params.table = table;
+    spring.params.table_rows = 3;
+    body = 42;
+    status = sh_world_add_spring_body(world, &spring, &body);
+    if (status != SH_OK) {
+        assert_true(body == SH_NULL_BODY);
+        goto done;
+    }
+    ++stage;
+    status = sh_world_remove_body(world, body);
+    if (status != SH_OK) goto done;
+    ++stage;
+    status = sh_world_add_spring_body(world, &spring, &body);
+    if (status != SH_OK) goto done;
+    ++stage;
+    sh_step_report report;
+    status = sh_world_step(world, 1e-3, &report);
+    if (status != SH_OK) goto done;
+    ++stage;
+
+done:
+    *out_stage = stage;
+    snprintf(g_failure_message, sizeof g_failure_message, "%s", sh_last_error_message());
+    if (mesh && mesh != (sh_mesh*)&mesh) assert_ok(sh_mesh_destroy(mesh));
+    if (world && world != (sh_world*)&world) assert_ok(sh_world_destroy(world));
+    return status;
+}
+
+static void test_failing_allocator(void** state) {
+    (void)state;
+    double* nodes;
+    int32_t* tets;
+    int32_t node_count, tet_count;
+    box_arrays(0.02, 0.01, 0.01, 2, 1, 1, &nodes, &node_count, &tets, &tet_count);
+    assert_true(node_count <= 64);
+
+    /* How many allocations the whole scene takes when nothing fails. */
+    reset_counts();
+    int stage = 0;
+    assert_ok(build_and_destroy_scene(nodes, node_count, tets, tet_count, &stage));
+    const size_t needed = g.attempts;
+    assert_true(needed > 0);
+    assert_int_equal(g.live_blocks, 0);
+
+    int leaks = 0, wrong_status = 0;
+    for (long n = 0; n <= (long)needed; ++n) {
+        reset_counts();
+        g.fail_after = n;
+        const long live_before = g.live_blocks;
+        const long long bytes_before = g.live_bytes;
+        const sh_status status = build_and_destroy_scene(nodes, node_count, tets, tet_count, &stage);
+        const size_t failed = g.failed;
+        g.fail_after = -1;
+        if (failed == 0) {
+            /* Allocation n+1 was never attempted: the scene was built in full. */
+            assert_ok(status);
+            assert_true((size_t)n >= needed);
+        } else if (status != SH_ERR_OUT_OF_MEMORY) {
+            print_error("fail after %ld allocations: stage %d returned %s (%s), expected SH_ERR_OUT_OF_MEMORY\n", n,
+                        stage, sh_status_string(status), g_failure_message);
+            ++wrong_status;
+        } else if (!strstr(g_failure_message, "memory")) {
+            print_error("fail after %ld allocations: stage %d: message \"%s\" does not mention memory\n", n, stage,
+                        g_failure_message);
+            ++wrong_status;
+        }
+        if (g.live_blocks > live_before) {
+            print_error("fail after %ld allocations (stage %d, %s: %s): %ld block(s), %lld byte(s) still live after "
+                        "destroying everything\n",
+                        n, stage, sh_status_string(status), g_failure_message, g.live_blocks - live_before,
+                        g.live_bytes - bytes_before);
+            ++leaks;
+        } else if (g.live_blocks < live_before) {
+            print_error("fail after %ld allocations (stage %d): %ld block(s) leaked by an earlier run were freed\n", n,
+                        stage, live_before - g.live_blocks);
+        }
+        assert_allocator_sane();
+    }
+    free(nodes);
+    free(tets);
+    assert_int_equal(wrong_status, 0);
+    assert_int_equal(leaks, 0);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_counting_allocator_sees_everything_freed),
+        cmocka_unit_test(test_set_allocator_busy_and_invalid),
+        cmocka_unit_test(test_restore_default_allocator),
+        cmocka_unit_test(test_step_allocates_nothing),
+        cmocka_unit_test(test_step_with_rollbacks_allocates_nothing),
+        cmocka_unit_test(test_rejected_step_allocates_nothing),
+        cmocka_unit_test(test_remove_body_allocates_nothing),
+        cmocka_unit_test(test_failing_allocator), /* last: a leak would stay behind */
+    };
+    return cmocka_run_group_tests(tests, setup_install, NULL);
+}

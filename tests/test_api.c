@@ -38,14 +38,7 @@ static void assert_no_error_message(void) {
 }
 
 /* A world with default gravity. */
-static sh_world* make_world(void) {
-    sh_world_def def;
-    sh_world_def_default(&def);
-    sh_world* world = NULL;
-    assert_ok(sh_world_create(&def, &world));
-    assert_non_null(world);
-    return world;
-}
+static sh_world* make_world(void) { return sh_test_world(-9.81); }
 
 /* An FEM body from mesh with default def. */
 static sh_body_id add_fem(sh_world* world, const sh_mesh* mesh) {
@@ -58,20 +51,11 @@ static sh_body_id add_fem(sh_world* world, const sh_mesh* mesh) {
     return id;
 }
 
-/* A spring body of two nodes 1 cm apart joined by one spring. */
+/* A spring body of two nodes 1 cm apart joined by one default spring. */
 static sh_body_id add_two_node_spring(sh_world* world) {
-    static const double nodes[6] = {0, 0, 0, 0.01, 0, 0};
-    static const int32_t springs[2] = {0, 1};
     sh_spring_body_def def;
     sh_spring_body_def_default(&def);
-    def.nodes = nodes;
-    def.node_count = 2;
-    def.springs = springs;
-    def.spring_count = 1;
-    sh_body_id id = SH_NULL_BODY;
-    assert_ok(sh_world_add_spring_body(world, &def, &id));
-    assert_true(id != SH_NULL_BODY);
-    return id;
+    return sh_test_spring_pair(world, 0.01, &def.params, def.node_mass, def.integrator, def.on_unstable);
 }
 
 static int32_t node_count_of(const sh_world* world, sh_body_id body) {

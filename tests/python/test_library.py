@@ -19,6 +19,23 @@ def test_version_is_0_1_0():
     assert softhap.version_string(2003004) == "2.3.4"
 
 
+def test_build_features_match_the_cmake_options():
+    features = softhap.build_features()
+    assert features <= {"SH_FEATURE_CHOLMOD", "SH_FEATURE_CCD"}
+    # If the library sits in a CMake build tree, its cache says which options were ON.
+    cache = os.path.join(os.path.dirname(os.path.realpath(softhap.library_path)), "CMakeCache.txt")
+    if not os.path.isfile(cache):
+        pytest.skip("the library is not in a CMake build tree")
+    options = {}
+    with open(cache) as text:
+        for line in text:
+            if line.startswith("SOFTHAP_WITH_") and ":BOOL=" in line:
+                name, value = line.strip().split(":BOOL=")
+                options[name] = value.upper() in ("ON", "1", "TRUE", "YES")
+    assert ("SH_FEATURE_CHOLMOD" in features) == options["SOFTHAP_WITH_CHOLMOD"]
+    assert ("SH_FEATURE_CCD" in features) == options["SOFTHAP_WITH_CCD"]
+
+
 def test_library_path_comes_from_environment_when_set():
     if os.environ.get("SOFTHAP_LIBRARY"):
         assert softhap.library_path == os.environ["SOFTHAP_LIBRARY"]

@@ -15,7 +15,7 @@ call raises softhap.Error with the status and sh_last_error_message().
 """
 
 from ._errors import Error, status_name
-from ._lib import SH_VERSION, Status, WarningKind, version_string
+from ._lib import SH_VERSION, FeatureKind, Status, WarningKind, version_string
 from ._loaded import lib as _c_library
 from ._loaded import status_string
 from ._record import BodyInfo, MeshInfo, StepReport
@@ -34,10 +34,18 @@ def version():
     return int(_c_library.sh_version())
 
 
+def build_features():
+    """The optional components compiled into the loaded library, as a frozenset of names
+    ("SH_FEATURE_CHOLMOD", "SH_FEATURE_CCD") from the sh_build_features() bit mask."""
+    bits = int(_c_library.sh_build_features())
+    return frozenset(kind.name for kind in FeatureKind if bits & int(kind))
+
+
 __all__ = [
     "Body",
     "BodyInfo",
     "Error",
+    "FeatureKind",
     "Mesh",
     "MeshInfo",
     "SH_VERSION",
@@ -45,6 +53,7 @@ __all__ = [
     "StepReport",
     "WarningKind",
     "World",
+    "build_features",
     "library_path",
     "status_name",
     "status_string",

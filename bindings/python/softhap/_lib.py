@@ -76,6 +76,14 @@ class WarningKind(enum.IntEnum):
 
 SH_WARN_COUNT = 5
 
+
+class FeatureKind(enum.IntEnum):
+    """sh_feature: optional components a build may include (bits of sh_build_features())."""
+
+    SH_FEATURE_CHOLMOD = 1
+    SH_FEATURE_CCD = 2
+
+
 INTEGRATORS = {
     "forward_euler": 0,
     "symplectic_euler": 1,
@@ -247,6 +255,7 @@ _pi = POINTER(c_int32)
 PROTOTYPES = {
     # version, status, errors, memory
     "sh_version": (c_int32, []),
+    "sh_build_features": (c_uint32, []),
     "sh_status_string": (c_char_p, [c_int]),
     "sh_last_error_message": (c_char_p, []),
     "sh_set_allocator": (_status, [c_void_p]),

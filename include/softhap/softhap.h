@@ -144,6 +144,12 @@ SH_API sh_status sh_mesh_create(const double* nodes, int32_t node_count, const i
  *  element. Thread: sim. Alloc: may. */
 SH_API sh_status sh_mesh_load(const char* path, sh_mesh** out_mesh);
 
+/** Create a new mesh whose nodes are scale * x + translation (translation may be NULL), e.g.
+ *  scale = 0.01 for a file in centimetres. scale must be finite and > 0.
+ *  Thread: sim. Alloc: may. */
+SH_API sh_status sh_mesh_transform(const sh_mesh* mesh, double scale, const double translation[3],
+                                   sh_mesh** out_mesh);
+
 /** Destroy a mesh. NULL is a no-op returning SH_OK; a destroyed pointer returns
  *  SH_ERR_INVALID_HANDLE. Thread: sim. Alloc: none. */
 SH_API sh_status sh_mesh_destroy(sh_mesh* mesh);

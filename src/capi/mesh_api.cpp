@@ -5,6 +5,7 @@
 #include "mesh/tet_mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 struct sh_mesh {
     sh::TetMesh mesh;
@@ -64,6 +65,30 @@ SH_API sh_status sh_mesh_load(const char* path, sh_mesh** out_mesh) {
         *out_mesh = nullptr;
         capi::require_pointer(path, "path");
         *out_mesh = publish(build_tet_mesh(load_mesh_file(path), path));
+    });
+}
+
+SH_API sh_status sh_mesh_transform(const sh_mesh* mesh, double scale, const double translation[3], sh_mesh** out_mesh) {
+    return capi::guard([&] {
+        capi::require_pointer(out_mesh, "out_mesh");
+        *out_mesh = nullptr;
+        const TetMesh& source = checked_mesh(mesh);
+        require(std::isfinite(scale) && scale > 0.0, SH_ERR_INVALID_ARGUMENT,
+                format("scale = %g, must be finite and > 0", scale));
+        double t[3] = {0.0, 0.0, 0.0};
+        if (translation)
+            for (int k = 0; k < 3; ++k) {
+                capi::require_finite(translation[k], "translation");
+                t[k] = translation[k];
+            }
+        MeshData data;
+        data.nodes = source.nodes;
+        for (size_t i = 0; i < data.nodes.size(); ++i) data.nodes[i] = scale * data.nodes[i] + t[i % 3];
+        data.tets = source.tets;
+        data.skipped_elements = source.skipped_element_count;
+        TetMesh moved = build_tet_mesh(std::move(data), "sh_mesh_transform");
+        moved.reoriented_tet_count = source.reoriented_tet_count;
+        *out_mesh = publish(std::move(moved));
     });
 }
 

@@ -1,8 +1,9 @@
 /* Mesh files through the public C API: the shared meshes load with the counts their README
  * gives; the same small mesh loads identically from every format; corrupted files fail with
- * an exact status and a message naming the file line; .vtu written by the library reads back
- * bit for bit. Expected values come from the README, from the fixtures' hand-written content
- * (tests/data/README.md), or from an independent numpy computation over the files. */
+ * an exact status and a message naming the file line; a file cut short anywhere never crashes;
+ * .vtu written by the library reads back bit for bit. Expected values come from the README,
+ * from the fixtures' hand-written content (tests/data/README.md), or from an independent numpy
+ * computation over the files. */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp */
 
 #include "test_support.h"
@@ -42,14 +43,36 @@ static const char* temp_path(const char* name) {
     return path;
 }
 
-/* Writes size bytes into name in the temporary directory; returns its path. */
-static const char* write_temp(const char* name, const void* bytes, size_t size) {
-    const char* path = temp_path(name);
+/* Writes size bytes into path (replacing it). */
+static void write_file(const char* path, const void* bytes, size_t size) {
     FILE* file = fopen(path, "wb");
     assert_non_null(file);
     assert_int_equal(fwrite(bytes, 1, size, file), size);
     assert_int_equal(fclose(file), 0);
+}
+
+/* Writes size bytes into name in the temporary directory; returns its path. */
+static const char* write_temp(const char* name, const void* bytes, size_t size) {
+    const char* path = temp_path(name);
+    write_file(path, bytes, size);
     return path;
+}
+
+/* Reads a whole file into a malloc'ed buffer. */
+static char* read_file(const char* path, size_t* size) {
+    FILE* file = fopen(path, "rb");
+    assert_non_null(file);
+    char* bytes = NULL;
+    size_t used = 0, got = 0;
+    char chunk[4096];
+    while ((got = fread(chunk, 1, sizeof chunk, file)) > 0) {
+        bytes = realloc(bytes, used + got);
+        memcpy(bytes + used, chunk, got);
+        used += got;
+    }
+    fclose(file);
+    *size = used;
+    return bytes;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -489,6 +512,51 @@ static void test_binary_garbage(void** state) {
     }
 }
 
+/* Every proper prefix of a fixture (a file cut short anywhere) loads or is refused as
+ * malformed, unsupported or degenerate, with the file named: never a crash, a hang, an I/O or
+ * internal error. A TetGen prefix is loaded with the other file of its pair complete. */
+static void check_prefixes(const char* fixture, const char* name, const char* companion_fixture,
+                           const char* companion_name) {
+    print_message("%s\n", fixture);
+    if (companion_fixture) {
+        size_t size = 0;
+        char* bytes = read_file(companion_fixture, &size);
+        write_temp(companion_name, bytes, size);
+        free(bytes);
+    }
+    size_t size = 0;
+    char* bytes = read_file(fixture, &size);
+    const char* path = temp_path(name);
+    for (size_t length = 0; length < size; ++length) {
+        write_file(path, bytes, length);
+        sh_mesh* mesh = NULL;
+        const sh_status status = sh_mesh_load(path, &mesh);
+        if (status == SH_OK) {
+            assert_ok(sh_mesh_destroy(mesh));
+            continue;
+        }
+        if ((status != SH_ERR_PARSE && status != SH_ERR_UNSUPPORTED && status != SH_ERR_DEGENERATE_MESH) ||
+            !strstr(sh_last_error_message(), name)) {
+            print_error("%s cut to %zu bytes: %s (%s)\n", fixture, length, sh_status_string(status),
+                        sh_last_error_message());
+            fail();
+        }
+    }
+    free(bytes);
+}
+
+static void test_every_truncation_fails_cleanly(void** state) {
+    (void)state;
+    check_prefixes(SH_TEST_DATA("two_tets_v1.msh"), "cut_v1.msh", NULL, NULL);
+    check_prefixes(SH_TEST_DATA("two_tets_v22.msh"), "cut_v22.msh", NULL, NULL);
+    check_prefixes(SH_TEST_DATA("two_tets_v41.msh"), "cut_v41.msh", NULL, NULL);
+    check_prefixes(SH_TEST_DATA("two_tets.vtk"), "cut.vtk", NULL, NULL);
+    check_prefixes(SH_TEST_DATA("two_tets_v51.vtk"), "cut_v51.vtk", NULL, NULL);
+    check_prefixes(SH_TEST_DATA("two_tets.vtu"), "cut.vtu", NULL, NULL);
+    check_prefixes(SH_TEST_DATA("two_tets0.node"), "cut_node.node", SH_TEST_DATA("two_tets0.ele"), "cut_node.ele");
+    check_prefixes(SH_TEST_DATA("two_tets0.ele"), "cut_ele.ele", SH_TEST_DATA("two_tets0.node"), "cut_ele.node");
+}
+
 static void test_empty_files(void** state) {
     (void)state;
     const char* const names[] = {"empty.msh", "empty.vtk", "empty.vtu", "empty.node", "empty.ele"};
@@ -608,6 +676,7 @@ int main(void) {
         cmocka_unit_test(test_corrupt_vtu),
         cmocka_unit_test(test_corrupt_tetgen),
         cmocka_unit_test(test_binary_garbage),
+        cmocka_unit_test(test_every_truncation_fails_cleanly),
         cmocka_unit_test(test_empty_files),
         cmocka_unit_test(test_missing_unknown_and_bad_arguments),
         cmocka_unit_test(test_vtu_round_trip_shared_meshes),

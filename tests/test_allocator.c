@@ -472,6 +472,64 @@ static void test_rejected_step_allocates_nothing(void** state) {
     assert_allocator_sane();
 }
 
+/* SH_ERR_OUT_OF_MEMORY means "nothing was changed": sh_body_set_material failing on any of
+ * its allocations leaves the masses and the elastic forces bitwise as they were. */
+static void test_set_material_out_of_memory_changes_nothing(void** state) {
+    (void)state;
+    reset_counts();
+    sh_world* world = sh_test_world(-9.81);
+    sh_mesh* mesh = sh_test_box(0.02, 0.01, 0.01, 2, 1, 1);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    sh_body_id body;
+    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_mesh_destroy(mesh));
+    sh_body_info info;
+    assert_ok(sh_body_get_info(world, body, &info));
+    assert_true(info.node_count <= 64);
+    double x[3 * 64], masses[64], forces[3 * 64], masses_now[64], forces_now[3 * 64];
+    assert_ok(sh_body_get_positions(world, body, x, 3 * 64));
+    for (int i = 0; i < 3 * info.node_count; ++i) x[i] *= 1.0 + 0.01 * (i % 5); /* strained */
+    assert_ok(sh_body_set_positions(world, body, x, info.node_count));
+    assert_ok(sh_body_get_masses(world, body, masses, 64));
+    assert_ok(sh_body_get_elastic_forces(world, body, forces, 3 * 64));
+
+    const int32_t region[3] = {1, 4, 9};
+    const sh_material other = {SH_MATERIAL_COROTATIONAL, 9e3, 0.3, 2500};
+    int failures = 0;
+    for (long n = 0; n < 10000; ++n) {
+        reset_counts();
+        g.fail_after = n;
+        const sh_status status = sh_body_set_material(world, body, region, 3, &other);
+        const size_t failed = g.failed;
+        g.fail_after = -1;
+        if (failed == 0) {
+            assert_ok(status);
+            break;
+        }
+        assert_status(status, SH_ERR_OUT_OF_MEMORY);
+        assert_ok(sh_body_get_masses(world, body, masses_now, 64));
+        assert_ok(sh_body_get_elastic_forces(world, body, forces_now, 3 * 64));
+        if (memcmp(masses_now, masses, sizeof(double) * (size_t)info.node_count) != 0 ||
+            memcmp(forces_now, forces, sizeof(double) * 3 * (size_t)info.node_count) != 0) {
+            print_error("sh_body_set_material failing after %ld allocations returned SH_ERR_OUT_OF_MEMORY but "
+                        "changed the body (masses %s, elastic forces %s)\n",
+                        n, memcmp(masses_now, masses, sizeof(double) * (size_t)info.node_count) ? "changed" : "same",
+                        memcmp(forces_now, forces, sizeof(double) * 3 * (size_t)info.node_count) ? "changed"
+                                                                                                  : "same");
+            ++failures;
+        }
+    }
+    /* The successful call does change them. */
+    assert_ok(sh_body_get_masses(world, body, masses_now, 64));
+    assert_true(memcmp(masses_now, masses, sizeof(double) * (size_t)info.node_count) != 0);
+    assert_ok(sh_world_destroy(world));
+    assert_int_equal(g.live_blocks, 0);
+    assert_allocator_sane();
+    assert_int_equal(failures, 0);
+}
+
 /* The scene of the failure-injection test: every creation call, each may fail with
  * SH_ERR_OUT_OF_MEMORY. Returns the first failing status (SH_OK if all succeeded); whatever
  * was created is destroyed before returning. */
@@ -625,6 +683,7 @@ int main(void) {
         cmocka_unit_test(test_step_with_rollbacks_allocates_nothing),
         cmocka_unit_test(test_rejected_step_allocates_nothing),
         cmocka_unit_test(test_remove_body_allocates_nothing),
+        cmocka_unit_test(test_set_material_out_of_memory_changes_nothing),
         cmocka_unit_test(test_failing_allocator), /* last: a leak would stay behind */
     };
     return cmocka_run_group_tests(tests, setup_install, NULL);

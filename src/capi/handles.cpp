@@ -22,7 +22,15 @@ vec<Entry>* g_entries = nullptr;  // allocated while any object lives, so it fol
 void register_handle(HandleKind kind, const void* object) {
     std::lock_guard<std::mutex> lock(g_mutex);
     if (!g_entries) g_entries = sh::create<vec<Entry>>();
-    g_entries->push_back({kind, object});
+    try {
+        g_entries->push_back({kind, object});
+    } catch (...) {
+        if (g_entries->empty()) {
+            sh::destroy(g_entries);
+            g_entries = nullptr;
+        }
+        throw;
+    }
     object_created();
 }
 

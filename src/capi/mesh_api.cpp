@@ -24,7 +24,12 @@ const TetMesh& checked_mesh(const sh_mesh* mesh) {
 sh_mesh* publish(TetMesh&& built) {
     sh_mesh* handle = sh::create<sh_mesh>();
     handle->mesh = std::move(built);
-    capi::register_handle(HandleKind::Mesh, handle);
+    try {
+        capi::register_handle(HandleKind::Mesh, handle);
+    } catch (...) {
+        sh::destroy(handle);
+        throw;
+    }
     return handle;
 }
 

@@ -2,6 +2,7 @@
 #include "capi/guard.hpp"
 #include "capi/handles.hpp"
 #include "capi/world_handle.hpp"
+#include "core/enum_value.hpp"
 #include "material/material_params.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "model/fem_body.hpp"
@@ -21,19 +22,22 @@ World& world_of(const sh_world* world) {
 
 namespace {
 
-IntegrationSettings integration_settings(sh_integrator integrator, sh_unstable_policy policy, double damping_mass,
-                                         double runaway_speed) {
+// Checks and copies the integration fields that FEM and spring defs share.
+template <class Def>
+IntegrationSettings integration_settings(const Def& def) {
+    const int integrator = enum_value(def.integrator), policy = enum_value(def.on_unstable);
+    const double damping_mass = def.damping_mass, runaway_speed = def.runaway_speed;
     require(integrator >= SH_INTEGRATOR_FORWARD_EULER && integrator <= SH_INTEGRATOR_RK4, SH_ERR_INVALID_ARGUMENT,
-            format("def->integrator = %d is not a sh_integrator", static_cast<int>(integrator)));
+            format("def->integrator = %d is not a sh_integrator", integrator));
     require(policy == SH_UNSTABLE_REJECT || policy == SH_UNSTABLE_SUBSTEP, SH_ERR_INVALID_ARGUMENT,
-            format("def->on_unstable = %d is not a sh_unstable_policy", static_cast<int>(policy)));
+            format("def->on_unstable = %d is not a sh_unstable_policy", policy));
     require(std::isfinite(damping_mass) && damping_mass >= 0.0, SH_ERR_INVALID_ARGUMENT,
             format("def->damping_mass = %g 1/s, must be finite and >= 0", damping_mass));
     require(runaway_speed > 0.0, SH_ERR_INVALID_ARGUMENT,
             format("def->runaway_speed = %g m/s, must be > 0", runaway_speed));
     IntegrationSettings s;
-    s.integrator = integrator;
-    s.on_unstable = policy;
+    s.integrator = static_cast<sh_integrator>(integrator);
+    s.on_unstable = static_cast<sh_unstable_policy>(policy);
     s.damping_mass = damping_mass;
     s.runaway_speed = runaway_speed;
     return s;
@@ -122,7 +126,7 @@ SH_API sh_status sh_world_add_fem_body(sh_world* world, const sh_fem_body_def* d
         require(std::isfinite(def->damping_stiffness) && def->damping_stiffness >= 0.0, SH_ERR_INVALID_ARGUMENT,
                 format("def->damping_stiffness = %g s, must be finite and >= 0", def->damping_stiffness));
         const IntegrationSettings settings =
-            integration_settings(def->integrator, def->on_unstable, def->damping_mass, def->runaway_speed);
+            integration_settings(*def);
         *out_body = w.add_body(sh::create<FemBody>(mesh, def->material, settings, def->damping_stiffness));
     });
 }
@@ -172,7 +176,7 @@ SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_
             for (size_t i = 0; i < node_count; ++i)
                 if (!mesh->node_used[i]) masses[i] = 0.0;  // orphans stay out of the dynamics
         const IntegrationSettings settings =
-            integration_settings(def->integrator, def->on_unstable, def->damping_mass, def->runaway_speed);
+            integration_settings(*def);
         *out_body = w.add_body(sh::create<SpringBody>(std::move(nodes), std::move(springs), def->params, masses, settings));
     });
 }

@@ -1,5 +1,6 @@
 #include "material/material_params.hpp"
 
+#include "core/enum_value.hpp"
 #include "core/error.hpp"
 
 #include <cmath>
@@ -7,8 +8,9 @@
 namespace sh {
 
 void validate_material(const sh_material& m, const char* context) {
-    require(m.model >= SH_MATERIAL_LINEAR && m.model <= SH_MATERIAL_NEOHOOKEAN, SH_ERR_INVALID_ARGUMENT,
-            format("%s: material.model %d is not a sh_material_model", context, static_cast<int>(m.model)));
+    const int model = enum_value(m.model);
+    require(model >= SH_MATERIAL_LINEAR && model <= SH_MATERIAL_NEOHOOKEAN, SH_ERR_INVALID_ARGUMENT,
+            format("%s: material.model %d is not a sh_material_model", context, model));
     require(std::isfinite(m.young) && m.young > 0.0, SH_ERR_INVALID_ARGUMENT,
             format("%s: material.young = %g Pa, must be finite and > 0", context, m.young));
     require(std::isfinite(m.poisson) && m.poisson > -1.0 && m.poisson < 0.5, SH_ERR_INVALID_ARGUMENT,

@@ -1,5 +1,6 @@
 #include "material/spring_laws.hpp"
 
+#include "core/enum_value.hpp"
 #include "core/error.hpp"
 
 #include <algorithm>
@@ -19,6 +20,9 @@ void require_finite_at_least(double value, double minimum, bool strict, const ch
 SpringLaw::SpringLaw(const sh_spring_params& p) : params_(p) {
     params_.table = nullptr;
     require_finite_at_least(p.damping, 0.0, false, "damping");
+    const int law = enum_value(p.law);
+    require(law >= SH_SPRING_LINEAR && law <= SH_SPRING_TABLE, SH_ERR_INVALID_ARGUMENT,
+            format("params.law = %d is not a sh_spring_law", law));
     switch (p.law) {
         case SH_SPRING_LINEAR:
             require_finite_at_least(p.stiffness, 0.0, true, "stiffness");
@@ -75,8 +79,6 @@ SpringLaw::SpringLaw(const sh_spring_params& p) : params_(p) {
             }
             break;
         }
-        default:
-            throw Error(SH_ERR_INVALID_ARGUMENT, format("params.law = %d is not a sh_spring_law", static_cast<int>(p.law)));
     }
 }
 

@@ -18,7 +18,6 @@ FemBody::FemBody(const TetMesh& mesh, const sh_material& material, IntegrationSe
     const size_t tet_count = tets_.size() / 4;
     inverse_rest_.resize(9 * tet_count);
     volume_.resize(tet_count);
-    materials_.assign(tet_count, material);
     for (size_t t = 0; t < tet_count; ++t) {
         const int32_t* tet = &tets_[4 * t];
         Eigen::Matrix3d dm;
@@ -29,29 +28,31 @@ FemBody::FemBody(const TetMesh& mesh, const sh_material& material, IntegrationSe
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) inverse_rest_[9 * t + 3 * i + j] = bm(i, j);
     }
-    rebuild();
+    rebuild(vec<sh_material>(tet_count, material));
 }
 
 void FemBody::set_material(const int32_t* elements, int32_t count, const sh_material& material) {
     for (int32_t k = 0; k < count; ++k)
         require(elements[k] >= 0 && elements[k] < element_count(), SH_ERR_INVALID_ARGUMENT,
                 format("elements[%d] = %d is not an element index in [0, %d)", k, elements[k], element_count()));
-    for (int32_t k = 0; k < count; ++k) materials_[static_cast<size_t>(elements[k])] = material;
-    rebuild();
+    vec<sh_material> materials = materials_;
+    for (int32_t k = 0; k < count; ++k) materials[static_cast<size_t>(elements[k])] = material;
+    rebuild(std::move(materials));
 }
 
-void FemBody::rebuild() {
+void FemBody::rebuild(vec<sh_material> materials) {
+    // Everything is built aside and swapped in at the end: a failed allocation changes nothing.
     const size_t tet_count = volume_.size();
-    std::fill(mass.begin(), mass.end(), 0.0);
+    vec<double> new_mass(mass.size(), 0.0);
     for (size_t t = 0; t < tet_count; ++t)
-        for (int a = 0; a < 4; ++a) mass[static_cast<size_t>(tets_[4 * t + a])] += materials_[t].density * volume_[t] / 4.0;
-    update_inverse_mass();
+        for (int a = 0; a < 4; ++a) new_mass[static_cast<size_t>(tets_[4 * t + a])] += materials[t].density * volume_[t] / 4.0;
 
+    vec<TetBlock> new_blocks[4];
     for (int model = 0; model < 4; ++model) {
         vec<size_t> members;
         for (size_t t = 0; t < tet_count; ++t)
-            if (materials_[t].model == model) members.push_back(t);
-        vec<TetBlock>& blocks = blocks_[model];
+            if (materials[t].model == model) members.push_back(t);
+        vec<TetBlock>& blocks = new_blocks[model];
         blocks.assign((members.size() + kLanes - 1) / kLanes, TetBlock{});
         for (size_t k = 0; k < members.size(); k += kLanes) {
             TetBlock& b = blocks[k / kLanes];
@@ -61,36 +62,41 @@ void FemBody::rebuild() {
                 for (int i = 0; i < 3; ++i)
                     for (int j = 0; j < 3; ++j) b.Bm.m[i][j][l] = inverse_rest_[9 * t + 3 * i + j];
                 b.volume[l] = used ? volume_[t] : 0.0;
-                b.lambda[l] = lame_lambda(materials_[t]);
-                b.mu[l] = lame_mu(materials_[t]);
+                b.lambda[l] = lame_lambda(materials[t]);
+                b.mu[l] = lame_mu(materials[t]);
                 for (int a = 0; a < 4; ++a) b.node[a][l] = tets_[4 * t + a];
             }
         }
     }
 
     double omega2 = 0.0;
-    for (size_t t = 0; t < tet_count; ++t) omega2 = std::max(omega2, element_max_frequency_squared(t));
+    for (size_t t = 0; t < tet_count; ++t) omega2 = std::max(omega2, element_max_frequency_squared(t, materials[t]));
     const double omega = std::sqrt(omega2);
     // Central-difference limit with stiffness damping ratio xi = beta omega / 2.
     const double xi = 0.5 * damping_stiffness_ * omega;
     stable_step_ = omega > 0.0 ? 2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi) : INFINITY;
+
+    materials_.swap(materials);
+    mass.swap(new_mass);
+    for (int model = 0; model < 4; ++model) blocks_[model].swap(new_blocks[model]);
+    update_inverse_mass();
 }
 
-double FemBody::element_max_frequency_squared(size_t t) const {
+double FemBody::element_max_frequency_squared(size_t t, const sh_material& material) const {
     // Largest eigenvalue of M_e^-1 K_e with the rest (small-strain) stiffness and the element's
     // share of the lumped mass: an upper bound of the assembled system's (Irons-Treharne).
     const double* bm = &inverse_rest_[9 * t];
     Eigen::Vector3d g[4];
     for (int a = 0; a < 3; ++a) g[a + 1] = Eigen::Vector3d(bm[3 * a], bm[3 * a + 1], bm[3 * a + 2]);
     g[0] = -(g[1] + g[2] + g[3]);
-    const double lambda = lame_lambda(materials_[t]), mu = lame_mu(materials_[t]), v0 = volume_[t];
+    const double lambda = lame_lambda(material), mu = lame_mu(material), v0 = volume_[t];
     Eigen::Matrix<double, 12, 12> k;
     for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b)
             k.block<3, 3>(3 * a, 3 * b) = v0 * (lambda * g[a] * g[b].transpose() + mu * g[b] * g[a].transpose() +
                                                  mu * g[a].dot(g[b]) * Eigen::Matrix3d::Identity());
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> eigen(k, Eigen::EigenvaluesOnly);  // ascending
-    return eigen.eigenvalues()(11) * 4.0 / (materials_[t].density * v0);
+    return eigen.eigenvalues()(11) * 4.0 / (material.density * v0);
 }
 
 namespace {

@@ -26,8 +26,9 @@ public:
     void write_vtu(const std::string& path) const override;
 
 private:
-    void rebuild();
-    double element_max_frequency_squared(size_t element) const;
+    /// Adopts materials (one per tet): masses, blocks and the stable step, all or nothing.
+    void rebuild(vec<sh_material> materials);
+    double element_max_frequency_squared(size_t element, const sh_material& material) const;
 
     vec<int32_t> tets_;          ///< 4 per tet
     vec<double> inverse_rest_;   ///< Bm = Dm^-1, 9 per tet, row-major

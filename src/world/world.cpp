@@ -41,6 +41,8 @@ sh_body_id World::add_body(Body* body) {
         free_slots_.pop_back();
     } else {
         try {
+            // Room for every slot in the free list, so that remove_body never allocates.
+            if (free_slots_.capacity() < slots_.size() + 1) free_slots_.reserve(2 * slots_.size() + 1);
             slots_.push_back(Slot{});
         } catch (...) {
             sh::destroy(body);
@@ -72,7 +74,7 @@ Body& World::body(sh_body_id id) const {
 void World::remove_body(sh_body_id id) {
     body(id);  // validates
     const uint32_t index = slot_of(id);
-    free_slots_.push_back(index);  // may throw before anything changes
+    free_slots_.push_back(index);  // within the capacity reserved in add_body
     sh::destroy(slots_[index].body);
     slots_[index].body = nullptr;
 }

@@ -8,7 +8,8 @@
  *    generation-checked uint64_t ids (0 is null);
  *  - definition structs are initialised by their *_def_default function, then edited;
  *  - units are SI (m, kg, s, N, Pa, N/m); vectors are in the world frame unless said otherwise;
- *  - "Thread:" says which thread may call (sim, haptic, any); "Alloc:" whether it may allocate.
+ *  - "Thread:" says which thread may call (sim, haptic, any); "Alloc:" whether it may allocate
+ *    on success (a failing sim-thread call may allocate to format its error message).
  */
 #ifndef SOFTHAP_H
 #define SOFTHAP_H
@@ -234,7 +235,11 @@ SH_API sh_status sh_world_step(sh_world* world, double dt, sh_step_report* repor
 /* ------------------------------------------------------------------------------------------ */
 /* Bodies: shared definitions                                                                   */
 
-/** Explicit time integrators. */
+/** Explicit time integrators. Forward Euler and RK2 have no stable step for an undamped
+ *  elastic body: each step multiplies a mode's energy by 1 + (w dt)^2 (forward Euler) or
+ *  1 + (w dt)^4 / 4 (RK2), so they drift even below dt_crit unless damping removes more; a
+ *  state that runs away is rolled back (SH_ERR_UNSTABLE). Use them for comparison; symplectic
+ *  Euler and RK4 are stable below dt_crit. */
 typedef enum sh_integrator {
     SH_INTEGRATOR_FORWARD_EULER = 0,   /**< x += dt v, v += dt a (first order) */
     SH_INTEGRATOR_SYMPLECTIC_EULER = 1,/**< v += dt a, x += dt v (first order, symplectic) */

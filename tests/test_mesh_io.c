@@ -370,6 +370,8 @@ static void test_corrupt_vtk_legacy(void** state) {
          {"cells_size.vtk:9:", "holds 6 values but the 1 cells hold 5", NULL}},
         {"out_of_range.vtk", VTK_HEAD VTK_POINTS "CELLS 1 5\n4 0 1 2 7\n" VTK_TYPES, NULL, NULL,
          SH_ERR_DEGENERATE_MESH, {"out_of_range.vtk", "tet 0 (line 9)", "node index 7 out of range"}},
+        {"absurd_cell.vtk", VTK_HEAD VTK_POINTS "CELLS 1 5\n9223372036854775807 0 1 2 3\n" VTK_TYPES, NULL, NULL,
+         SH_ERR_PARSE, {"absurd_cell.vtk:9:", "holds 5 values but cell 0 goes past it", NULL}},
         {"types_count.vtk", VTK_HEAD VTK_POINTS VTK_TET "CELL_TYPES 2\n10 10\n", NULL, NULL, SH_ERR_PARSE,
          {"types_count.vtk:10:", "2 cell types for 1 cells", NULL}},
         {"points_header_large.vtk", VTK_HEAD "POINTS 5 double\n0 0 0 1 0 0\n0 1 0 0 0 1\n" VTK_TET VTK_TYPES, NULL,

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <limits>
 
+#include <sys/stat.h>
+
 namespace sh {
 namespace {
 
@@ -37,6 +39,11 @@ void split_fields(std::string_view line, char comment, Fields& fields) {
 vec<char> read_text_file(const std::string& path) {
     std::FILE* file = std::fopen(path.c_str(), "rb");
     if (!file) throw Error(SH_ERR_IO, format("cannot open '%s': %s", path.c_str(), std::strerror(errno)));
+    struct stat info;
+    if (fstat(fileno(file), &info) == 0 && !S_ISREG(info.st_mode)) {  // a directory, a device, a pipe
+        std::fclose(file);
+        throw Error(SH_ERR_IO, format("cannot read '%s': not a regular file", path.c_str()));
+    }
     vec<char> bytes;
     char chunk[1 << 16];
     size_t got = 0;

@@ -93,9 +93,9 @@ private:
             if (c > 0) token = r_.expect_token("a cell's node count");
             const int64_t nodes = r_.to_int(token, "a cell's node count");
             if (nodes < 0) r_.fail(format("cell %d has a negative node count %lld", c, static_cast<long long>(nodes)));
-            values += 1 + nodes;
-            if (values > size)
+            if (nodes > size - values - 1)  // compared before adding: nodes may be absurdly large
                 r_.fail(format("CELLS header says the list holds %d values but cell %d goes past it", size, c));
+            values += 1 + nodes;
             const int line = r_.line();
             for (int64_t a = 0; a < nodes; ++a) {
                 cells_.connectivity.push_back(r_.read_int("a cell's node index"));

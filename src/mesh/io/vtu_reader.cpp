@@ -92,7 +92,7 @@ private:
         else if (e.name == "Piece") open_piece(e);
         else if (e.name == "DataArray") open_data_array(e);
         if (!e.self_closing) stack_.push_back({e.name, e.line});
-        else target_ = Target::None;
+        else if (e.name == "DataArray") target_ = Target::None;  // <DataArray .../> holds no data
     }
 
     void open_root(const XmlEvent& e) {

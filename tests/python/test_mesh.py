@@ -242,3 +242,23 @@ def test_legacy_vtk_and_tetgen_files(tmp_path):
         info = softhap.Mesh.load(path).info
         assert (info.node_count, info.tet_count) == (4, 1), path
         assert info.volume == pytest.approx(volume, rel=1e-14), path
+
+
+def test_transform_scales_and_translates(meshes):
+    mesh = softhap.Mesh.load(meshes / "liver.msh")
+    centimetres = mesh.transform(0.01, (1.0, -2.0, 0.5))
+    np.testing.assert_allclose(centimetres.nodes, 0.01 * mesh.nodes + [1.0, -2.0, 0.5], rtol=1e-15, atol=1e-15)
+    np.testing.assert_array_equal(centimetres.tets, mesh.tets)
+    assert centimetres.info.volume == pytest.approx(1e-6 * mesh.info.volume, rel=1e-12)
+    scaled = mesh.transform(2.0)
+    np.testing.assert_array_equal(scaled.nodes, 2.0 * mesh.nodes)
+    assert mesh.info.volume == pytest.approx(tet_volumes(mesh.nodes, mesh.tets).sum())  # unchanged
+    for bad in (0.0, -1.0, np.nan, np.inf):
+        with pytest.raises(softhap.Error) as info:
+            mesh.transform(bad)
+        assert info.value.status_name == "SH_ERR_INVALID_ARGUMENT"
+    with pytest.raises(softhap.Error) as info:
+        mesh.transform(1.0, (0.0, np.nan, 0.0))
+    assert info.value.status_name == "SH_ERR_INVALID_ARGUMENT"
+    with pytest.raises(ValueError):
+        mesh.transform(1.0, (0.0, 0.0))

@@ -262,6 +262,7 @@ PROTOTYPES = {
     # meshes
     "sh_mesh_create": (_status, [_pd, c_int32, _pi, c_int32, POINTER(_handle)]),
     "sh_mesh_load": (_status, [c_char_p, POINTER(_handle)]),
+    "sh_mesh_transform": (_status, [_handle, c_double, _pd, POINTER(_handle)]),
     "sh_mesh_destroy": (_status, [_handle]),
     "sh_mesh_get_info": (_status, [_handle, POINTER(sh_mesh_info)]),
     "sh_mesh_get_nodes": (_status, [_handle, _pd, c_int64]),

@@ -58,6 +58,27 @@ class Mesh:
         mesh._handle = handle.value
         return mesh
 
+    def transform(self, scale, translation=None):
+        """Return a new Mesh whose nodes are scale * x + translation (3 floats, m; None for
+        none), e.g. scale=0.01 for a file in centimetres. scale must be finite and > 0
+        (otherwise softhap.Error SH_ERR_INVALID_ARGUMENT). This mesh is unchanged."""
+        handle = self._require_handle("sh_mesh_transform")
+        if translation is None:
+            offset = None
+            offset_ptr = None
+        else:
+            offset = _arrays.float_array(translation, "translation", (3,))
+            offset_ptr = _arrays.double_ptr(offset)
+        out = ctypes.c_void_p()
+        check(
+            lib.sh_mesh_transform(handle, float(scale), offset_ptr, ctypes.byref(out)),
+            "sh_mesh_transform",
+        )
+        mesh = Mesh.__new__(Mesh)
+        mesh._handle = out.value
+        del offset
+        return mesh
+
     # -- lifetime --------------------------------------------------------------------------
 
     def close(self):

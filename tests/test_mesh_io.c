@@ -138,58 +138,23 @@ static void check_shared_mesh(const shared_mesh* expected) {
     assert_ok(sh_mesh_destroy(mesh));
 }
 
-static void test_load_liver(void** state) {
+static void test_shared_meshes(void** state) {
     (void)state;
-    const shared_mesh m = {SH_TEST_MESH("liver.msh"), 181, 596, 0, 0, 0, 276, 914, 36.56085106149482};
-    check_shared_mesh(&m);
-}
-
-static void test_load_liver2_skips_triangles_and_lines(void** state) {
-    (void)state;
-    const shared_mesh m = {SH_TEST_MESH("liver2.msh"), 507, 1493, 0, 0, 860 + 71, 860, 2429, 1.125092151433261};
-    check_shared_mesh(&m);
-}
-
-static void test_load_msh4_cube(void** state) {
-    (void)state;
-    /* The file's $Elements: 8 points, 12 lines, 24 triangles, 24 tets; 14 nodes; a unit cube. */
-    const shared_mesh m = {SH_TEST_MESH("msh4_cube.msh"), 14, 24, 0, 0, 8 + 12 + 24, 24, 49, 1.0};
-    check_shared_mesh(&m);
-}
-
-static void test_load_single_tetra_reoriented(void** state) {
-    (void)state;
-    /* (5,5,0) (0,5,0) (0,0,0) (2.5,3.5,-3): base area 12.5, height 3, volume 12.5, listed with
-     * negative orientation (by hand: det = -75). */
-    const shared_mesh m = {SH_TEST_MESH("single_tetra.msh"), 4, 1, 0, 1, 0, 4, 6, 12.5};
-    check_shared_mesh(&m);
-}
-
-static void test_load_6_tetra_bad_reoriented(void** state) {
-    (void)state;
-    const shared_mesh m = {SH_TEST_MESH("6_tetra_bad.msh"), 17, 6, 0, 1, 0, 24, 36, 40.65};
-    check_shared_mesh(&m);
-}
-
-static void test_load_armadillo(void** state) {
-    (void)state;
-    const shared_mesh m = {SH_TEST_MESH("Armadillo_Tetra_4406.vtu"), 1446, 4406, 0, 0, 0, 2532, 7118,
-                           231.21430723500526};
-    check_shared_mesh(&m);
-}
-
-static void test_load_raptor_8418_with_orphans(void** state) {
-    (void)state;
-    const shared_mesh m = {SH_TEST_MESH("raptorTetra_8418.vtu"), 2996, 8418, 3, 0, 0, 5750, 14284,
-                           27.251766950557336};
-    check_shared_mesh(&m);
-}
-
-static void test_load_raptor_19409_with_orphans(void** state) {
-    (void)state;
-    const shared_mesh m = {SH_TEST_MESH("raptorTetra_19409.vtu"), 5992, 19409, 2, 0, 0, 10416, 30605,
-                           27.489063544917354};
-    check_shared_mesh(&m);
+    static const shared_mesh meshes[] = {
+        /* file                                 nodes  tets orph reor skipped  surf  edges  volume */
+        {SH_TEST_MESH("liver.msh"),               181,  596,  0,  0,        0,  276,   914, 36.56085106149482},
+        {SH_TEST_MESH("liver2.msh"),              507, 1493,  0,  0, 860 + 71,  860,  2429, 1.125092151433261},
+        /* msh4_cube: its $Elements hold 8 points, 12 lines, 24 triangles, 24 tets; a unit cube */
+        {SH_TEST_MESH("msh4_cube.msh"),            14,   24,  0,  0,  8+12+24,   24,    49, 1.0},
+        /* single_tetra: (5,5,0) (0,5,0) (0,0,0) (2.5,3.5,-3), base area 12.5, height 3, listed
+         * with negative orientation (by hand: det = -75) */
+        {SH_TEST_MESH("single_tetra.msh"),          4,    1,  0,  1,        0,    4,     6, 12.5},
+        {SH_TEST_MESH("6_tetra_bad.msh"),          17,    6,  0,  1,        0,   24,    36, 40.65},
+        {SH_TEST_MESH("Armadillo_Tetra_4406.vtu"), 1446, 4406, 0,  0,        0, 2532,  7118, 231.21430723500526},
+        {SH_TEST_MESH("raptorTetra_8418.vtu"),    2996, 8418,  3,  0,        0, 5750, 14284, 27.251766950557336},
+        {SH_TEST_MESH("raptorTetra_19409.vtu"),   5992, 19409, 2,  0,        0, 10416, 30605, 27.489063544917354},
+    };
+    for (size_t i = 0; i < sizeof meshes / sizeof meshes[0]; ++i) check_shared_mesh(&meshes[i]);
 }
 
 static void test_broken_armadillo_is_refused(void** state) {
@@ -232,36 +197,16 @@ static void check_two_tets(const char* path, int32_t skipped) {
     assert_ok(sh_mesh_destroy(mesh));
 }
 
-static void test_same_mesh_gmsh_1(void** state) {
+static void test_same_mesh_in_every_format(void** state) {
     (void)state;
-    check_two_tets(SH_TEST_DATA("two_tets_v1.msh"), 1);
-}
-
-static void test_same_mesh_gmsh_2_2(void** state) {
-    (void)state;
-    check_two_tets(SH_TEST_DATA("two_tets_v22.msh"), 1);
-}
-
-static void test_same_mesh_gmsh_4_1_sparse_tags(void** state) {
-    (void)state;
-    check_two_tets(SH_TEST_DATA("two_tets_v41.msh"), 1);
-}
-
-static void test_same_mesh_vtk_legacy(void** state) {
-    (void)state;
-    check_two_tets(SH_TEST_DATA("two_tets.vtk"), 1);
-    check_two_tets(SH_TEST_DATA("two_tets_v51.vtk"), 1);
-}
-
-static void test_same_mesh_vtu(void** state) {
-    (void)state;
-    check_two_tets(SH_TEST_DATA("two_tets.vtu"), 1);
-}
-
-static void test_same_mesh_tetgen_either_file(void** state) {
-    (void)state;
-    check_two_tets(SH_TEST_DATA("two_tets0.node"), 0);
-    check_two_tets(SH_TEST_DATA("two_tets0.ele"), 0);
+    check_two_tets(SH_TEST_DATA("two_tets_v1.msh"), 1);   /* Gmsh 1, sparse tags, a triangle */
+    check_two_tets(SH_TEST_DATA("two_tets_v22.msh"), 1);  /* Gmsh 2.2, shuffled tags, a point */
+    check_two_tets(SH_TEST_DATA("two_tets_v41.msh"), 1);  /* Gmsh 4.1, two blocks, sparse tags */
+    check_two_tets(SH_TEST_DATA("two_tets.vtk"), 1);      /* legacy VTK 3.0, a vertex cell */
+    check_two_tets(SH_TEST_DATA("two_tets_v51.vtk"), 1);  /* legacy VTK 5.1 offsets/connectivity */
+    check_two_tets(SH_TEST_DATA("two_tets.vtu"), 1);      /* VTK XML, a vertex cell */
+    check_two_tets(SH_TEST_DATA("two_tets0.node"), 0);    /* TetGen from 0, given the .node */
+    check_two_tets(SH_TEST_DATA("two_tets0.ele"), 0);     /* ... or the .ele */
 }
 
 static void test_same_mesh_tetgen_one_based(void** state) {
@@ -656,22 +601,10 @@ static void test_vtu_write_errors(void** state) {
 
 int main(void) {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_load_liver),
-        cmocka_unit_test(test_load_liver2_skips_triangles_and_lines),
-        cmocka_unit_test(test_load_msh4_cube),
-        cmocka_unit_test(test_load_single_tetra_reoriented),
-        cmocka_unit_test(test_load_6_tetra_bad_reoriented),
-        cmocka_unit_test(test_load_armadillo),
-        cmocka_unit_test(test_load_raptor_8418_with_orphans),
-        cmocka_unit_test(test_load_raptor_19409_with_orphans),
+        cmocka_unit_test(test_shared_meshes),
         cmocka_unit_test(test_broken_armadillo_is_refused),
         cmocka_unit_test(test_surface_obj_is_unsupported),
-        cmocka_unit_test(test_same_mesh_gmsh_1),
-        cmocka_unit_test(test_same_mesh_gmsh_2_2),
-        cmocka_unit_test(test_same_mesh_gmsh_4_1_sparse_tags),
-        cmocka_unit_test(test_same_mesh_vtk_legacy),
-        cmocka_unit_test(test_same_mesh_vtu),
-        cmocka_unit_test(test_same_mesh_tetgen_either_file),
+        cmocka_unit_test(test_same_mesh_in_every_format),
         cmocka_unit_test(test_same_mesh_tetgen_one_based),
         cmocka_unit_test(test_corrupt_gmsh),
         cmocka_unit_test(test_corrupt_vtk_legacy),

@@ -166,7 +166,7 @@ private:
     void read_nodes_v1_v2(const char* section, const char* end) {
         begin_nodes(section);
         const int32_t count = read_count_line("the node count");
-        mesh_.nodes.reserve(3 * std::min<size_t>(count, r_.max_records(4)));
+        reserve_nodes(count);
         for (int32_t i = 0; i < count; ++i) {
             expect_record(section, i, count, "nodes");
             if (f_.size() != 4) r_.fail(format("expected 4 fields for node (tag x y z), got %zu", f_.size()));
@@ -207,84 +207,76 @@ private:
     // Version 4.1 nodes: entity blocks, each a header, the tags, then the coordinates.
     void read_nodes_v4() {
         begin_nodes("$Nodes");
-        int32_t total = 0;
-        const int32_t blocks = read_header_v4("the $Nodes header", total);
-        mesh_.nodes.reserve(3 * std::min<size_t>(total, r_.max_records(4)));
         vec<std::string_view> block_tags;
-        int32_t read = 0;
-        for (int32_t b = 0; b < blocks; ++b) {
-            expect_record("$Nodes", read, total, "nodes");
-            if (f_.size() != 4)
-                r_.fail(format("expected 4 fields for a node block header (entityDim entityTag parametric "
-                               "numNodes), got %zu", f_.size()));
-            const int64_t dim = r_.to_int(f_[0], "the entity dimension");
-            const bool parametric = r_.to_int(f_[2], "the parametric flag") != 0;
-            const int32_t block = block_size(f_[3], total - read, "nodes");
-            const size_t fields = 3 + ((parametric && dim > 0) ? static_cast<size_t>(dim) : 0);
-            block_tags.clear();
-            for (int32_t i = 0; i < block; ++i) {
-                expect_record("$Nodes", read + i, total, "node tags");
-                if (f_.size() != 1) r_.fail(format("expected 1 field for a node tag, got %zu", f_.size()));
-                block_tags.push_back(f_[0]);
-            }
-            for (int32_t i = 0; i < block; ++i) {
-                expect_record("$Nodes", read + i, total, "node coordinates");
-                if (f_.size() != fields)
-                    r_.fail(format("expected %zu fields for node coordinates, got %zu", fields, f_.size()));
-                add_node(block_tags[static_cast<size_t>(i)], &f_[0]);
-            }
-            read += block;
-        }
-        check_total(read, total, "nodes");
-        expect_end("$EndNodes", format("%d nodes", total).c_str());
+        read_blocks_v4("$Nodes", "nodes", "entityDim entityTag parametric numNodes",
+                       [&](int32_t total) { reserve_nodes(total); },
+                       [&](int32_t read, int32_t block, int32_t total) {
+                           const int64_t dim = r_.to_int(f_[0], "the entity dimension");
+                           const bool parametric = r_.to_int(f_[2], "the parametric flag") != 0;
+                           const size_t fields = 3 + ((parametric && dim > 0) ? static_cast<size_t>(dim) : 0);
+                           block_tags.clear();
+                           for (int32_t i = 0; i < block; ++i) {
+                               expect_record("$Nodes", read + i, total, "node tags");
+                               if (f_.size() != 1) r_.fail(format("expected 1 field for a node tag, got %zu", f_.size()));
+                               block_tags.push_back(f_[0]);
+                           }
+                           for (int32_t i = 0; i < block; ++i) {
+                               expect_record("$Nodes", read + i, total, "node coordinates");
+                               if (f_.size() != fields)
+                                   r_.fail(format("expected %zu fields for node coordinates, got %zu", fields, f_.size()));
+                               add_node(block_tags[static_cast<size_t>(i)], &f_[0]);
+                           }
+                       });
+        expect_end("$EndNodes", "the node blocks");
     }
 
     // Version 4.1 elements: entity blocks, each a header with the type, then "tag nodes..." lines.
     void read_elements_v4() {
         begin_elements("$Elements");
-        int32_t total = 0;
-        const int32_t blocks = read_header_v4("the $Elements header", total);
-        reserve_elements(total, 5);
+        read_blocks_v4("$Elements", "elements", "entityDim entityTag elementType numElements",
+                       [&](int32_t total) { reserve_elements(total, 5); },
+                       [&](int32_t read, int32_t block, int32_t total) {
+                           const int64_t type = r_.to_int(f_[2], "the element type");
+                           for (int32_t i = 0; i < block; ++i) {
+                               expect_record("$Elements", read + i, total, "elements");
+                               add_element(f_[0], type, 1);
+                           }
+                       });
+        expect_end("$EndElements", "the element blocks");
+    }
+
+    // A 4.1 section: "numEntityBlocks total minTag maxTag" (reserve(total) is called), then
+    // blocks whose 4-field header (layout names the fields) ends with the block size;
+    // read_block(read, size, total) reads a block's records with its header in f_. The blocks
+    // must add up to the total.
+    template <class Reserve, class ReadBlock>
+    void read_blocks_v4(const char* section, const char* what, const char* layout, Reserve&& reserve,
+                        ReadBlock&& read_block) {
+        r_.expect_line(f_, "the section header");
+        if (f_.size() != 4)
+            r_.fail(format("expected 4 fields for the %s header (numEntityBlocks num%s minTag maxTag), got %zu",
+                           section, section + 1, f_.size()));
+        const int32_t blocks = r_.to_count(f_[0], "the entity block count");
+        const int32_t total = r_.to_count(f_[1], "the total count");
+        reserve(total);
         int32_t read = 0;
         for (int32_t b = 0; b < blocks; ++b) {
-            expect_record("$Elements", read, total, "elements");
+            expect_record(section, read, total, what);
             if (f_.size() != 4)
-                r_.fail(format("expected 4 fields for an element block header (entityDim entityTag "
-                               "elementType numElements), got %zu", f_.size()));
-            const int64_t type = r_.to_int(f_[2], "the element type");
-            const int32_t block = block_size(f_[3], total - read, "elements");
-            for (int32_t i = 0; i < block; ++i) {
-                expect_record("$Elements", read + i, total, "elements");
-                add_element(f_[0], type, 1);
-            }
+                r_.fail(format("expected 4 fields for a block header (%s), got %zu", layout, f_.size()));
+            const int32_t block = r_.to_count(f_[3], "the block size");
+            if (block > total - read)
+                r_.fail(format("block of %d %s exceeds the %d left of the header's total", block, what, total - read));
+            read_block(read, block, total);
             read += block;
         }
-        check_total(read, total, "elements");
-        expect_end("$EndElements", format("%d elements", total).c_str());
+        if (read != total) r_.fail(format("the blocks hold %d %s but the header announces %d", read, what, total));
     }
 
-    // "numEntityBlocks total minTag maxTag": returns the block count and sets total.
-    int32_t read_header_v4(const char* what, int32_t& total) {
-        r_.expect_line(f_, what);
-        if (f_.size() != 4) r_.fail(format("expected 4 fields for %s, got %zu", what, f_.size()));
-        total = r_.to_count(f_[1], "the total count");
-        return r_.to_count(f_[0], "the entity block count");
-    }
+    // Reserves for count nodes (of at least 4 tokens), no more than the rest of the file can hold.
+    void reserve_nodes(int32_t count) { mesh_.nodes.reserve(3 * std::min<size_t>(count, r_.max_records(4))); }
 
-    // The blocks of a 4.1 section must add up to the header's total.
-    void check_total(int32_t read, int32_t total, const char* what) {
-        if (read != total)
-            r_.fail(format("the blocks hold %d %s but the header announces %d", read, what, total));
-    }
-
-    // Size of a 4.1 entity block, which must fit in what the header has left.
-    int32_t block_size(std::string_view token, int32_t left, const char* what) {
-        const int32_t size = r_.to_count(token, "the block size");
-        if (size > left)
-            r_.fail(format("block of %d %s exceeds the %d left of the header's total", size, what, left));
-        return size;
-    }
-
+    // Reserves for count elements, no more than the rest of the file can hold.
     void reserve_elements(int32_t count, int tokens_per_element) {
         const size_t cap = std::min<size_t>(count, r_.max_records(tokens_per_element));
         mesh_.tets.reserve(4 * cap);

@@ -22,9 +22,16 @@ void expect_no_more(TextReader& r, Fields& f, int32_t count, const char* what) {
         r.fail(format("more lines than the %d %s the header announces", count, what));
 }
 
-// Optional header field i (default when absent).
-int64_t header_field(const TextReader& r, const Fields& f, size_t i, int64_t fallback, const char* what) {
-    return i < f.size() ? r.to_int(f[i], what) : fallback;
+// Reads a header line "<count> [optional...]": returns the count (named count_name in
+// messages) and overwrites each of the optional values (which hold their defaults) the line gives.
+int32_t read_header(TextReader& r, Fields& f, const char* what, const char* count_name, int64_t* optional,
+                    size_t optional_count) {
+    r.expect_line(f, what, '#');
+    if (f.size() > 1 + optional_count)
+        r.fail(format("expected at most %zu fields for %s, got %zu", 1 + optional_count, what, f.size()));
+    const int32_t count = r.to_count(f[0], count_name);
+    for (size_t i = 1; i < f.size(); ++i) optional[i - 1] = r.to_int(f[i], what);
+    return count;
 }
 
 class TetgenReader {
@@ -32,28 +39,22 @@ public:
     MeshData read(const std::string& path, std::string_view text) {
         const size_t dot = path.find_last_of('.');
         const std::string stem = path.substr(0, dot);
-        const bool given_node = equals_nocase(std::string_view(path).substr(dot + 1), "node");
-        const std::string other = stem + (given_node ? ".ele" : ".node");
-        try {
-            other_text_ = read_text_file(other);
-        } catch (const Error& e) {
-            throw Error(e.status(), e.message() + " (TetGen needs the .node and .ele files side by side)");
+        if (equals_nocase(std::string_view(path).substr(dot + 1), "node")) {
+            read_nodes(TextReader(path, text));
+            read_elements(TextReader(stem + ".ele", read_beside(stem + ".ele")));
+        } else {
+            read_nodes(TextReader(stem + ".node", read_beside(stem + ".node")));
+            read_elements(TextReader(path, text));
         }
-        const std::string_view other_view(other_text_.data(), other_text_.size());
-        read_nodes(TextReader(given_node ? path : other, given_node ? text : other_view));
-        read_elements(TextReader(given_node ? other : path, given_node ? other_view : text));
         return std::move(mesh_);
     }
 
 private:
     // "<points> <dimension> <attributes> <boundary markers>", then "<index> x y z [attributes] [marker]".
     void read_nodes(TextReader r) {
-        r.expect_line(f_, "the .node header", '#');
-        if (f_.size() > 4) r.fail(format("expected at most 4 fields for the .node header, got %zu", f_.size()));
-        const int32_t count = r.to_count(f_[0], "the node count");
-        const int64_t dimension = header_field(r, f_, 1, 3, "the dimension");
-        const int64_t attributes = header_field(r, f_, 2, 0, "the attribute count");
-        const int64_t markers = header_field(r, f_, 3, 0, "the boundary marker count");
+        int64_t header[3] = {3, 0, 0};  // dimension, attributes, boundary markers
+        const int32_t count = read_header(r, f_, "the .node header", "the node count", header, 3);
+        const int64_t dimension = header[0], attributes = header[1], markers = header[2];
         if (dimension != 3)
             r.unsupported(format("dimension %lld: only 3D TetGen meshes are supported", static_cast<long long>(dimension)));
         if (attributes < 0 || attributes > 1000 || (markers != 0 && markers != 1))
@@ -78,11 +79,9 @@ private:
 
     // "<tets> <nodes per tet (4 or 10)> <region attribute (0 or 1)>", then "<index> nodes... [attribute]".
     void read_elements(TextReader r) {
-        r.expect_line(f_, "the .ele header", '#');
-        if (f_.size() > 3) r.fail(format("expected at most 3 fields for the .ele header, got %zu", f_.size()));
-        const int32_t count = r.to_count(f_[0], "the tet count");
-        const int64_t nodes = header_field(r, f_, 1, 4, "the nodes per tet");
-        const int64_t attributes = header_field(r, f_, 2, 0, "the region attribute count");
+        int64_t header[2] = {4, 0};  // nodes per tet, region attributes
+        const int32_t count = read_header(r, f_, "the .ele header", "the tet count", header, 2);
+        const int64_t nodes = header[0], attributes = header[1];
         if (nodes != 4 && nodes != 10) r.fail(format("nodes per tet is %lld, must be 4 or 10", static_cast<long long>(nodes)));
         if (attributes < 0 || attributes > 1000) r.fail("the region attribute count must be in [0, 1000]");
         const size_t fields = 1 + static_cast<size_t>(nodes + attributes);
@@ -102,6 +101,16 @@ private:
             mesh_.tet_lines.push_back(r.line());
         }
         expect_no_more(r, f_, count, "tets");
+    }
+
+    // Reads the companion file (kept alive in other_text_ while it is parsed).
+    std::string_view read_beside(const std::string& other) {
+        try {
+            other_text_ = read_text_file(other);
+        } catch (const Error& e) {
+            throw Error(e.status(), e.message() + " (TetGen needs the .node and .ele files side by side)");
+        }
+        return std::string_view(other_text_.data(), other_text_.size());
     }
 
     vec<char> other_text_;  // the file found beside the given one

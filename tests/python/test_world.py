@@ -245,3 +245,18 @@ def test_repr_and_ids():
         assert body.id != 0
         assert "World" in repr(world) and "Body" in repr(body)
     assert "closed" in repr(world)
+
+
+def test_non_finite_state_is_rolled_back():
+    with softhap.World(gravity=(0.0, 0.0, 0.0)) as world:
+        body = world.add_spring_body([[0.0, 0.0, 1.0]], mass=1e-3)
+        body.apply_forces([[1e308, 0.0, 0.0]])  # finite, but a = F / m overflows to inf
+        with pytest.raises(softhap.Error) as info:
+            world.step(0.01)
+        assert info.value.status_name == "SH_ERR_UNSTABLE"
+        assert info.value.report.unstable_body_count == 1
+        np.testing.assert_array_equal(body.positions, [[0.0, 0.0, 1.0]])
+        np.testing.assert_array_equal(body.velocities, [[0.0, 0.0, 0.0]])
+        assert world.warnings["SH_WARN_UNSTABLE"] == 1
+        body.apply_forces(None)
+        world.step(0.01)  # usable again

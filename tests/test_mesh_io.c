@@ -536,31 +536,36 @@ static void test_missing_unknown_and_bad_arguments(void** state) {
 /* ------------------------------------------------------------------------------------------ */
 /* Writing .vtu                                                                                 */
 
-/* Writes mesh with sh_mesh_write_vtu, loads the file and checks nodes (bitwise) and tets. */
-static void check_round_trip(const sh_mesh* mesh, const char* name) {
-    const char* path = temp_path(name);
-    assert_ok(sh_mesh_write_vtu(mesh, path));
-    sh_mesh* back = load_ok(path);
-    const sh_mesh_info a = info_of(mesh), b = info_of(back);
-    assert_int_equal(b.node_count, a.node_count);
-    assert_int_equal(b.tet_count, a.tet_count);
-    assert_int_equal(b.orphan_node_count, a.orphan_node_count);
-    assert_int_equal(b.reoriented_tet_count, 0); /* written already positively oriented */
-    const size_t node_values = 3 * (size_t)a.node_count, tet_values = 4 * (size_t)a.tet_count;
+/* Asserts that b has a's nodes (bitwise) and tets. */
+static void assert_same_mesh(const sh_mesh* a, const sh_mesh* b) {
+    const sh_mesh_info ia = info_of(a), ib = info_of(b);
+    assert_int_equal(ib.node_count, ia.node_count);
+    assert_int_equal(ib.tet_count, ia.tet_count);
+    assert_int_equal(ib.orphan_node_count, ia.orphan_node_count);
+    const size_t node_values = 3 * (size_t)ia.node_count, tet_values = 4 * (size_t)ia.tet_count;
     double* nodes_a = malloc(sizeof(double) * node_values);
     double* nodes_b = malloc(sizeof(double) * node_values);
     int32_t* tets_a = malloc(sizeof(int32_t) * tet_values);
     int32_t* tets_b = malloc(sizeof(int32_t) * tet_values);
-    assert_ok(sh_mesh_get_nodes(mesh, nodes_a, (int64_t)node_values));
-    assert_ok(sh_mesh_get_nodes(back, nodes_b, (int64_t)node_values));
-    assert_ok(sh_mesh_get_tets(mesh, tets_a, (int64_t)tet_values));
-    assert_ok(sh_mesh_get_tets(back, tets_b, (int64_t)tet_values));
+    assert_ok(sh_mesh_get_nodes(a, nodes_a, (int64_t)node_values));
+    assert_ok(sh_mesh_get_nodes(b, nodes_b, (int64_t)node_values));
+    assert_ok(sh_mesh_get_tets(a, tets_a, (int64_t)tet_values));
+    assert_ok(sh_mesh_get_tets(b, tets_b, (int64_t)tet_values));
     assert_memory_equal(nodes_a, nodes_b, sizeof(double) * node_values);
     assert_memory_equal(tets_a, tets_b, sizeof(int32_t) * tet_values);
     free(nodes_a);
     free(nodes_b);
     free(tets_a);
     free(tets_b);
+}
+
+/* Writes mesh with sh_mesh_write_vtu and loads the file back: the same nodes and tets. */
+static void check_round_trip(const sh_mesh* mesh, const char* name) {
+    const char* path = temp_path(name);
+    assert_ok(sh_mesh_write_vtu(mesh, path));
+    sh_mesh* back = load_ok(path);
+    assert_same_mesh(mesh, back);
+    assert_int_equal(info_of(back).reoriented_tet_count, 0); /* written already positively oriented */
     assert_ok(sh_mesh_destroy(back));
 }
 
@@ -587,6 +592,42 @@ static void test_vtu_round_trip_awkward_doubles(void** state) {
     assert_ok(sh_mesh_create(nodes, 7, tets, 1, &mesh));
     check_round_trip(mesh, "awkward.vtu");
     assert_ok(sh_mesh_destroy(mesh));
+}
+
+/* Bodies write through the same writer: an FEM body's tets with a "velocity" point array (which
+ * the loader passes over), a spring body's springs as VTK_LINE cells (which it skips). */
+static void test_body_vtu_files(void** state) {
+    (void)state;
+    sh_world* world = sh_test_world(0.0);
+
+    sh_mesh* liver = load_ok(SH_TEST_MESH("liver.msh"));
+    sh_fem_body_def fem;
+    sh_fem_body_def_default(&fem);
+    fem.mesh = liver;
+    sh_body_id organ = SH_NULL_BODY;
+    assert_ok(sh_world_add_fem_body(world, &fem, &organ));
+    const char* organ_path = temp_path("organ.vtu");
+    assert_ok(sh_body_write_vtu(world, organ, organ_path));
+    size_t size = 0;
+    char* text = read_file(organ_path, &size);
+    text = realloc(text, size + 1);
+    text[size] = '\0';
+    assert_non_null(strstr(text, "<PointData Vectors=\"velocity\">"));
+    free(text);
+    sh_mesh* written = load_ok(organ_path);
+    assert_same_mesh(liver, written); /* a body at rest is its mesh */
+    assert_ok(sh_mesh_destroy(written));
+    assert_ok(sh_mesh_destroy(liver));
+
+    sh_spring_body_def spring;
+    sh_spring_body_def_default(&spring); /* only for its default spring law */
+    const sh_body_id pair = sh_test_spring_pair(world, 0.01, &spring.params, 0.001, SH_INTEGRATOR_SYMPLECTIC_EULER,
+                                                SH_UNSTABLE_SUBSTEP);
+    const char* pair_path = temp_path("pair.vtu");
+    assert_ok(sh_body_write_vtu(world, pair, pair_path));
+    const char* const no_tets[3] = {"pair.vtu", "no tetrahedra", NULL};
+    expect_load(pair_path, SH_ERR_DEGENERATE_MESH, no_tets);
+    assert_ok(sh_world_destroy(world));
 }
 
 static void test_vtu_write_errors(void** state) {
@@ -616,6 +657,7 @@ int main(void) {
         cmocka_unit_test(test_missing_unknown_and_bad_arguments),
         cmocka_unit_test(test_vtu_round_trip_shared_meshes),
         cmocka_unit_test(test_vtu_round_trip_awkward_doubles),
+        cmocka_unit_test(test_body_vtu_files),
         cmocka_unit_test(test_vtu_write_errors),
     };
     return cmocka_run_group_tests(tests, make_temp_dir, remove_temp_dir);

@@ -14,23 +14,20 @@ namespace {
 Body& body_of(const sh_world* world, sh_body_id id) { return capi::world_of(world).body(id); }
 
 void require_node_count(const Body& body, int32_t node_count) {
-    require(node_count == body.node_count(), SH_ERR_INVALID_ARGUMENT,
-            format("node_count = %d, the body has %d nodes", node_count, body.node_count()));
+    SH_REQUIRE(node_count == body.node_count(), SH_ERR_INVALID_ARGUMENT, "node_count = %d, the body has %d nodes", node_count, body.node_count());
 }
 
 void require_all_finite(const double* values, size_t count, const char* name) {
     capi::require_pointer(values, name);
     for (size_t i = 0; i < count; ++i)
-        require(std::isfinite(values[i]), SH_ERR_INVALID_ARGUMENT,
-                format("%s[%zu] (node %zu) is not finite", name, i, i / 3));
+        SH_REQUIRE(std::isfinite(values[i]), SH_ERR_INVALID_ARGUMENT, "%s[%zu] (node %zu) is not finite", name, i, i / 3);
 }
 
 void require_node_indices(const Body& body, const int32_t* nodes, int32_t count) {
-    require(count >= 0, SH_ERR_INVALID_ARGUMENT, format("count = %d, must be >= 0", count));
+    SH_REQUIRE(count >= 0, SH_ERR_INVALID_ARGUMENT, "count = %d, must be >= 0", count);
     if (count > 0) capi::require_pointer(nodes, "nodes");
     for (int32_t k = 0; k < count; ++k)
-        require(nodes[k] >= 0 && nodes[k] < body.node_count(), SH_ERR_INVALID_ARGUMENT,
-                format("nodes[%d] = %d is not a node index in [0, %d)", k, nodes[k], body.node_count()));
+        SH_REQUIRE(nodes[k] >= 0 && nodes[k] < body.node_count(), SH_ERR_INVALID_ARGUMENT, "nodes[%d] = %d is not a node index in [0, %d)", k, nodes[k], body.node_count());
 }
 
 void copy_out(const vec<double>& source, double* out, int64_t capacity) {
@@ -50,7 +47,7 @@ SH_API sh_status sh_body_set_material(sh_world* world, sh_body_id body, const in
         require(b.is_fem(), SH_ERR_UNSUPPORTED, "sh_body_set_material needs an FEM body; this is a mass-spring body");
         capi::require_pointer(material, "material");
         validate_material(*material, "sh_body_set_material");
-        require(element_count >= 0, SH_ERR_INVALID_ARGUMENT, format("element_count = %d, must be >= 0", element_count));
+        SH_REQUIRE(element_count >= 0, SH_ERR_INVALID_ARGUMENT, "element_count = %d, must be >= 0", element_count);
         if (element_count > 0) capi::require_pointer(elements, "elements");
         static_cast<FemBody&>(b).set_material(elements, element_count, *material);
     });
@@ -179,8 +176,7 @@ SH_API sh_status sh_body_set_node_damping(sh_world* world, sh_body_id body, cons
         }
         require_node_count(b, node_count);
         for (int32_t i = 0; i < node_count; ++i)
-            require(std::isfinite(coefficients[i]) && coefficients[i] >= 0.0, SH_ERR_INVALID_ARGUMENT,
-                    format("coefficients[%d] = %g 1/s, must be finite and >= 0", i, coefficients[i]));
+            SH_REQUIRE(std::isfinite(coefficients[i]) && coefficients[i] >= 0.0, SH_ERR_INVALID_ARGUMENT, "coefficients[%d] = %g 1/s, must be finite and >= 0", i, coefficients[i]);
         b.node_damping.assign(coefficients, coefficients + node_count);
     });
 }

@@ -53,8 +53,8 @@ SH_API sh_status sh_mesh_create(const double* nodes, int32_t node_count, const i
     return capi::guard([&] {
         capi::require_pointer(out_mesh, "out_mesh");
         *out_mesh = nullptr;
-        require(node_count > 0, SH_ERR_INVALID_ARGUMENT, format("node_count is %d, must be > 0", node_count));
-        require(tet_count > 0, SH_ERR_INVALID_ARGUMENT, format("tet_count is %d, must be > 0", tet_count));
+        SH_REQUIRE(node_count > 0, SH_ERR_INVALID_ARGUMENT, "node_count is %d, must be > 0", node_count);
+        SH_REQUIRE(tet_count > 0, SH_ERR_INVALID_ARGUMENT, "tet_count is %d, must be > 0", tet_count);
         capi::require_pointer(nodes, "nodes");
         capi::require_pointer(tets, "tets");
         MeshData data;
@@ -78,8 +78,7 @@ SH_API sh_status sh_mesh_transform(const sh_mesh* mesh, double scale, const doub
         capi::require_pointer(out_mesh, "out_mesh");
         *out_mesh = nullptr;
         const TetMesh& source = checked_mesh(mesh);
-        require(std::isfinite(scale) && scale > 0.0, SH_ERR_INVALID_ARGUMENT,
-                format("scale = %g, must be finite and > 0", scale));
+        SH_REQUIRE(std::isfinite(scale) && scale > 0.0, SH_ERR_INVALID_ARGUMENT, "scale = %g, must be finite and > 0", scale);
         double t[3] = {0.0, 0.0, 0.0};
         if (translation)
             for (int k = 0; k < 3; ++k) {

@@ -27,14 +27,10 @@ template <class Def>
 IntegrationSettings integration_settings(const Def& def) {
     const int integrator = enum_value(def.integrator), policy = enum_value(def.on_unstable);
     const double damping_mass = def.damping_mass, runaway_speed = def.runaway_speed;
-    require(integrator >= SH_INTEGRATOR_FORWARD_EULER && integrator <= SH_INTEGRATOR_RK4, SH_ERR_INVALID_ARGUMENT,
-            format("def->integrator = %d is not a sh_integrator", integrator));
-    require(policy == SH_UNSTABLE_REJECT || policy == SH_UNSTABLE_SUBSTEP, SH_ERR_INVALID_ARGUMENT,
-            format("def->on_unstable = %d is not a sh_unstable_policy", policy));
-    require(std::isfinite(damping_mass) && damping_mass >= 0.0, SH_ERR_INVALID_ARGUMENT,
-            format("def->damping_mass = %g 1/s, must be finite and >= 0", damping_mass));
-    require(runaway_speed > 0.0, SH_ERR_INVALID_ARGUMENT,
-            format("def->runaway_speed = %g m/s, must be > 0", runaway_speed));
+    SH_REQUIRE(integrator >= SH_INTEGRATOR_FORWARD_EULER && integrator <= SH_INTEGRATOR_RK4, SH_ERR_INVALID_ARGUMENT, "def->integrator = %d is not a sh_integrator", integrator);
+    SH_REQUIRE(policy == SH_UNSTABLE_REJECT || policy == SH_UNSTABLE_SUBSTEP, SH_ERR_INVALID_ARGUMENT, "def->on_unstable = %d is not a sh_unstable_policy", policy);
+    SH_REQUIRE(std::isfinite(damping_mass) && damping_mass >= 0.0, SH_ERR_INVALID_ARGUMENT, "def->damping_mass = %g 1/s, must be finite and >= 0", damping_mass);
+    SH_REQUIRE(runaway_speed > 0.0, SH_ERR_INVALID_ARGUMENT, "def->runaway_speed = %g m/s, must be > 0", runaway_speed);
     IntegrationSettings s;
     s.integrator = static_cast<sh_integrator>(integrator);
     s.on_unstable = static_cast<sh_unstable_policy>(policy);
@@ -123,8 +119,7 @@ SH_API sh_status sh_world_add_fem_body(sh_world* world, const sh_fem_body_def* d
         if (!def->mesh) throw Error(SH_ERR_INVALID_ARGUMENT, "def->mesh is NULL");
         const TetMesh& mesh = capi::mesh_of(def->mesh);
         validate_material(def->material, "def");
-        require(std::isfinite(def->damping_stiffness) && def->damping_stiffness >= 0.0, SH_ERR_INVALID_ARGUMENT,
-                format("def->damping_stiffness = %g s, must be finite and >= 0", def->damping_stiffness));
+        SH_REQUIRE(std::isfinite(def->damping_stiffness) && def->damping_stiffness >= 0.0, SH_ERR_INVALID_ARGUMENT, "def->damping_stiffness = %g s, must be finite and >= 0", def->damping_stiffness);
         const IntegrationSettings settings =
             integration_settings(*def);
         *out_body = w.add_body(sh::create<FemBody>(mesh, def->material, settings, def->damping_stiffness));
@@ -152,8 +147,7 @@ SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_
         const TetMesh* mesh = def->mesh ? &capi::mesh_of(def->mesh) : nullptr;
         vec<double> nodes;
         if (def->nodes) {
-            require(def->node_count > 0, SH_ERR_INVALID_ARGUMENT,
-                    format("def->node_count = %d, must be > 0", def->node_count));
+            SH_REQUIRE(def->node_count > 0, SH_ERR_INVALID_ARGUMENT, "def->node_count = %d, must be > 0", def->node_count);
             nodes.assign(def->nodes, def->nodes + 3 * static_cast<size_t>(def->node_count));
         } else {
             require(mesh != nullptr, SH_ERR_INVALID_ARGUMENT, "def->nodes and def->mesh are both NULL");
@@ -162,8 +156,7 @@ SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_
         const size_t node_count = nodes.size() / 3;
         vec<int32_t> springs;
         if (def->springs) {
-            require(def->spring_count >= 0, SH_ERR_INVALID_ARGUMENT,
-                    format("def->spring_count = %d, must be >= 0", def->spring_count));
+            SH_REQUIRE(def->spring_count >= 0, SH_ERR_INVALID_ARGUMENT, "def->spring_count = %d, must be >= 0", def->spring_count);
             springs.assign(def->springs, def->springs + 2 * static_cast<size_t>(def->spring_count));
         } else if (mesh) {
             require(mesh->node_count() == static_cast<int32_t>(node_count), SH_ERR_INVALID_ARGUMENT,

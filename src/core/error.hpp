@@ -19,7 +19,7 @@ private:
     std::string message_;
 };
 
-/// Throws Error(status, message) when condition is false.
+/// Throws Error(status, message) when condition is false (for fixed messages; see SH_REQUIRE).
 inline void require(bool condition, sh_status status, const std::string& message) {
     if (!condition) throw Error(status, message);
 }
@@ -28,3 +28,10 @@ inline void require(bool condition, sh_status status, const std::string& message
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
 }  // namespace sh
+
+/// Throws sh::Error(status, printf-formatted message) when condition is false; the message is
+/// only formatted on failure, so checks in loops cost a comparison.
+#define SH_REQUIRE(condition, status, ...) \
+    do {                                   \
+        if (!(condition)) throw ::sh::Error((status), ::sh::format(__VA_ARGS__)); \
+    } while (0)

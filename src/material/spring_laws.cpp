@@ -11,8 +11,7 @@ namespace {
 
 void require_finite_at_least(double value, double minimum, bool strict, const char* name) {
     const bool ok = std::isfinite(value) && (strict ? value > minimum : value >= minimum);
-    require(ok, SH_ERR_INVALID_ARGUMENT,
-            format("params.%s = %g, must be finite and %s %g", name, value, strict ? ">" : ">=", minimum));
+    SH_REQUIRE(ok, SH_ERR_INVALID_ARGUMENT, "params.%s = %g, must be finite and %s %g", name, value, strict ? ">" : ">=", minimum);
 }
 
 }  // namespace
@@ -21,8 +20,7 @@ SpringLaw::SpringLaw(const sh_spring_params& p) : params_(p) {
     params_.table = nullptr;
     require_finite_at_least(p.damping, 0.0, false, "damping");
     const int law = enum_value(p.law);
-    require(law >= SH_SPRING_LINEAR && law <= SH_SPRING_TABLE, SH_ERR_INVALID_ARGUMENT,
-            format("params.law = %d is not a sh_spring_law", law));
+    SH_REQUIRE(law >= SH_SPRING_LINEAR && law <= SH_SPRING_TABLE, SH_ERR_INVALID_ARGUMENT, "params.law = %d is not a sh_spring_law", law);
     switch (p.law) {
         case SH_SPRING_LINEAR:
             require_finite_at_least(p.stiffness, 0.0, true, "stiffness");
@@ -37,18 +35,15 @@ SpringLaw::SpringLaw(const sh_spring_params& p) : params_(p) {
             break;
         case SH_SPRING_TABLE: {
             require(p.table != nullptr, SH_ERR_INVALID_ARGUMENT, "params.table is NULL");
-            require(p.table_rows >= 2, SH_ERR_INVALID_ARGUMENT,
-                    format("params.table_rows = %d, a curve needs at least 2 rows", p.table_rows));
+            SH_REQUIRE(p.table_rows >= 2, SH_ERR_INVALID_ARGUMENT, "params.table_rows = %d, a curve needs at least 2 rows", p.table_rows);
             const size_t n = static_cast<size_t>(p.table_rows);
             strain_.resize(n);
             force_.resize(n);
             for (size_t k = 0; k < n; ++k) {
                 strain_[k] = p.table[2 * k];
                 force_[k] = p.table[2 * k + 1];
-                require(std::isfinite(strain_[k]) && std::isfinite(force_[k]), SH_ERR_INVALID_ARGUMENT,
-                        format("params.table row %zu is not finite", k));
-                require(k == 0 || strain_[k] > strain_[k - 1], SH_ERR_INVALID_ARGUMENT,
-                        format("params.table row %zu: strain %g does not increase", k, strain_[k]));
+                SH_REQUIRE(std::isfinite(strain_[k]) && std::isfinite(force_[k]), SH_ERR_INVALID_ARGUMENT, "params.table row %zu is not finite", k);
+                SH_REQUIRE(k == 0 || strain_[k] > strain_[k - 1], SH_ERR_INVALID_ARGUMENT, "params.table row %zu: strain %g does not increase", k, strain_[k]);
             }
             // Fritsch-Carlson slopes: a monotone data set gives a monotone curve.
             vec<double> secant(n - 1);

@@ -85,8 +85,7 @@ TetMesh build_tet_mesh(MeshData data, const std::string& origin) {
 
     for (int32_t n = 0; n < node_count; ++n)
         for (int k = 0; k < 3; ++k)
-            require(std::isfinite(data.nodes[3 * static_cast<size_t>(n) + k]), SH_ERR_DEGENERATE_MESH,
-                    format("%s: node %d has a non-finite coordinate", origin.c_str(), n));
+            SH_REQUIRE(std::isfinite(data.nodes[3 * static_cast<size_t>(n) + k]), SH_ERR_DEGENERATE_MESH, "%s: node %d has a non-finite coordinate", origin.c_str(), n);
 
     // Scale for the zero-volume test: relative to the mesh's bounding box.
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -102,13 +101,11 @@ TetMesh build_tet_mesh(MeshData data, const std::string& origin) {
     for (size_t t = 0; t < tet_count; ++t) {
         int32_t* tet = &data.tets[4 * t];
         for (int a = 0; a < 4; ++a)
-            require(tet[a] >= 0 && tet[a] < node_count, SH_ERR_DEGENERATE_MESH,
-                    format("%s: %s: node index %d out of range [0, %d)", origin.c_str(),
-                           tet_name(data, t).c_str(), tet[a], node_count));
+            SH_REQUIRE(tet[a] >= 0 && tet[a] < node_count, SH_ERR_DEGENERATE_MESH, "%s: %s: node index %d out of range [0, %d)", origin.c_str(),
+                           tet_name(data, t).c_str(), tet[a], node_count);
         for (int a = 0; a < 4; ++a)
             for (int b = a + 1; b < 4; ++b)
-                require(tet[a] != tet[b], SH_ERR_DEGENERATE_MESH,
-                        format("%s: %s repeats node %d", origin.c_str(), tet_name(data, t).c_str(), tet[a]));
+                SH_REQUIRE(tet[a] != tet[b], SH_ERR_DEGENERATE_MESH, "%s: %s repeats node %d", origin.c_str(), tet_name(data, t).c_str(), tet[a]);
         const double* p[4];
         for (int a = 0; a < 4; ++a) p[a] = &data.nodes[3 * static_cast<size_t>(tet[a])];
         double longest = 0.0;
@@ -120,9 +117,8 @@ TetMesh build_tet_mesh(MeshData data, const std::string& origin) {
         longest = std::sqrt(longest);
         double volume = signed_tet_volume(p[0], p[1], p[2], p[3]);
         // A tet is degenerate when its volume is negligible against a cube of its longest edge.
-        require(std::fabs(volume) > 1e-12 * longest * longest * longest, SH_ERR_DEGENERATE_MESH,
-                format("%s: %s has zero volume (nodes %d %d %d %d)", origin.c_str(),
-                       tet_name(data, t).c_str(), tet[0], tet[1], tet[2], tet[3]));
+        SH_REQUIRE(std::fabs(volume) > 1e-12 * longest * longest * longest, SH_ERR_DEGENERATE_MESH, "%s: %s has zero volume (nodes %d %d %d %d)", origin.c_str(),
+                       tet_name(data, t).c_str(), tet[0], tet[1], tet[2], tet[3]);
         if (volume < 0) {
             std::swap(tet[2], tet[3]);
             volume = -volume;
@@ -136,11 +132,10 @@ TetMesh build_tet_mesh(MeshData data, const std::string& origin) {
     }
     std::sort(sorted.begin(), sorted.end());
     for (size_t i = 1; i < sorted.size(); ++i)
-        require(!std::equal(sorted[i].begin(), sorted[i].begin() + 4, sorted[i - 1].begin()),
-                SH_ERR_DEGENERATE_MESH,
-                format("%s: %s duplicates %s", origin.c_str(),
+        SH_REQUIRE(!std::equal(sorted[i].begin(), sorted[i].begin() + 4, sorted[i - 1].begin()),
+                SH_ERR_DEGENERATE_MESH, "%s: %s duplicates %s", origin.c_str(),
                        tet_name(data, static_cast<size_t>(std::max(sorted[i][4], sorted[i - 1][4]))).c_str(),
-                       tet_name(data, static_cast<size_t>(std::min(sorted[i][4], sorted[i - 1][4]))).c_str()));
+                       tet_name(data, static_cast<size_t>(std::min(sorted[i][4], sorted[i - 1][4]))).c_str());
 
     for (int32_t n = 0; n < node_count; ++n) mesh.orphan_node_count += mesh.node_used[static_cast<size_t>(n)] ? 0 : 1;
     for (int k = 0; k < 3; ++k) {

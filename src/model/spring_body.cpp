@@ -18,27 +18,24 @@ SpringBody::SpringBody(vec<double> nodes, vec<int32_t> springs, const sh_spring_
         if (springs_[s_i] >= 0 && springs_[s_i] < n) on_spring[static_cast<size_t>(springs_[s_i])] = 1;
     for (int32_t i = 0; i < n; ++i) {
         for (int k = 0; k < 3; ++k)
-            require(std::isfinite(x[3 * static_cast<size_t>(i) + k]), SH_ERR_INVALID_ARGUMENT,
-                    format("node %d has a non-finite coordinate", i));
+            SH_REQUIRE(std::isfinite(x[3 * static_cast<size_t>(i) + k]), SH_ERR_INVALID_ARGUMENT, "node %d has a non-finite coordinate", i);
         const double m = masses[static_cast<size_t>(i)];
         // Zero mass is allowed only for a node no spring uses: it is left out of the dynamics.
         const bool ok = std::isfinite(m) && (m > 0.0 || (m == 0.0 && spring_count > 0 && !on_spring[static_cast<size_t>(i)]));
-        require(ok, SH_ERR_INVALID_ARGUMENT, format("node %d: mass %g kg, must be finite and > 0", i, m));
+        SH_REQUIRE(ok, SH_ERR_INVALID_ARGUMENT, "node %d: mass %g kg, must be finite and > 0", i, m);
         mass[static_cast<size_t>(i)] = m;
     }
     rest_length_.resize(spring_count);
     for (size_t s_i = 0; s_i < spring_count; ++s_i) {
         const int32_t a = springs_[2 * s_i], b = springs_[2 * s_i + 1];
-        require(a >= 0 && a < n && b >= 0 && b < n, SH_ERR_INVALID_ARGUMENT,
-                format("spring %zu: node index (%d, %d) out of range [0, %d)", s_i, a, b, n));
-        require(a != b, SH_ERR_INVALID_ARGUMENT, format("spring %zu joins node %d to itself", s_i, a));
+        SH_REQUIRE(a >= 0 && a < n && b >= 0 && b < n, SH_ERR_INVALID_ARGUMENT, "spring %zu: node index (%d, %d) out of range [0, %d)", s_i, a, b, n);
+        SH_REQUIRE(a != b, SH_ERR_INVALID_ARGUMENT, "spring %zu joins node %d to itself", s_i, a);
         double l2 = 0.0;
         for (int k = 0; k < 3; ++k) {
             const double d = x[3 * static_cast<size_t>(b) + k] - x[3 * static_cast<size_t>(a) + k];
             l2 += d * d;
         }
-        require(l2 > 0.0, SH_ERR_INVALID_ARGUMENT,
-                format("spring %zu (nodes %d, %d) has zero rest length", s_i, a, b));
+        SH_REQUIRE(l2 > 0.0, SH_ERR_INVALID_ARGUMENT, "spring %zu (nodes %d, %d) has zero rest length", s_i, a, b);
         rest_length_[s_i] = std::sqrt(l2);
     }
     row_bound_.resize(static_cast<size_t>(n));

@@ -80,8 +80,7 @@ void World::remove_body(sh_body_id id) {
 }
 
 void World::step(double dt, sh_step_report* report) {
-    require(std::isfinite(dt) && dt > 0.0, SH_ERR_INVALID_ARGUMENT,
-            format("dt = %g s, must be finite and > 0", dt));
+    SH_REQUIRE(std::isfinite(dt) && dt > 0.0, SH_ERR_INVALID_ARGUMENT, "dt = %g s, must be finite and > 0", dt);
     const auto start = std::chrono::steady_clock::now();
     sh_step_report r{};
     r.substeps = 1;

@@ -116,8 +116,7 @@ void write_integers(VtuOut& out, const char* attributes, int64_t count, int per_
 
 void write_vtu(const std::string& path, const VtuFrame& frame) {
     const int type = vtk_cell_type(frame.nodes_per_cell);
-    require(type != 0, SH_ERR_INVALID_ARGUMENT,
-            format("write_vtu: nodes_per_cell is %d, must be 2, 3 or 4", frame.nodes_per_cell));
+    SH_REQUIRE(type != 0, SH_ERR_INVALID_ARGUMENT, "write_vtu: nodes_per_cell is %d, must be 2, 3 or 4", frame.nodes_per_cell);
     require(frame.point_count >= 0 && frame.cell_count >= 0 && (frame.points || frame.point_count == 0) &&
                 (frame.cells || frame.cell_count == 0),
             SH_ERR_INVALID_ARGUMENT, "write_vtu: negative counts or missing arrays");

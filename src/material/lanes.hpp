@@ -2,6 +2,12 @@
 // so the same source compiles to AVX-512, AVX2 or SSE2 as the target allows.
 #pragma once
 
+#include <cmath>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
 namespace sh {
 
 /// Tets processed together by the element kernels.
@@ -20,6 +26,17 @@ SH_INLINE Lanes splat(double s) { return Lanes{} + s; }
 
 /// Element-wise select: mask ? a : b.
 SH_INLINE Lanes select(LaneMask mask, Lanes a, Lanes b) { return mask ? a : b; }
+
+/// Element-wise square root (vectorised where the target has it).
+SH_INLINE Lanes lanes_sqrt(Lanes a) {
+#if defined(__AVX512F__)
+    static_assert(kLanes == 8, "AVX-512 path assumes 8 double lanes");
+    return _mm512_sqrt_pd(a);
+#else
+    for (int l = 0; l < kLanes; ++l) a[l] = std::sqrt(a[l]);
+    return a;
+#endif
+}
 
 /// Sum of the lanes.
 SH_INLINE double lane_sum(Lanes a) {

@@ -26,26 +26,33 @@ Mat3L polar_rotation(const Mat3L& F) {
     // |det| vs (|F|^2/3)^(3/2): 1 for a scaled rotation, small when nearly flat.
     const Lanes scale3 = norm2 * norm2 * norm2 / 27.0;
     const LaneMask bad = d * d < kSvdThreshold * kSvdThreshold * scale3 || d <= 0.0;
+    bool any_bad = false;
+    for (int l = 0; l < kLanes; ++l) any_bad |= bad[l] != 0;
 
+    // Bad lanes start from I (keeps Newton finite; the SVD below replaces them).
     Mat3L R = F;
-    for (int l = 0; l < kLanes; ++l)
-        if (bad[l])
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) R.m[i][j][l] = i == j ? 1.0 : 0.0;  // keeps Newton finite; SVD below
+    if (any_bad) {
+        const Mat3L I = identity_lanes();
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) R.m[i][j] = select(bad, I.m[i][j], F.m[i][j]);
+    }
 
     for (int iteration = 0; iteration < 20; ++iteration) {
         const Mat3L C = cofactor(R);  // R^-T = C / det R
-        const Lanes dr = det(R);
+        const Lanes dr = R.m[0][0] * C.m[0][0] + R.m[0][1] * C.m[0][1] + R.m[0][2] * C.m[0][2];
         const Lanes inv_det = 1.0 / dr;
-        const Lanes rr = ddot(R, R), cc = ddot(C, C) * inv_det * inv_det;
         Lanes gamma = splat(1.0);  // Frobenius scaling speeds up the first iterations
-        if (iteration < 6)
-            for (int l = 0; l < kLanes; ++l) gamma[l] = std::sqrt(std::sqrt(cc[l] / rr[l]));
+        Lanes c_scale = inv_det;
+        if (iteration < 6) {
+            const Lanes rr = ddot(R, R), cc = ddot(C, C) * inv_det * inv_det;
+            gamma = lanes_sqrt(lanes_sqrt(cc / rr));
+            c_scale = inv_det / gamma;
+        }
         Mat3L next;
         Lanes change = Lanes{};
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) {
-                next.m[i][j] = 0.5 * (gamma * R.m[i][j] + C.m[i][j] * inv_det / gamma);
+                next.m[i][j] = 0.5 * (gamma * R.m[i][j] + C.m[i][j] * c_scale);
                 const Lanes diff = next.m[i][j] - R.m[i][j];
                 change += diff * diff;
             }
@@ -55,15 +62,16 @@ Mat3L polar_rotation(const Mat3L& F) {
         if (worst < 1e-28) break;
     }
 
-    for (int l = 0; l < kLanes; ++l) {
-        if (!bad[l]) continue;
-        Eigen::Matrix3d f;
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) f(i, j) = F.m[i][j][l];
-        const Eigen::Matrix3d r = rotation_by_svd(f);
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) R.m[i][j][l] = r(i, j);
-    }
+    if (any_bad)
+        for (int l = 0; l < kLanes; ++l) {
+            if (!bad[l]) continue;
+            Eigen::Matrix3d f;
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) f(i, j) = F.m[i][j][l];
+            const Eigen::Matrix3d r = rotation_by_svd(f);
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) R.m[i][j][l] = r(i, j);
+        }
     return R;
 }
 

@@ -2,6 +2,12 @@
 // P(F), its differential dP(F)[dF] (for stiffness damping) and the energy density psi(F).
 // lambda and mu are the Lame parameters of the material's small-strain limit; every model
 // reduces to linear elasticity for small strains.
+//
+// Every law is homogeneous of degree one in (lambda, mu): P, dP and psi scale with them. The
+// element kernels use this to pass lambda and mu already multiplied by -V0 (see TetBlock), which
+// yields the nodal-force matrix -V0 P and the element energy -V0 psi without extra products.
+// The formulas are written out for symmetric tensors (strain, second Piola stress) so the hot
+// loops compute each unique entry once.
 #pragma once
 
 #include "material/lanes.hpp"
@@ -11,51 +17,110 @@
 
 namespace sh {
 
+/// Symmetric 3x3 per lane: diagonal d[i] and off-diagonal o[0] = (0,1), o[1] = (0,2), o[2] = (1,2).
+struct Sym3L {
+    Lanes d[3];
+    Lanes o[3];
+};
+
+/// 2 mu A + lambda tr(A) I for symmetric A (a linear isotropic law).
+SH_INLINE Sym3L isotropic_law(const Sym3L& a, Lanes lambda, Lanes mu) {
+    const Lanes mu2 = mu + mu;
+    const Lanes lt = lambda * (a.d[0] + a.d[1] + a.d[2]);
+    Sym3L s;
+    for (int i = 0; i < 3; ++i) s.d[i] = mu2 * a.d[i] + lt;
+    for (int i = 0; i < 3; ++i) s.o[i] = mu2 * a.o[i];
+    return s;
+}
+
+/// mu A : A + lambda/2 tr(A)^2 for symmetric A (the energy of isotropic_law).
+SH_INLINE Lanes isotropic_energy(const Sym3L& a, Lanes lambda, Lanes mu) {
+    const Lanes tr = a.d[0] + a.d[1] + a.d[2];
+    const Lanes dd = a.d[0] * a.d[0] + a.d[1] * a.d[1] + a.d[2] * a.d[2];
+    const Lanes oo = a.o[0] * a.o[0] + a.o[1] * a.o[1] + a.o[2] * a.o[2];
+    return mu * (dd + 2.0 * oo) + 0.5 * lambda * tr * tr;
+}
+
+/// sym(A) - s I.
+SH_INLINE Sym3L sym_part(const Mat3L& a, double s) {
+    Sym3L r;
+    for (int i = 0; i < 3; ++i) r.d[i] = a.m[i][i] - s;
+    r.o[0] = 0.5 * (a.m[0][1] + a.m[1][0]);
+    r.o[1] = 0.5 * (a.m[0][2] + a.m[2][0]);
+    r.o[2] = 0.5 * (a.m[1][2] + a.m[2][1]);
+    return r;
+}
+
+/// A S for symmetric S.
+SH_INLINE Mat3L mul_sym(const Mat3L& a, const Sym3L& s) {
+    const Lanes c[3][3] = {{s.d[0], s.o[0], s.o[1]}, {s.o[0], s.d[1], s.o[2]}, {s.o[1], s.o[2], s.d[2]}};
+    Mat3L r;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][0] * c[0][j] + a.m[i][1] * c[1][j] + a.m[i][2] * c[2][j];
+    return r;
+}
+
+/// Symmetric 3x3 as a full matrix.
+SH_INLINE Mat3L full(const Sym3L& s) {
+    Mat3L r;
+    for (int i = 0; i < 3; ++i) r.m[i][i] = s.d[i];
+    r.m[0][1] = r.m[1][0] = s.o[0];
+    r.m[0][2] = r.m[2][0] = s.o[1];
+    r.m[1][2] = r.m[2][1] = s.o[2];
+    return r;
+}
+
 /// Small-strain linear elasticity: eps = sym(F) - I, P = 2 mu eps + lambda tr(eps) I.
 struct LinearMaterial {
     struct State {};
     static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State&) {
-        const Mat3L eps = add_diagonal(sym(F), splat(-1.0));
-        return add_diagonal(combine(2.0 * mu, eps, Lanes{}, eps), lambda * trace(eps));
+        return full(isotropic_law(sym_part(F, 1.0), lambda, mu));
     }
     static SH_INLINE Mat3L differential(const Mat3L&, const State&, const Mat3L& dF, Lanes lambda, Lanes mu) {
-        const Mat3L deps = sym(dF);
-        return add_diagonal(combine(2.0 * mu, deps, Lanes{}, deps), lambda * trace(deps));
+        return full(isotropic_law(sym_part(dF, 0.0), lambda, mu));
     }
     static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) {
-        const Mat3L eps = add_diagonal(sym(F), splat(-1.0));
-        const Lanes tr = trace(eps);
-        return mu * ddot(eps, eps) + 0.5 * lambda * tr * tr;
+        return isotropic_energy(sym_part(F, 1.0), lambda, mu);
     }
 };
 
 /// St. Venant-Kirchhoff: E = (F^T F - I)/2, S = lambda tr(E) I + 2 mu E, P = F S.
 struct StvkMaterial {
     struct State {
-        Mat3L S;
+        Sym3L S;
     };
-    static SH_INLINE Mat3L second_piola(const Mat3L& E, Lanes lambda, Lanes mu) {
-        return add_diagonal(combine(2.0 * mu, E, Lanes{}, E), lambda * trace(E));
+    /// sym(A^T B) for the differential (A^T B + B^T A)/2 of F^T F / 2.
+    static SH_INLINE Sym3L sym_tn(const Mat3L& a, const Mat3L& b) {
+        auto dot = [&](int i, int j) { return a.m[0][i] * b.m[0][j] + a.m[1][i] * b.m[1][j] + a.m[2][i] * b.m[2][j]; };
+        Sym3L r;
+        for (int i = 0; i < 3; ++i) r.d[i] = dot(i, i);
+        r.o[0] = 0.5 * (dot(0, 1) + dot(1, 0));
+        r.o[1] = 0.5 * (dot(0, 2) + dot(2, 0));
+        r.o[2] = 0.5 * (dot(1, 2) + dot(2, 1));
+        return r;
     }
-    static SH_INLINE Mat3L green_strain(const Mat3L& F) {
-        Mat3L E = mul_tn(F, F);
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) E.m[i][j] = 0.5 * E.m[i][j];
-        return add_diagonal(E, splat(-0.5));
+    static SH_INLINE Sym3L green_strain(const Mat3L& F) {
+        auto dot = [&](int i, int j) { return F.m[0][i] * F.m[0][j] + F.m[1][i] * F.m[1][j] + F.m[2][i] * F.m[2][j]; };
+        Sym3L E;
+        for (int i = 0; i < 3; ++i) E.d[i] = 0.5 * dot(i, i) - 0.5;
+        E.o[0] = 0.5 * dot(0, 1);
+        E.o[1] = 0.5 * dot(0, 2);
+        E.o[2] = 0.5 * dot(1, 2);
+        return E;
     }
     static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State& state) {
-        state.S = second_piola(green_strain(F), lambda, mu);
-        return mul(F, state.S);
+        state.S = isotropic_law(green_strain(F), lambda, mu);
+        return mul_sym(F, state.S);
     }
     static SH_INLINE Mat3L differential(const Mat3L& F, const State& state, const Mat3L& dF, Lanes lambda, Lanes mu) {
-        const Mat3L dE = sym(mul_tn(F, dF));
-        const Mat3L a = mul(dF, state.S), b = mul(F, second_piola(dE, lambda, mu));
-        return combine(splat(1.0), a, splat(1.0), b);
+        const Mat3L a = mul_sym(dF, state.S), b = mul_sym(F, isotropic_law(sym_tn(F, dF), lambda, mu));
+        Mat3L r;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][j] + b.m[i][j];
+        return r;
     }
     static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) {
-        const Mat3L E = green_strain(F);
-        const Lanes tr = trace(E);
-        return mu * ddot(E, E) + 0.5 * lambda * tr * tr;
+        return isotropic_energy(green_strain(F), lambda, mu);
     }
 };
 
@@ -66,9 +131,8 @@ struct CorotationalMaterial {
         Mat3L R;
     };
     static SH_INLINE Mat3L rotated_stress(const Mat3L& R, const Mat3L& G, Lanes lambda, Lanes mu, bool subtract_identity) {
-        Mat3L eps = sym(mul_tn(R, G));
-        if (subtract_identity) eps = add_diagonal(eps, splat(-1.0));
-        return mul(R, add_diagonal(combine(2.0 * mu, eps, Lanes{}, eps), lambda * trace(eps)));
+        const Sym3L eps = sym_part(mul_tn(R, G), subtract_identity ? 1.0 : 0.0);
+        return mul_sym(R, isotropic_law(eps, lambda, mu));
     }
     static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State& state) {
         state.R = polar_rotation(F);
@@ -78,9 +142,7 @@ struct CorotationalMaterial {
         return rotated_stress(state.R, dF, lambda, mu, false);
     }
     static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) {
-        const Mat3L eps = add_diagonal(sym(mul_tn(polar_rotation(F), F)), splat(-1.0));
-        const Lanes tr = trace(eps);
-        return mu * ddot(eps, eps) + 0.5 * lambda * tr * tr;
+        return isotropic_energy(sym_part(mul_tn(polar_rotation(F), F), 1.0), lambda, mu);
     }
 };
 
@@ -92,17 +154,23 @@ struct NeoHookeanMaterial {
         Mat3L cof;
         Lanes ic, j;
     };
+    /// m, l and alpha; alpha only depends on the ratio mu/lambda, and lanes with lambda = mu = 0
+    /// (block padding) get alpha = 1 so that they stay finite (and, having zero moduli, inert).
     static SH_INLINE void parameters(Lanes lambda, Lanes mu, Lanes& m, Lanes& l, Lanes& alpha) {
         m = (4.0 / 3.0) * mu;
         l = lambda + (5.0 / 6.0) * mu;
-        alpha = 1.0 + 0.75 * m / l;
+        alpha = select(l != 0.0, 1.0 + 0.75 * m / l, splat(1.0));
+    }
+    /// det F from its cofactor matrix (first row expansion).
+    static SH_INLINE Lanes det_from_cofactor(const Mat3L& F, const Mat3L& cof) {
+        return F.m[0][0] * cof.m[0][0] + F.m[0][1] * cof.m[0][1] + F.m[0][2] * cof.m[0][2];
     }
     static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State& state) {
         Lanes m, l, alpha;
         parameters(lambda, mu, m, l, alpha);
         state.ic = ddot(F, F);
         state.cof = cofactor(F);
-        state.j = det(F);
+        state.j = det_from_cofactor(F, state.cof);
         return combine(m * (1.0 - 1.0 / (state.ic + 1.0)), F, l * (state.j - alpha), state.cof);
     }
     static SH_INLINE Mat3L differential(const Mat3L& F, const State& state, const Mat3L& dF, Lanes lambda, Lanes mu) {
@@ -119,7 +187,10 @@ struct NeoHookeanMaterial {
             for (int j = 0; j < 3; ++j) dcof.m[i][j] = c_plus.m[i][j] - state.cof.m[i][j] - c_d.m[i][j];
         const Mat3L a = combine(m * (1.0 - inv), dF, 2.0 * m * inv * inv * ddot(F, dF), F);
         const Mat3L b = combine(l * ddot(state.cof, dF), state.cof, l * (state.j - alpha), dcof);
-        return combine(splat(1.0), a, splat(1.0), b);
+        Mat3L r;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][j] + b.m[i][j];
+        return r;
     }
     static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) {
         Lanes m, l, alpha;

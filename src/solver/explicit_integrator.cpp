@@ -1,7 +1,14 @@
 #include "solver/explicit_integrator.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 namespace sh {
 namespace {
@@ -105,6 +112,139 @@ void compute_accelerations(const Body& body, const double* x, const double* v, c
     }
 }
 
+namespace {
+
+// Calls visit(i) for every node i with kinematic[i] set; skips eight clear bytes at a time.
+template <class Visit>
+void for_each_kinematic(const vec<uint8_t>& kinematic, Visit&& visit) {
+    const size_t n = kinematic.size();
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t word;
+        std::memcpy(&word, &kinematic[i], sizeof word);
+        if (!word) continue;
+        for (size_t k = i; k < i + 8; ++k)
+            if (kinematic[k]) visit(k);
+    }
+    for (; i < n; ++i)
+        if (kinematic[i]) visit(i);
+}
+
+// One forward or symplectic Euler step of the whole body in one pass over the nodes, from the
+// internal forces already in w.a[0]: accelerations as compute_accelerations makes them, the
+// update, the start state saved to w.x0/w.v0 (kinematic nodes' velocities are patched by the
+// caller), velocities of the nodes that are not integrated zeroed, and the runaway check.
+// Non-free nodes are sane afterwards by construction (kinematic ones are put on their finite
+// targets by the caller, orphans do not move), so only free nodes are checked.
+template <bool Symplectic, bool PerNodeDamping>
+struct EulerPass {
+    double* __restrict x;
+    double* __restrict v;
+    double* __restrict x0;
+    double* __restrict v0;
+    const double* __restrict f;
+    const double* __restrict fe;
+    const double* __restrict inv_mass;
+    const double* __restrict node_damping;
+    double alpha, h, limit2, g[3];
+
+    EulerPass(Body& body, double step, const double gravity[3])
+        : x(body.x.data()), v(body.v.data()), x0(body.workspace.x0.data()), v0(body.workspace.v0.data()),
+          f(body.workspace.a[0].data()), fe(body.external_force.data()), inv_mass(body.inverse_mass.data()),
+          node_damping(PerNodeDamping ? body.node_damping.data() : nullptr), alpha(body.settings.damping_mass),
+          h(step), limit2(body.settings.runaway_speed * body.settings.runaway_speed),
+          g{gravity[0], gravity[1], gravity[2]} {}
+
+    // The runaway test of state_is_sane for free node i.
+    bool node_insane(size_t i) const {
+        const double* xi = &x[3 * i];
+        const double* vi = &v[3 * i];
+        const double speed2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
+        // NaN fails every comparison, so !(a <= b) also catches it.
+        return !(speed2 <= limit2 && std::isfinite(xi[0] + xi[1] + xi[2]));
+    }
+
+    // Node i alone; true if it is free and insane.
+    bool node(size_t i) const {
+        const double inv_m = inv_mass[i];
+        const double c = PerNodeDamping ? alpha + node_damping[i] : alpha;
+        const bool is_free = inv_m > 0.0;
+        for (int k = 0; k < 3; ++k) {
+            const size_t j = 3 * i + k;
+            const double xj = x[j], vj = v[j];
+            const double acc = is_free ? (f[j] + fe[j]) * inv_m + g[k] - c * vj : 0.0;
+            x0[j] = xj;
+            v0[j] = vj;
+            double xn, vn;
+            if (Symplectic) {
+                vn = vj + h * acc;
+                xn = xj + h * vn;
+            } else {
+                xn = xj + h * vj;
+                vn = vj + h * acc;
+            }
+            x[j] = xn;
+            v[j] = is_free ? vn : 0.0;
+        }
+        return is_free && node_insane(i);
+    }
+
+    // All n nodes; true if all free nodes are sane.
+    bool run(size_t n) const {
+        bool insane = false;
+        size_t i = 0;
+#if defined(__AVX512F__)
+        // Eight nodes (24 doubles, three registers) at a time. Per-node values are spread to
+        // the xyz layout with permutes; the runaway test is a conservative per-component bound
+        // (|v_k| <= 0.57 limit gives speed^2 <= 0.975 limit^2; |x_k| <= DBL_MAX/4 keeps the
+        // sum finite), and a chunk that fails it gets the exact per-node test.
+        const __m512i spread[3] = {_mm512_set_epi64(2, 2, 1, 1, 1, 0, 0, 0), _mm512_set_epi64(5, 4, 4, 4, 3, 3, 3, 2),
+                                   _mm512_set_epi64(7, 7, 7, 6, 6, 6, 5, 5)};
+        const __m512d gv[3] = {_mm512_set_pd(g[1], g[0], g[2], g[1], g[0], g[2], g[1], g[0]),
+                               _mm512_set_pd(g[0], g[2], g[1], g[0], g[2], g[1], g[0], g[2]),
+                               _mm512_set_pd(g[2], g[1], g[0], g[2], g[1], g[0], g[2], g[1])};
+        const __m512d hv = _mm512_set1_pd(h), zero = _mm512_setzero_pd();
+        const __m512d v_bound = _mm512_set1_pd(0.57 * std::sqrt(limit2)), x_bound = _mm512_set1_pd(0.25 * DBL_MAX);
+        const __m512d alpha_v = _mm512_set1_pd(alpha);
+        for (; i + 8 <= n; i += 8) {
+            const __m512d inv8 = _mm512_loadu_pd(inv_mass + i);
+            const __m512d c8 = PerNodeDamping ? _mm512_add_pd(alpha_v, _mm512_loadu_pd(node_damping + i)) : alpha_v;
+            __mmask8 flagged = 0;
+            for (int r = 0; r < 3; ++r) {
+                const size_t j = 3 * i + 8 * r;
+                const __m512d inv = _mm512_permutexvar_pd(spread[r], inv8);
+                const __m512d c = PerNodeDamping ? _mm512_permutexvar_pd(spread[r], c8) : c8;
+                const __mmask8 is_free = _mm512_cmp_pd_mask(inv, zero, _CMP_GT_OQ);
+                const __m512d xj = _mm512_loadu_pd(x + j), vj = _mm512_loadu_pd(v + j);
+                const __m512d load = _mm512_add_pd(_mm512_loadu_pd(f + j), _mm512_loadu_pd(fe + j));
+                const __m512d acc =
+                    _mm512_maskz_mov_pd(is_free, _mm512_fnmadd_pd(c, vj, _mm512_fmadd_pd(load, inv, gv[r])));
+                _mm512_storeu_pd(x0 + j, xj);
+                _mm512_storeu_pd(v0 + j, vj);
+                __m512d xn, vn;
+                if (Symplectic) {
+                    vn = _mm512_fmadd_pd(hv, acc, vj);
+                    xn = _mm512_fmadd_pd(hv, vn, xj);
+                } else {
+                    xn = _mm512_fmadd_pd(hv, vj, xj);
+                    vn = _mm512_fmadd_pd(hv, acc, vj);
+                }
+                _mm512_storeu_pd(x + j, xn);
+                _mm512_storeu_pd(v + j, _mm512_maskz_mov_pd(is_free, vn));
+                flagged |= is_free & (_mm512_cmp_pd_mask(_mm512_abs_pd(vn), v_bound, _CMP_NLE_UQ) |
+                                      _mm512_cmp_pd_mask(_mm512_abs_pd(xn), x_bound, _CMP_NLE_UQ));
+            }
+            if (flagged)
+                for (size_t k = i; k < i + 8; ++k) insane |= inv_mass[k] > 0.0 && node_insane(k);
+        }
+#endif
+        for (; i < n; ++i) insane |= node(i);
+        return !insane;
+    }
+};
+
+}  // namespace
+
 BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
     BodyStepResult result;
     result.dt_critical = body.critical_dt();
@@ -120,6 +260,41 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
     result.substeps = static_cast<int32_t>(substeps);
 
     IntegratorWorkspace& w = body.workspace;
+    const sh_integrator integrator = body.settings.integrator;
+    if (result.substeps == 1 &&
+        (integrator == SH_INTEGRATOR_SYMPLECTIC_EULER || integrator == SH_INTEGRATOR_FORWARD_EULER)) {
+        // The real-time case, in two passes over the nodes besides the forces. Kinematic nodes'
+        // start velocities wait in w.vs (stage state, unused by the Euler methods).
+        for_each_kinematic(body.kinematic, [&](size_t i) {
+            for (int k = 0; k < 3; ++k) {
+                const size_t j = 3 * i + k;
+                w.vs[j] = body.v[j];
+                body.v[j] = (body.target[j] - body.x[j]) / dt;
+            }
+        });
+        double* f = w.a[0].data();
+        std::fill(f, f + body.x.size(), 0.0);
+        body.add_internal_forces(body.x.data(), body.v.data(), f);
+        const bool per_node = !body.node_damping.empty();
+        const bool symplectic = integrator == SH_INTEGRATOR_SYMPLECTIC_EULER;
+        const size_t n = body.mass.size();
+        const bool sane = symplectic ? (per_node ? EulerPass<true, true>(body, dt, g).run(n) : EulerPass<true, false>(body, dt, g).run(n))
+                                     : (per_node ? EulerPass<false, true>(body, dt, g).run(n) : EulerPass<false, false>(body, dt, g).run(n));
+        for_each_kinematic(body.kinematic, [&](size_t i) {
+            for (int k = 0; k < 3; ++k) {
+                const size_t j = 3 * i + k;
+                w.v0[j] = w.vs[j];
+                body.x[j] = body.target[j];
+            }
+        });
+        if (!sane) {
+            std::copy(w.x0.begin(), w.x0.end(), body.x.begin());
+            std::copy(w.v0.begin(), w.v0.end(), body.v.begin());
+            result.stable = false;
+        }
+        return result;
+    }
+
     std::copy(body.x.begin(), body.x.end(), w.x0.begin());
     std::copy(body.v.begin(), body.v.end(), w.v0.begin());
     const size_t n = body.mass.size();

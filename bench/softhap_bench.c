@@ -212,7 +212,7 @@ static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_i
 
 typedef struct {
     int steps;
-    double median_ns, p99_ns, p999_ns, mean_ns;
+    double min_ns, median_ns, p99_ns, p999_ns, mean_ns;
     int substeps;     /* largest seen in reports */
     int failed;       /* steps that did not return SH_OK */
     sh_step_report last;
@@ -267,6 +267,7 @@ static timing time_steps(sh_world* world, double dt, int with_report, double bud
     for (int s = 0; s < t.steps; ++s) sum += ns[s];
     qsort(ns, (size_t)t.steps, sizeof(double), cmp_double);
     t.mean_ns = sum / t.steps;
+    t.min_ns = ns[0];
     t.median_ns = median(ns, t.steps);
     t.p99_ns = quantile(ns, t.steps, 0.99);
     t.p999_ns = quantile(ns, t.steps, 0.999);
@@ -281,10 +282,10 @@ static void print_case(const char* name, const bench_mesh* m, int springs, doubl
                        uint64_t substep_warnings, int with_report) {
     printf("{\"case\":\"%s\",\"tets\":%d,", name, m->info.tet_count);
     if (springs) printf("\"springs\":%d,", m->edge_count);
-    printf("\"ns_per_tet_step\":%.2f,\"median_us\":%.2f,\"p99_us\":%.2f,\"p999_us\":%.2f,\"mean_us\":%.2f,"
+    printf("\"ns_per_tet_step\":%.2f,\"median_us\":%.2f,\"p99_us\":%.2f,\"p999_us\":%.2f,\"mean_us\":%.2f,\"min_us\":%.2f,"
            "\"steps\":%d,\"substeps\":%d,\"substep_warnings\":%llu,\"failed_steps\":%d,\"dt\":%.4g,\"dt_crit\":%.4g",
            t->median_ns / m->info.tet_count, t->median_ns * 1e-3, t->p99_ns * 1e-3, t->p999_ns * 1e-3,
-           t->mean_ns * 1e-3, t->steps, t->substeps, (unsigned long long)substep_warnings, t->failed, dt,
+           t->mean_ns * 1e-3, t->min_ns * 1e-3, t->steps, t->substeps, (unsigned long long)substep_warnings, t->failed, dt,
            t->last.dt_critical);
     if (with_report)
         printf(",\"kinetic_J\":%.6g,\"elastic_J\":%.6g,\"potential_J\":%.6g", t->last.kinetic_energy,

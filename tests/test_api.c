@@ -848,7 +848,7 @@ static void test_spring_def_errors(void** state) {
     def.spring_count = -1;
     EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "spring_count");
     two_node_def(&def, nodes, one_spring);
-    def.integrator = (sh_integrator)4;
+    def.integrator = (sh_integrator)5;
     EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "integrator");
     two_node_def(&def, nodes, one_spring);
     def.runaway_speed = -1.0;

@@ -223,6 +223,12 @@ typedef struct sh_step_report {
     double potential_energy;/**< gravitational energy -m g.x after the step (J) */
     uint32_t warnings;      /**< bit (1 << sh_warning) set for each kind raised in this step */
     int32_t unstable_body_count; /**< bodies rejected or rolled back in this step */
+    int32_t newton_iterations;   /**< implicit bodies: most Newton iterations of any body */
+    int32_t linear_iterations;   /**< implicit bodies: total linear-solver iterations (CG), or
+                                      solves (direct) */
+    double newton_residual;      /**< implicit bodies: largest final relative residual */
+    double factorize_seconds;    /**< implicit bodies: time in sparse factorisations (s) */
+    double solve_seconds;        /**< implicit bodies: time in sparse solves (s) */
 } sh_step_report;
 
 /** Advance every body by dt seconds with its own integrator. A body whose step is rejected
@@ -235,7 +241,7 @@ SH_API sh_status sh_world_step(sh_world* world, double dt, sh_step_report* repor
 /* ------------------------------------------------------------------------------------------ */
 /* Bodies: shared definitions                                                                   */
 
-/** Explicit time integrators. Forward Euler and RK2 have no stable step for an undamped
+/** Time integrators. Forward Euler and RK2 have no stable step for an undamped
  *  elastic body: each step multiplies a mode's energy by 1 + (w dt)^2 (forward Euler) or
  *  1 + (w dt)^4 / 4 (RK2), so they drift even below dt_crit unless damping removes more; a
  *  state that runs away is rolled back (SH_ERR_UNSTABLE). Use them for comparison; symplectic
@@ -244,8 +250,34 @@ typedef enum sh_integrator {
     SH_INTEGRATOR_FORWARD_EULER = 0,   /**< x += dt v, v += dt a (first order) */
     SH_INTEGRATOR_SYMPLECTIC_EULER = 1,/**< v += dt a, x += dt v (first order, symplectic) */
     SH_INTEGRATOR_RK2 = 2,             /**< explicit midpoint (second order) */
-    SH_INTEGRATOR_RK4 = 3              /**< classical Runge-Kutta (fourth order) */
+    SH_INTEGRATOR_RK4 = 3,             /**< classical Runge-Kutta (fourth order) */
+    SH_INTEGRATOR_IMPLICIT_EULER = 4   /**< backward Euler, linearised per step (Baraff-Witkin)
+                                            with optional Newton iterations: unconditionally
+                                            stable, first order, dissipative; see
+                                            sh_implicit_settings */
 } sh_integrator;
+
+/** Sparse linear solvers of the implicit integrator and the static solver. */
+typedef enum sh_linear_solver {
+    SH_LINEAR_SOLVER_DEFAULT = 0, /**< CHOLMOD when built in, else SH_LINEAR_SOLVER_LDLT */
+    SH_LINEAR_SOLVER_CHOLMOD = 1, /**< SuiteSparse CHOLMOD; symbolic analysis reused while the
+                                       sparsity pattern is unchanged */
+    SH_LINEAR_SOLVER_LDLT = 2,    /**< Eigen's SimplicialLDLT (no extra dependency) */
+    SH_LINEAR_SOLVER_CG = 3       /**< Eigen's conjugate gradient, warm-started from the last
+                                       step's solution */
+} sh_linear_solver;
+
+/** Settings of the implicit integrator (read only for SH_INTEGRATOR_IMPLICIT_EULER). */
+typedef struct sh_implicit_settings {
+    sh_linear_solver linear_solver; /**< default SH_LINEAR_SOLVER_DEFAULT */
+    int32_t newton_max_iterations;  /**< 1 = one linearised solve per step (default); more =
+                                         Newton iterations until newton_tolerance */
+    double newton_tolerance;        /**< stop when the residual |g| <= tol max(|g_0|, dt |f_ext +
+                                         m g|) or the velocity correction <= tol max(|v|, dt |g|,
+                                         1e-9 m/s); default 1e-6 */
+    double cg_tolerance;            /**< CG relative residual; default 1e-8 */
+    int32_t cg_max_iterations;      /**< CG iteration cap; default 2000 */
+} sh_implicit_settings;
 
 /** What a step larger than the body's critical step does. */
 typedef enum sh_unstable_policy {
@@ -283,6 +315,7 @@ typedef struct sh_fem_body_def {
     double damping_stiffness;       /**< Rayleigh beta (s): f = -beta K v; default 0 */
     double runaway_speed;           /**< a node faster than this (m/s) rolls the step back;
                                          default 1e4 */
+    sh_implicit_settings implicit;  /**< used with SH_INTEGRATOR_IMPLICIT_EULER */
 } sh_fem_body_def;
 
 /** Fill an FEM body def with defaults: StVK, E = 3 kPa, nu = 0.45, rho = 1000 kg/m^3 (soft
@@ -341,6 +374,7 @@ typedef struct sh_spring_body_def {
     sh_unstable_policy on_unstable; /**< default SH_UNSTABLE_SUBSTEP */
     double damping_mass;            /**< per-node viscous damping alpha (1/s): f = -alpha m v */
     double runaway_speed;           /**< a node faster than this (m/s) rolls back; default 1e4 */
+    sh_implicit_settings implicit;  /**< used with SH_INTEGRATOR_IMPLICIT_EULER */
 } sh_spring_body_def;
 
 /** Fill a spring body def with defaults: linear springs k = 100 N/m, c = 0, node mass 1 g,
@@ -432,6 +466,45 @@ SH_API sh_status sh_body_get_elastic_energy(const sh_world* world, sh_body_id bo
 /** Write the body's current shape as ASCII .vtu (FEM: tets; springs: lines) with point data
  *  "velocity". Thread: sim. Alloc: may. */
 SH_API sh_status sh_body_write_vtu(const sh_world* world, sh_body_id body, const char* path);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Static equilibrium                                                                           */
+
+/** Number of residuals kept in sh_static_report.residual_history. */
+#define SH_STATIC_HISTORY 64
+
+/** Settings of sh_world_solve_static. Initialise with sh_static_def_default. */
+typedef struct sh_static_def {
+    uint32_t internal_init;         /**< set by sh_static_def_default; do not touch */
+    double tolerance;               /**< stop when |residual| / |applied load| is below; 1e-10 */
+    int32_t max_iterations;         /**< Newton iterations per load step; default 50 */
+    int32_t load_steps;             /**< apply the loads in this many equal increments; 1 */
+    sh_linear_solver linear_solver; /**< default SH_LINEAR_SOLVER_DEFAULT */
+} sh_static_def;
+
+/** Fill a static def with defaults. Thread: any. Alloc: none. */
+SH_API void sh_static_def_default(sh_static_def* def);
+
+/** What sh_world_solve_static did. */
+typedef struct sh_static_report {
+    int32_t iterations;       /**< Newton iterations over all bodies and load steps */
+    int32_t load_steps;       /**< load steps taken */
+    int32_t converged;        /**< 1 if every body reached the tolerance */
+    int32_t history_count;    /**< entries in residual_history */
+    double residual;          /**< final largest relative residual */
+    double residual_history[SH_STATIC_HISTORY]; /**< relative residual after each iteration */
+    double wall_seconds;      /**< wall-clock time (s) */
+} sh_static_report;
+
+/** Move every body to static equilibrium under gravity (lumped, rho g V / 4 per node per tet
+ *  for FEM bodies) and its external forces, with fixed and prescribed nodes held: Newton-Raphson
+ *  K(x_i) dx = f_ext + f(x_i) with backtracking line search on the potential energy, one sparse
+ *  solve for linear materials. Positions are updated in place and velocities zeroed. A body
+ *  with no fixed node (singular K) is SH_ERR_SOLVER; SH_ERR_NOT_CONVERGED if the tolerance is
+ *  not reached; on any error every body keeps its previous state. report may be NULL.
+ *  Thread: sim. Alloc: may. */
+SH_API sh_status sh_world_solve_static(sh_world* world, const sh_static_def* def,
+                                       sh_static_report* report);
 
 #ifdef __cplusplus
 }

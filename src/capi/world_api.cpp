@@ -22,16 +22,47 @@ World& world_of(const sh_world* world) {
 
 namespace {
 
+// Checks the implicit integrator's settings.
+sh_implicit_settings checked_implicit_settings(const sh_implicit_settings& in) {
+    const int solver = enum_value(in.linear_solver);
+    SH_REQUIRE(solver >= SH_LINEAR_SOLVER_DEFAULT && solver <= SH_LINEAR_SOLVER_CG, SH_ERR_INVALID_ARGUMENT,
+               "def->implicit.linear_solver = %d is not a sh_linear_solver", solver);
+    require(solver != SH_LINEAR_SOLVER_CHOLMOD || (sh_build_features() & SH_FEATURE_CHOLMOD), SH_ERR_UNSUPPORTED,
+            "def->implicit.linear_solver is SH_LINEAR_SOLVER_CHOLMOD but this library was built without CHOLMOD");
+    SH_REQUIRE(in.newton_max_iterations >= 1, SH_ERR_INVALID_ARGUMENT,
+               "def->implicit.newton_max_iterations = %d, must be >= 1", in.newton_max_iterations);
+    SH_REQUIRE(std::isfinite(in.newton_tolerance) && in.newton_tolerance > 0.0, SH_ERR_INVALID_ARGUMENT,
+               "def->implicit.newton_tolerance = %g, must be finite and > 0", in.newton_tolerance);
+    SH_REQUIRE(std::isfinite(in.cg_tolerance) && in.cg_tolerance > 0.0, SH_ERR_INVALID_ARGUMENT,
+               "def->implicit.cg_tolerance = %g, must be finite and > 0", in.cg_tolerance);
+    SH_REQUIRE(in.cg_max_iterations >= 1, SH_ERR_INVALID_ARGUMENT,
+               "def->implicit.cg_max_iterations = %d, must be >= 1", in.cg_max_iterations);
+    sh_implicit_settings out = in;
+    out.linear_solver = static_cast<sh_linear_solver>(solver);
+    return out;
+}
+
+sh_implicit_settings default_implicit_settings() {
+    sh_implicit_settings s{};
+    s.linear_solver = SH_LINEAR_SOLVER_DEFAULT;
+    s.newton_max_iterations = 1;
+    s.newton_tolerance = 1e-6;
+    s.cg_tolerance = 1e-8;
+    s.cg_max_iterations = 2000;
+    return s;
+}
+
 // Checks and copies the integration fields that FEM and spring defs share.
 template <class Def>
 IntegrationSettings integration_settings(const Def& def) {
     const int integrator = enum_value(def.integrator), policy = enum_value(def.on_unstable);
     const double damping_mass = def.damping_mass, runaway_speed = def.runaway_speed;
-    SH_REQUIRE(integrator >= SH_INTEGRATOR_FORWARD_EULER && integrator <= SH_INTEGRATOR_RK4, SH_ERR_INVALID_ARGUMENT, "def->integrator = %d is not a sh_integrator", integrator);
+    SH_REQUIRE(integrator >= SH_INTEGRATOR_FORWARD_EULER && integrator <= SH_INTEGRATOR_IMPLICIT_EULER, SH_ERR_INVALID_ARGUMENT, "def->integrator = %d is not a sh_integrator", integrator);
     SH_REQUIRE(policy == SH_UNSTABLE_REJECT || policy == SH_UNSTABLE_SUBSTEP, SH_ERR_INVALID_ARGUMENT, "def->on_unstable = %d is not a sh_unstable_policy", policy);
     SH_REQUIRE(std::isfinite(damping_mass) && damping_mass >= 0.0, SH_ERR_INVALID_ARGUMENT, "def->damping_mass = %g 1/s, must be finite and >= 0", damping_mass);
     SH_REQUIRE(runaway_speed > 0.0, SH_ERR_INVALID_ARGUMENT, "def->runaway_speed = %g m/s, must be > 0", runaway_speed);
     IntegrationSettings s;
+    if (integrator == SH_INTEGRATOR_IMPLICIT_EULER) s.implicit = checked_implicit_settings(def.implicit);
     s.integrator = static_cast<sh_integrator>(integrator);
     s.on_unstable = static_cast<sh_unstable_policy>(policy);
     s.damping_mass = damping_mass;
@@ -97,6 +128,33 @@ SH_API sh_status sh_world_step(sh_world* world, double dt, sh_step_report* repor
     return capi::guard([&] { capi::world_of(world).step(dt, report); });
 }
 
+SH_API void sh_static_def_default(sh_static_def* def) {
+    if (!def) return;
+    *def = sh_static_def{};
+    def->internal_init = capi::kDefInitialised;
+    def->tolerance = 1e-10;
+    def->max_iterations = 50;
+    def->load_steps = 1;
+    def->linear_solver = SH_LINEAR_SOLVER_DEFAULT;
+}
+
+SH_API sh_status sh_world_solve_static(sh_world* world, const sh_static_def* def, sh_static_report* report) {
+    return capi::guard([&] {
+        World& w = capi::world_of(world);
+        capi::require_initialised(def, "def");
+        SH_REQUIRE(std::isfinite(def->tolerance) && def->tolerance > 0.0, SH_ERR_INVALID_ARGUMENT,
+                   "def->tolerance = %g, must be finite and > 0", def->tolerance);
+        SH_REQUIRE(def->max_iterations >= 1, SH_ERR_INVALID_ARGUMENT, "def->max_iterations = %d, must be >= 1",
+                   def->max_iterations);
+        SH_REQUIRE(def->load_steps >= 1, SH_ERR_INVALID_ARGUMENT, "def->load_steps = %d, must be >= 1", def->load_steps);
+        sh_static_def checked = *def;
+        sh_implicit_settings solver = default_implicit_settings();
+        solver.linear_solver = def->linear_solver;
+        checked.linear_solver = checked_implicit_settings(solver).linear_solver;
+        w.solve_static(checked, report);
+    });
+}
+
 SH_API void sh_fem_body_def_default(sh_fem_body_def* def) {
     if (!def) return;
     *def = sh_fem_body_def{};
@@ -108,6 +166,7 @@ SH_API void sh_fem_body_def_default(sh_fem_body_def* def) {
     def->integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
     def->on_unstable = SH_UNSTABLE_SUBSTEP;
     def->runaway_speed = 1e4;
+    def->implicit = default_implicit_settings();
 }
 
 SH_API sh_status sh_world_add_fem_body(sh_world* world, const sh_fem_body_def* def, sh_body_id* out_body) {
@@ -136,6 +195,7 @@ SH_API void sh_spring_body_def_default(sh_spring_body_def* def) {
     def->integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
     def->on_unstable = SH_UNSTABLE_SUBSTEP;
     def->runaway_speed = 1e4;
+    def->implicit = default_implicit_settings();
 }
 
 SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_def* def, sh_body_id* out_body) {

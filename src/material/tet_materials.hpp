@@ -109,6 +109,19 @@ struct StvkMaterial {
         return E;
     }
     static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State& state) {
+#ifdef SH_STVK_FOLD
+        // S = 2 mu E + lambda tr(E) I with E = (C - I)/2, C = F^T F: S = mu (C - I) + lambda tr(E) I.
+        auto dot = [&](int i, int j) { return F.m[0][i] * F.m[0][j] + F.m[1][i] * F.m[1][j] + F.m[2][i] * F.m[2][j]; };
+        const Lanes c0 = dot(0, 0), c1 = dot(1, 1), c2 = dot(2, 2);
+        const Lanes lt = lambda * (0.5 * ((c0 + c1) + c2) - 1.5);
+        state.S.d[0] = mu * (c0 - 1.0) + lt;
+        state.S.d[1] = mu * (c1 - 1.0) + lt;
+        state.S.d[2] = mu * (c2 - 1.0) + lt;
+        state.S.o[0] = mu * dot(0, 1);
+        state.S.o[1] = mu * dot(0, 2);
+        state.S.o[2] = mu * dot(1, 2);
+        return mul_sym(F, state.S);
+#endif
         state.S = isotropic_law(green_strain(F), lambda, mu);
         return mul_sym(F, state.S);
     }
@@ -195,10 +208,18 @@ struct NeoHookeanMaterial {
     static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) {
         Lanes m, l, alpha;
         parameters(lambda, mu, m, l, alpha);
-        const Lanes ic = ddot(F, F), jm = det(F) - alpha, rest = 1.0 - alpha;
+        // Written in H = F - I so that no O(lambda) constants cancel near rest:
+        // Ic - 3 = 2 tr H + |H|^2, J - 1 = tr H + i2(H) + det H,
+        // (J - a)^2 - (1 - a)^2 = (J - 1)(J - 1 + 2 (1 - a)).
+        const Mat3L H = add_diagonal(F, splat(-1.0));
+        const Lanes tr = trace(H), hh = ddot(H, H);
+        Lanes h2 = Lanes{};  // tr(H H)
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) h2 += H.m[i][j] * H.m[j][i];
+        const Lanes ic3 = 2.0 * tr + hh, j1 = tr + 0.5 * (tr * tr - h2) + det(H);
         Lanes logs;
-        for (int k = 0; k < kLanes; ++k) logs[k] = std::log((ic[k] + 1.0) / 4.0);
-        return 0.5 * m * (ic - 3.0) + 0.5 * l * (jm * jm - rest * rest) - 0.5 * m * logs;
+        for (int k = 0; k < kLanes; ++k) logs[k] = std::log1p(0.25 * ic3[k]);
+        return 0.5 * m * (ic3 - logs) + 0.5 * l * j1 * (j1 + 2.0 * (1.0 - alpha));
     }
 };
 

@@ -1,5 +1,9 @@
 #include "model/body.hpp"
 
+#include "mesh/io/mesh_io.hpp"
+
+#include <cmath>
+
 namespace sh {
 
 Body::Body(IntegrationSettings s, vec<double> rest_positions) : settings(s), x(std::move(rest_positions)) {
@@ -25,7 +29,20 @@ void Body::update_inverse_mass() {
         inverse_mass[i] = (mass[i] > 0.0 && !kinematic[i]) ? 1.0 / mass[i] : 0.0;
 }
 
+void Body::write_vtu(const std::string& path) const {
+    VtuFrame frame;
+    frame.points = x.data();
+    frame.point_count = node_count();
+    frame.cells = element_nodes();
+    frame.cell_count = element_count();
+    frame.nodes_per_cell = nodes_per_element();
+    frame.point_vectors = v.data();
+    frame.point_vectors_name = "velocity";
+    sh::write_vtu(path, frame);
+}
+
 double Body::critical_dt() const {
+    if (settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER) return INFINITY;  // unconditionally stable
     // Stability limits on the imaginary axis relative to leapfrog's 2/omega: RK4 reaches
     // 2*sqrt(2)/omega. Forward Euler and RK2 have no undamped stable step at all (their energy
     // grows at every dt); they get the leapfrog limit, beyond which growth is explosive.

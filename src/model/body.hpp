@@ -11,10 +11,13 @@
 
 namespace sh {
 
+class SparseSystem;
+
 /// Per-body integration settings shared by FEM and mass-spring bodies.
 struct IntegrationSettings {
     sh_integrator integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
     sh_unstable_policy on_unstable = SH_UNSTABLE_SUBSTEP;
+    sh_implicit_settings implicit{};   ///< read for SH_INTEGRATOR_IMPLICIT_EULER
     double damping_mass = 0.0;   ///< alpha (1/s)
     double runaway_speed = 1e4;  ///< m/s
 };
@@ -46,14 +49,26 @@ public:
     /// Largest stable step of an undamped leapfrog step, 2 / omega_max, at state x (s).
     virtual double stable_step(const double* x) const = 0;
 
+    /// Adds stiffness_scale * K(x) + damping_scale * D(x) into system: K = -df/dx the tangent
+    /// stiffness with each element block projected to positive semi-definite, D = -df/dv the
+    /// internal damping (stiffness-proportional or dashpots).
+    virtual void add_tangent(const double* x, double stiffness_scale, double damping_scale,
+                             SparseSystem& system) const = 0;
+
+    /// Element connectivity: element_count() x nodes_per_element() node indices.
+    virtual const int32_t* element_nodes() const = 0;
+
+    /// 4 for tets, 2 for springs.
+    virtual int nodes_per_element() const = 0;
+
     /// Tets or springs.
     virtual int32_t element_count() const = 0;
 
     /// True for FEM bodies.
     virtual bool is_fem() const = 0;
 
-    /// Writes the current shape as .vtu.
-    virtual void write_vtu(const std::string& path) const = 0;
+    /// Writes the current shape (element cells, velocity point data) as .vtu.
+    void write_vtu(const std::string& path) const;
 
     /// Critical step of this body's integrator at the current state (s).
     double critical_dt() const;

@@ -3,7 +3,6 @@
 #include "core/error.hpp"
 #include "material/material_params.hpp"
 #include "material/tet_materials.hpp"
-#include "mesh/io/mesh_io.hpp"
 #include "model/fem_kernel.hpp"
 
 #include <Eigen/Dense>
@@ -180,16 +179,5 @@ double FemBody::elastic_energy(const double* xs) const {
 
 double FemBody::stable_step(const double*) const { return stable_step_; }
 
-void FemBody::write_vtu(const std::string& path) const {
-    VtuFrame frame;
-    frame.points = x.data();
-    frame.point_count = node_count();
-    frame.cells = tets_.data();
-    frame.cell_count = element_count();
-    frame.nodes_per_cell = 4;
-    frame.point_vectors = v.data();
-    frame.point_vectors_name = "velocity";
-    sh::write_vtu(path, frame);
-}
 
 }  // namespace sh

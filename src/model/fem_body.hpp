@@ -21,9 +21,12 @@ public:
     void add_internal_forces(const double* x, const double* v, double* f) const override;
     double elastic_energy(const double* x) const override;
     double stable_step(const double* x) const override;
+    void add_tangent(const double* x, double stiffness_scale, double damping_scale,
+                     SparseSystem& system) const override;
+    const int32_t* element_nodes() const override { return tets_.data(); }
+    int nodes_per_element() const override { return 4; }
     int32_t element_count() const override { return static_cast<int32_t>(volume_.size()); }
     bool is_fem() const override { return true; }
-    void write_vtu(const std::string& path) const override;
 
 private:
     /// Adopts materials (one per tet): masses, blocks and the stable step, all or nothing.

@@ -1,7 +1,7 @@
 #include "model/spring_body.hpp"
 
 #include "core/error.hpp"
-#include "mesh/io/mesh_io.hpp"
+#include "solver/sparse_system.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -101,16 +101,31 @@ double SpringBody::stable_step(const double* xs) const {
     return 2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi);
 }
 
-void SpringBody::write_vtu(const std::string& path) const {
-    VtuFrame frame;
-    frame.points = x.data();
-    frame.point_count = node_count();
-    frame.cells = springs_.data();
-    frame.cell_count = element_count();
-    frame.nodes_per_cell = 2;
-    frame.point_vectors = v.data();
-    frame.point_vectors_name = "velocity";
-    sh::write_vtu(path, frame);
+void SpringBody::add_tangent(const double* xs, double stiffness_scale, double damping_scale, SparseSystem& system) const {
+    // Spring block B = k_t n n^T + (T/l)(I - n n^T), with k_t and T/l clamped at zero (a
+    // compressed spring's negative geometric stiffness is dropped so B stays semi-definite);
+    // dashpot block c n n^T. The element matrix is [B, -B; -B, B].
+    for (size_t s = 0; s < rest_length_.size(); ++s) {
+        const size_t a = static_cast<size_t>(springs_[2 * s]), b = static_cast<size_t>(springs_[2 * s + 1]);
+        double n[3], l2 = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            n[k] = xs[3 * b + k] - xs[3 * a + k];
+            l2 += n[k] * n[k];
+        }
+        const double l = std::sqrt(l2), l0 = rest_length_[s];
+        if (!(l > 0.0)) continue;
+        for (double& c : n) c /= l;
+        const double axial = stiffness_scale * std::max(law_.stiffness(l, l0), 0.0) + damping_scale * law_.damping();
+        const double transverse = stiffness_scale * std::max(law_.tension(l, l0) / l, 0.0);
+        double ke[36];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+                const double block = axial * n[i] * n[j] + transverse * ((i == j ? 1.0 : 0.0) - n[i] * n[j]);
+                ke[6 * i + j] = ke[6 * (i + 3) + j + 3] = block;
+                ke[6 * i + j + 3] = ke[6 * (i + 3) + j] = -block;
+            }
+        system.add_element(s, ke, 1.0);
+    }
 }
 
 }  // namespace sh

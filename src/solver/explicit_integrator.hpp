@@ -11,10 +11,18 @@ namespace sh {
 /// What step_explicit did.
 struct BodyStepResult {
     bool stable = true;       ///< false: the body was left exactly as before the call
+    sh_status status = SH_OK; ///< why it was not stable (SH_ERR_UNSTABLE, _SOLVER, _NOT_CONVERGED)
+    const char* reason = "";  ///< static text for the message
     bool rejected = false;    ///< dt exceeded dt_crit under SH_UNSTABLE_REJECT
     int32_t substeps = 1;     ///< sub-steps taken
     double dt_critical = 0.0; ///< the body's critical step at the start (s)
+    int32_t newton_iterations = 0;  ///< implicit: Newton iterations taken
+    int32_t linear_iterations = 0;  ///< implicit: linear-solver iterations (1 per direct solve)
+    double newton_residual = 0.0;   ///< implicit: final relative residual (-1 if not measured)
+    double factorize_seconds = 0.0; ///< implicit: time in factorisations (s)
+    double solve_seconds = 0.0;     ///< implicit: time in solves (s)
 };
+
 
 /// Advances body by dt (s) under gravity (m/s^2). Allocation-free.
 BodyStepResult step_explicit(Body& body, double dt, const double gravity[3]);

@@ -2,6 +2,9 @@
 
 #include "core/error.hpp"
 #include "solver/explicit_integrator.hpp"
+#include "solver/implicit_integrator.hpp"
+#include "solver/static_solver.hpp"
+#include "solver/step_support.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -31,7 +34,10 @@ World::World(const sh_world_def& def) {
 }
 
 World::~World() {
-    for (Slot& slot : slots_) sh::destroy(slot.body);
+    for (Slot& slot : slots_) {
+        sh::destroy(slot.body);
+        sh::destroy(slot.implicit);
+    }
 }
 
 sh_body_id World::add_body(Body* body) {
@@ -53,7 +59,7 @@ sh_body_id World::add_body(Body* body) {
     Slot& slot = slots_[index];
     slot.body = body;
     slot.generation = next_generation();
-    return (static_cast<uint64_t>(slot.generation) << 32) | (static_cast<uint64_t>(index) + 1);
+    return id_of(index);
 }
 
 bool World::is_valid(sh_body_id id) const {
@@ -76,7 +82,9 @@ void World::remove_body(sh_body_id id) {
     const uint32_t index = slot_of(id);
     free_slots_.push_back(index);  // within the capacity reserved in add_body
     sh::destroy(slots_[index].body);
+    sh::destroy(slots_[index].implicit);
     slots_[index].body = nullptr;
+    slots_[index].implicit = nullptr;
 }
 
 void World::step(double dt, sh_step_report* report) {
@@ -85,23 +93,32 @@ void World::step(double dt, sh_step_report* report) {
     sh_step_report r{};
     r.substeps = 1;
     r.dt_critical = INFINITY;
-    sh_body_id first_unstable = SH_NULL_BODY;
-    double first_unstable_dt_crit = 0.0;
-    bool first_unstable_rejected = false;
+    sh_body_id first_failed = SH_NULL_BODY;
+    BodyStepResult first_failure;
     for (size_t index = 0; index < slots_.size(); ++index) {
-        Body* body = slots_[index].body;
-        if (!body) continue;
-        const BodyStepResult result = step_explicit(*body, dt, gravity);
+        Slot& slot = slots_[index];
+        if (!slot.body) continue;
+        BodyStepResult result;
+        if (slot.body->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER) {
+            if (!slot.implicit) slot.implicit = sh::create<ImplicitState>();
+            result = step_implicit(*slot.body, *slot.implicit, dt, gravity);
+        } else {
+            result = step_explicit(*slot.body, dt, gravity);
+        }
         r.dt_critical = std::min(r.dt_critical, result.dt_critical);
         r.substeps = std::max(r.substeps, result.substeps);
+        r.newton_iterations = std::max(r.newton_iterations, result.newton_iterations);
+        r.linear_iterations += result.linear_iterations;
+        r.newton_residual = std::max(r.newton_residual, result.newton_residual);
+        r.factorize_seconds += result.factorize_seconds;
+        r.solve_seconds += result.solve_seconds;
         if (result.substeps > 1) r.warnings |= 1u << SH_WARN_SUBSTEPPED;
         if (!result.stable) {
             r.warnings |= 1u << SH_WARN_UNSTABLE;
             ++r.unstable_body_count;
-            if (first_unstable == SH_NULL_BODY) {
-                first_unstable = (static_cast<uint64_t>(slots_[index].generation) << 32) | (index + 1);
-                first_unstable_dt_crit = result.dt_critical;
-                first_unstable_rejected = result.rejected;
+            if (first_failed == SH_NULL_BODY) {
+                first_failed = id_of(index);
+                first_failure = result;
             }
         }
     }
@@ -124,18 +141,38 @@ void World::step(double dt, sh_step_report* report) {
         r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         *report = r;
     }
-    if (first_unstable != SH_NULL_BODY) {
-        if (first_unstable_rejected)
-            throw Error(SH_ERR_UNSTABLE,
-                        format("body 0x%llx: dt = %g s exceeds its critical step %g s (policy: reject); %d "
-                               "body(ies) left unchanged",
-                               static_cast<unsigned long long>(first_unstable), dt, first_unstable_dt_crit,
-                               r.unstable_body_count));
-        throw Error(SH_ERR_UNSTABLE,
-                    format("body 0x%llx: the state became non-finite or exceeded the runaway speed; rolled back "
-                           "(%d body(ies) unstable)",
-                           static_cast<unsigned long long>(first_unstable), r.unstable_body_count));
+    if (first_failed == SH_NULL_BODY) return;
+    const unsigned long long id = static_cast<unsigned long long>(first_failed);
+    if (first_failure.rejected)
+        throw Error(SH_ERR_UNSTABLE, format("body 0x%llx: dt = %g s exceeds its critical step %g s (policy: reject); "
+                                            "%d body(ies) left unchanged",
+                                            id, dt, first_failure.dt_critical, r.unstable_body_count));
+    const sh_status status = first_failure.status == SH_OK ? SH_ERR_UNSTABLE : first_failure.status;
+    const char* reason = first_failure.reason[0] ? first_failure.reason
+                                                 : "the state became non-finite or exceeded the runaway speed; rolled back";
+    throw Error(status, format("body 0x%llx: %s (%d body(ies) left as before the step)", id, reason, r.unstable_body_count));
+}
+
+void World::solve_static(const sh_static_def& def, sh_static_report* report) {
+    const auto start = std::chrono::steady_clock::now();
+    sh_static_report r{};
+    for (Slot& slot : slots_)
+        if (slot.body) save_start_state(*slot.body);
+    try {
+        for (Slot& slot : slots_)
+            if (slot.body) solve_static_body(*slot.body, gravity, def, r);
+    } catch (...) {
+        for (Slot& slot : slots_)
+            if (slot.body) restore_start_state(*slot.body);
+        throw;
     }
+    r.converged = 1;
+    r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (report) *report = r;
+}
+
+sh_body_id World::id_of(size_t index) const {
+    return (static_cast<uint64_t>(slots_[index].generation) << 32) | (static_cast<uint64_t>(index) + 1);
 }
 
 }  // namespace sh

@@ -10,6 +10,8 @@
 
 namespace sh {
 
+struct ImplicitState;
+
 /// The simulation world of the C API's sh_world.
 class World {
 public:
@@ -34,14 +36,20 @@ public:
     /// filling report and advancing the stable bodies) if any body was rejected or rolled back.
     void step(double dt, sh_step_report* report);
 
+    /// Moves every body to static equilibrium (see sh_world_solve_static); on failure every
+    /// body is restored and the error rethrown.
+    void solve_static(const sh_static_def& def, sh_static_report* report);
+
     double gravity[3];
     uint64_t warnings[SH_WARN_COUNT] = {};
 
 private:
     struct Slot {
         Body* body = nullptr;
+        ImplicitState* implicit = nullptr;  ///< built on the first implicit step
         uint32_t generation = 0;
     };
+    sh_body_id id_of(size_t index) const;
     vec<Slot> slots_;
     vec<uint32_t> free_slots_;
 };

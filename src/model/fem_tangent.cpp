@@ -1,0 +1,113 @@
+// Tangent stiffness of FEM bodies for the implicit and static solvers:
+// K_e = V0 G^T C G with C = dP/dF (9x9, from each material's differential on the unit basis of F)
+// and G the map from nodal displacements to F (dF_kj / dx_ak = g_a[j], g_a the shape-function
+// gradients). For StVK and neo-Hookean, C is projected to positive semi-definite per element.
+#include "model/fem_body.hpp"
+
+#include "material/material_params.hpp"
+#include "material/tet_materials.hpp"
+#include "solver/sparse_system.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+
+namespace sh {
+namespace {
+
+using Matrix9 = Eigen::Matrix<double, 9, 9>;
+
+// dP/dF per lane of a batch of elements of one material model.
+template <class Material>
+void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, Matrix9 (&C)[kLanes]) {
+    typename Material::State state;
+    Material::stress(F, lambda, mu, state);
+    for (int q = 0; q < 9; ++q) {
+        Mat3L dF{};
+        dF.m[q / 3][q % 3] = splat(1.0);
+        const Mat3L dP = Material::differential(F, state, dF, lambda, mu);
+        for (int l = 0; l < kLanes; ++l)
+            for (int p = 0; p < 9; ++p) C[l](p, q) = dP.m[p / 3][p % 3][l];
+    }
+}
+
+void project_positive(Matrix9& c) {
+    const Eigen::SelfAdjointEigenSolver<Matrix9> eigen(c);
+    if (eigen.eigenvalues()(0) >= 0.0) return;
+    c = eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+}  // namespace
+
+void FemBody::add_tangent(const double* xs, double stiffness_scale, double damping_scale, SparseSystem& system) const {
+    const double scale = stiffness_scale + damping_scale * damping_stiffness_;  // D = beta K
+    if (scale == 0.0) return;
+    const size_t tet_count = volume_.size();
+
+    auto process = [&](int model, const int32_t* members, int count) {
+        Mat3L F = identity_lanes();
+        Lanes lambda = splat(1.0), mu = splat(1.0);
+        for (int l = 0; l < count; ++l) {
+            const size_t t = static_cast<size_t>(members[l]);
+            const int32_t* tet = &tets_[4 * t];
+            const double* bm = &inverse_rest_[9 * t];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) {
+                    double f = 0.0;
+                    for (int a = 0; a < 3; ++a) f += (xs[3 * tet[a + 1] + i] - xs[3 * tet[0] + i]) * bm[3 * a + j];
+                    F.m[i][j][l] = f;
+                }
+            lambda[l] = lame_lambda(materials_[t]);
+            mu[l] = lame_mu(materials_[t]);
+        }
+        Matrix9 C[kLanes];
+        switch (model) {
+            case SH_MATERIAL_LINEAR: stress_derivatives<LinearMaterial>(F, lambda, mu, C); break;
+            case SH_MATERIAL_STVK: stress_derivatives<StvkMaterial>(F, lambda, mu, C); break;
+            case SH_MATERIAL_COROTATIONAL: stress_derivatives<CorotationalMaterial>(F, lambda, mu, C); break;
+            default: stress_derivatives<NeoHookeanMaterial>(F, lambda, mu, C); break;
+        }
+        for (int l = 0; l < count; ++l) {
+            const size_t t = static_cast<size_t>(members[l]);
+            Matrix9 c = 0.5 * (C[l] + C[l].transpose());
+            if (model == SH_MATERIAL_STVK || model == SH_MATERIAL_NEOHOOKEAN) project_positive(c);
+            const double* bm = &inverse_rest_[9 * t];
+            double g[4][3];
+            for (int j = 0; j < 3; ++j) {
+                g[0][j] = 0.0;
+                for (int a = 1; a < 4; ++a) {
+                    g[a][j] = bm[3 * (a - 1) + j];
+                    g[0][j] -= g[a][j];
+                }
+            }
+            // CG(q, (b, l)) = sum_m C(q, (l, m)) g_b[m]; K((a, k), (b, l)) = V0 sum_j g_a[j] CG((k, j), (b, l)).
+            double cg[9][12];
+            for (int q = 0; q < 9; ++q)
+                for (int b = 0; b < 4; ++b)
+                    for (int lc = 0; lc < 3; ++lc)
+                        cg[q][3 * b + lc] = c(q, 3 * lc) * g[b][0] + c(q, 3 * lc + 1) * g[b][1] + c(q, 3 * lc + 2) * g[b][2];
+            double ke[144];
+            for (int a = 0; a < 4; ++a)
+                for (int k = 0; k < 3; ++k)
+                    for (int col = 0; col < 12; ++col)
+                        ke[12 * (3 * a + k) + col] = volume_[t] * (g[a][0] * cg[3 * k][col] + g[a][1] * cg[3 * k + 1][col] +
+                                                                   g[a][2] * cg[3 * k + 2][col]);
+            system.add_element(t, ke, scale);
+        }
+    };
+
+    int32_t batch[4][kLanes];
+    int filled[4] = {0, 0, 0, 0};
+    for (size_t t = 0; t < tet_count; ++t) {
+        const int model = materials_[t].model;
+        batch[model][filled[model]++] = static_cast<int32_t>(t);
+        if (filled[model] == kLanes) {
+            process(model, batch[model], kLanes);
+            filled[model] = 0;
+        }
+    }
+    for (int model = 0; model < 4; ++model)
+        if (filled[model] > 0) process(model, batch[model], filled[model]);
+}
+
+}  // namespace sh

@@ -1,0 +1,162 @@
+#include "solver/implicit_integrator.hpp"
+
+#include "core/error.hpp"
+#include "solver/step_support.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace sh {
+namespace {
+
+// Speeds below this (m/s) count as rest when judging a Newton correction negligible.
+constexpr double kSpeedFloor = 1e-9;
+
+LinearSolverKind solver_kind(sh_linear_solver kind) {
+    switch (kind) {
+        case SH_LINEAR_SOLVER_CHOLMOD: return LinearSolverKind::Cholmod;
+        case SH_LINEAR_SOLVER_LDLT: return LinearSolverKind::Ldlt;
+        case SH_LINEAR_SOLVER_CG: return LinearSolverKind::ConjugateGradient;
+        default: return (sh_build_features() & SH_FEATURE_CHOLMOD) ? LinearSolverKind::Cholmod : LinearSolverKind::Ldlt;
+    }
+}
+
+double norm(const vec<double>& a) {
+    double s = 0.0;
+    for (double v : a) s += v * v;
+    return std::sqrt(s);
+}
+
+}  // namespace
+
+int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_implicit_settings& s) {
+    const int32_t n = body.node_count();
+    bool changed = state.free_count < 0;
+    int32_t free_count = 0;
+    if (!changed)
+        for (int32_t i = 0; i < n && !changed; ++i) changed = (state.free_index[static_cast<size_t>(i)] >= 0) != body.is_free(i);
+    if (!changed) return 3 * state.free_count;
+
+    vec<int32_t> free_index(static_cast<size_t>(n), -1);
+    for (int32_t i = 0; i < n; ++i)
+        if (body.is_free(i)) free_index[static_cast<size_t>(i)] = free_count++;
+    SparseSystem system;
+    system.build_pattern(body.element_nodes(), static_cast<size_t>(body.element_count()), body.nodes_per_element(),
+                         free_index.data(), n, free_count);
+    LinearSolverPtr solver = make_linear_solver(solver_kind(s.linear_solver), s.cg_tolerance, s.cg_max_iterations);
+    if (free_count > 0) solver->analyze(system);
+    const size_t dofs = 3 * static_cast<size_t>(free_count);
+    vec<double> residual(dofs), delta(dofs, 0.0), diagonal(dofs);
+    // Commit only once everything is built.
+    state.system = std::move(system);
+    state.solver = std::move(solver);
+    state.free_index.swap(free_index);
+    state.residual.swap(residual);
+    state.delta.swap(delta);
+    state.diagonal.swap(diagonal);
+    state.free_count = free_count;
+    return 3 * free_count;
+}
+
+BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double g[3]) {
+    BodyStepResult result;
+    result.dt_critical = INFINITY;
+    const sh_implicit_settings& s = body.settings.implicit;
+    const int32_t dofs = prepare_implicit_state(body, state, s);
+    const vec<int32_t>& global = state.system.dof_to_global();
+    IntegratorWorkspace& w = body.workspace;
+    const size_t n3 = body.x.size();
+
+    save_start_state(body);
+    begin_kinematic_motion(body, dt);
+    const bool per_node = !body.node_damping.empty();
+    for (int32_t d = 0; d < dofs; ++d) {
+        const size_t node = static_cast<size_t>(global[static_cast<size_t>(d)]) / 3;
+        const double c = body.settings.damping_mass + (per_node ? body.node_damping[node] : 0.0);
+        state.diagonal[static_cast<size_t>(d)] = body.mass[node] * (1.0 + dt * c);
+    }
+
+    // Newton on g(v) = M (v - v0) - dt F(x0 + dt v, v) over the free DOFs, from v = v0.
+    const int max_iterations = std::max(1, s.newton_max_iterations);
+    double* a = w.a[0].data();
+    double residual0 = 0.0;
+    double applied_load = 0.0;  // |f_ext + m g| over the free DOFs (N)
+    for (int32_t d = 0; d < dofs; ++d) {
+        const size_t j = static_cast<size_t>(global[static_cast<size_t>(d)]);
+        const double load = body.external_force[j] + body.mass[j / 3] * g[j % 3];
+        applied_load += load * load;
+    }
+    applied_load = std::sqrt(applied_load);
+    const double gravity_norm = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    result.newton_residual = -1.0;
+    bool converged = max_iterations == 1;
+    for (int iteration = 0;; ++iteration) {
+        for (size_t j = 0; j < n3; ++j) body.x[j] = w.x0[j] + dt * body.v[j];
+        compute_accelerations(body, body.x.data(), body.v.data(), g, a);
+        for (int32_t d = 0; d < dofs; ++d) {
+            const size_t j = static_cast<size_t>(global[static_cast<size_t>(d)]);
+            state.residual[static_cast<size_t>(d)] = body.mass[j / 3] * (body.v[j] - w.v0[j] - dt * a[j]);
+        }
+        const double r = norm(state.residual);
+        if (iteration == 0) residual0 = std::max(r, dt * applied_load);
+        if (iteration > 0) result.newton_residual = residual0 > 0.0 ? r / residual0 : 0.0;
+        // Converged: small against the first residual or the applied load's impulse.
+        if (residual0 == 0.0 || (iteration > 0 && r <= s.newton_tolerance * residual0)) {
+            converged = true;
+            break;
+        }
+        if (iteration == max_iterations) break;
+
+        state.system.clear_values();
+        body.add_tangent(body.x.data(), dt * dt, dt, state.system);
+        state.system.add_diagonal(state.diagonal.data(), 1.0);
+        try {
+            state.solver->factorize(state.system);
+            for (double& r_d : state.residual) r_d = -r_d;
+            result.linear_iterations += state.solver->solve(state.system, state.residual.data(), state.delta.data());
+        } catch (const Error& e) {
+            result.factorize_seconds += state.solver->factorize_seconds;
+            restore_start_state(body);
+            result.stable = false;
+            result.status = e.status();
+            result.reason = e.status() == SH_ERR_NOT_CONVERGED ? "the linear solver did not converge"
+                                                                 : "the sparse factorisation failed (matrix not positive definite)";
+            return result;
+        }
+        result.factorize_seconds += state.solver->factorize_seconds;
+        result.solve_seconds += state.solver->solve_seconds;
+        ++result.newton_iterations;
+        double largest_change = 0.0, largest_speed = 0.0;
+        for (int32_t d = 0; d < dofs; ++d) {
+            double& v = body.v[static_cast<size_t>(global[static_cast<size_t>(d)])];
+            v += state.delta[static_cast<size_t>(d)];
+            largest_change = std::max(largest_change, std::fabs(state.delta[static_cast<size_t>(d)]));
+            largest_speed = std::max(largest_speed, std::fabs(v));
+        }
+        // Near equilibrium of a stiff body the residual is cancellation noise of large element
+        // forces, so a negligible velocity correction also ends the iteration.
+        const double speed_scale = std::max({largest_speed, dt * gravity_norm, kSpeedFloor});
+        const bool negligible = iteration > 0 && largest_change <= s.newton_tolerance * speed_scale;
+        if (max_iterations == 1 || negligible) {
+            for (size_t j = 0; j < n3; ++j) body.x[j] = w.x0[j] + dt * body.v[j];
+            converged = true;
+            break;
+        }
+    }
+    end_kinematic_motion(body);
+    if (!converged) {
+        restore_start_state(body);
+        result.stable = false;
+        result.status = SH_ERR_NOT_CONVERGED;
+        result.reason = "Newton iterations did not reach newton_tolerance";
+    } else if (!body_state_is_sane(body)) {
+        restore_start_state(body);
+        result.stable = false;
+        result.status = SH_ERR_UNSTABLE;
+        result.reason = "the state became non-finite or exceeded the runaway speed; rolled back";
+    }
+    return result;
+}
+
+}  // namespace sh

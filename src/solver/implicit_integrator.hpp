@@ -1,0 +1,33 @@
+// Backward (implicit) Euler for one body: Newton iterations on the end-of-step velocity,
+// starting from the current one (one iteration = the linearised Baraff-Witkin step), with the
+// sparse system and linear solver kept across steps while the set of free nodes is unchanged.
+#pragma once
+
+#include "model/body.hpp"
+#include "solver/explicit_integrator.hpp"
+#include "solver/linear_solver.hpp"
+#include "solver/sparse_system.hpp"
+
+namespace sh {
+
+/// Per-body state of the implicit integrator: built on first use, kept across steps.
+struct ImplicitState {
+    SparseSystem system;
+    LinearSolverPtr solver;
+    vec<int32_t> free_index;    ///< per node: index among free nodes, or -1
+    vec<double> residual;       ///< per free DOF
+    vec<double> delta;          ///< per free DOF (CG warm start)
+    vec<double> diagonal;       ///< per free DOF: m (1 + h (alpha + c_i))
+    int32_t free_count = -1;    ///< -1: pattern not built yet
+};
+
+/// Advances body by dt with backward Euler. On a failed factorisation (SH_ERR_SOLVER), a
+/// Newton loop that misses its tolerance (SH_ERR_NOT_CONVERGED) or a non-finite or runaway
+/// state (SH_ERR_UNSTABLE) the body is restored and result.status says why.
+BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double gravity[3]);
+
+/// Rebuilds state's pattern, solver and symbolic analysis if body's free nodes changed since
+/// the last call. Returns the number of free DOFs.
+int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_implicit_settings& settings);
+
+}  // namespace sh

@@ -1,0 +1,25 @@
+// Pieces every time-stepping scheme shares: saving and restoring the start state, moving
+// fixed and prescribed nodes, and the sanity check that triggers a rollback.
+#pragma once
+
+#include "model/body.hpp"
+
+namespace sh {
+
+/// Copies x and v into the workspace (x0, v0).
+void save_start_state(Body& body);
+
+/// Restores x and v from the workspace.
+void restore_start_state(Body& body);
+
+/// Gives fixed and prescribed nodes the velocity that takes them to their targets in dt.
+void begin_kinematic_motion(Body& body, double dt);
+
+/// Puts fixed and prescribed nodes exactly on their targets with zero velocity; zero velocity
+/// for nodes outside the dynamics (orphans).
+void end_kinematic_motion(Body& body);
+
+/// True if every position is finite and no node is faster than the body's runaway speed.
+bool body_state_is_sane(const Body& body);
+
+}  // namespace sh

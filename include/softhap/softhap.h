@@ -91,7 +91,9 @@ typedef enum sh_warning {
     SH_WARN_INVERTED = 2,       /**< an element had det F <= 0 during a step */
     SH_WARN_CAPACITY = 3,       /**< a fixed capacity clamped a result */
     SH_WARN_FORCE_CLAMPED = 4,  /**< an output force was clamped */
-    SH_WARN_COUNT = 5           /**< number of warning kinds */
+    SH_WARN_LOCKING = 5,        /**< a material with nu > 0.45 was given to linear tets, which
+                                     lock (are too stiff) when nearly incompressible */
+    SH_WARN_COUNT = 6           /**< number of warning kinds */
 } sh_warning;
 
 /* ------------------------------------------------------------------------------------------ */

@@ -50,6 +50,7 @@ SH_API sh_status sh_body_set_material(sh_world* world, sh_body_id body, const in
         SH_REQUIRE(element_count >= 0, SH_ERR_INVALID_ARGUMENT, "element_count = %d, must be >= 0", element_count);
         if (element_count > 0) capi::require_pointer(elements, "elements");
         static_cast<FemBody&>(b).set_material(elements, element_count, *material);
+        if (material->poisson > kLockingPoisson && element_count > 0) ++capi::world_of(world).warnings[SH_WARN_LOCKING];
     });
 }
 

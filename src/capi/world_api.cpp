@@ -182,6 +182,7 @@ SH_API sh_status sh_world_add_fem_body(sh_world* world, const sh_fem_body_def* d
         const IntegrationSettings settings =
             integration_settings(*def);
         *out_body = w.add_body(sh::create<FemBody>(mesh, def->material, settings, def->damping_stiffness));
+        if (def->material.poisson > kLockingPoisson) ++w.warnings[SH_WARN_LOCKING];
     });
 }
 

@@ -9,6 +9,9 @@ namespace sh {
 /// -1 < poisson < 0.5 and density > 0, all finite. context prefixes the message.
 void validate_material(const sh_material& material, const char* context);
 
+/// Poisson's ratio above which linear (4-node) tets lock: SH_WARN_LOCKING.
+constexpr double kLockingPoisson = 0.45;
+
 /// Lame lambda (Pa) of an isotropic material.
 double lame_lambda(const sh_material& material);
 

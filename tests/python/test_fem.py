@@ -487,3 +487,13 @@ def test_defaults_are_the_documented_c_defaults():
         np.testing.assert_array_equal(default.elastic_forces(), explicit.elastic_forces())
         expected, _ = uniaxial_forces("stvk", 3000.0, 0.45, 0.1)
         np.testing.assert_allclose(default.elastic_forces(), expected, rtol=1e-10)
+
+
+def test_nearly_incompressible_material_counts_a_locking_warning():
+    with softhap.World() as world:
+        world.add_fem_body(unit_tet_mesh(), poisson=0.45)
+        world.step(1e-3)
+        assert world.warnings["SH_WARN_LOCKING"] == 0
+        world.add_fem_body(unit_tet_mesh(), poisson=0.49)
+        world.step(1e-3)
+        assert world.warnings["SH_WARN_LOCKING"] >= 1

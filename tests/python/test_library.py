@@ -137,6 +137,7 @@ def test_status_names_and_strings():
         "SH_WARN_INVERTED",
         "SH_WARN_CAPACITY",
         "SH_WARN_FORCE_CLAMPED",
+        "SH_WARN_LOCKING",
     ]
 
 

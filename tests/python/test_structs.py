@@ -71,13 +71,16 @@ def test_field_offsets_match_c(c_layout, name):
 def test_sizes_computed_by_hand():
     # Independent of any compiler: the x86-64/aarch64 SysV layout worked out from the header.
     assert ctypes.sizeof(_lib.sh_world_def) == 32  # u32, pad 4, 3 doubles
-    assert ctypes.sizeof(_lib.sh_step_report) == 56
+    assert ctypes.sizeof(_lib.sh_step_report) == 88
     assert ctypes.sizeof(_lib.sh_mesh_info) == 88  # 7 int32, pad 4, 7 doubles
     assert ctypes.sizeof(_lib.sh_material) == 32
-    assert ctypes.sizeof(_lib.sh_fem_body_def) == 80
+    assert ctypes.sizeof(_lib.sh_fem_body_def) == 112  # 80 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_spring_params) == 72
-    assert ctypes.sizeof(_lib.sh_spring_body_def) == 160
+    assert ctypes.sizeof(_lib.sh_spring_body_def) == 192  # 160 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_body_info) == 32
+    assert ctypes.sizeof(_lib.sh_implicit_settings) == 32
+    assert ctypes.sizeof(_lib.sh_static_def) == 32
+    assert ctypes.sizeof(_lib.sh_static_report) == 16 + 8 + 64 * 8 + 8
     assert _lib.sh_spring_body_def.params.offset == 48
     assert _lib.sh_step_report.warnings.offset == 48
 
@@ -87,3 +90,40 @@ def test_every_header_function_is_declared():
     text = (INCLUDE_DIR / "softhap" / "softhap.h").read_text()
     declared = set(re.findall(r"SH_API\s+[^;(]*?\b(sh_\w+)\s*\(", text))
     assert declared == set(_lib.PROTOTYPES)
+
+
+def _python_constants():
+    """{C name: value} of every enum constant and macro the bindings mirror."""
+    constants = {"SH_VERSION": _lib.SH_VERSION, "SH_WARN_COUNT": _lib.SH_WARN_COUNT,
+                 "SH_STATIC_HISTORY": _lib.SH_STATIC_HISTORY}
+    for enum_class in (_lib.Status, _lib.WarningKind, _lib.FeatureKind):
+        constants.update({member.name: int(member) for member in enum_class})
+    for prefix, table in [
+        ("SH_INTEGRATOR_", _lib.INTEGRATORS),
+        ("SH_UNSTABLE_", _lib.UNSTABLE_POLICIES),
+        ("SH_MATERIAL_", _lib.MATERIAL_MODELS),
+        ("SH_SPRING_", _lib.SPRING_LAWS),
+        ("SH_LINEAR_SOLVER_", _lib.LINEAR_SOLVERS),
+    ]:
+        constants.update({prefix + name.upper(): value for name, value in table.items()})
+    return constants
+
+
+def test_constants_match_c(cc, tmp_path):
+    constants = _python_constants()
+    lines = ["#include <stdio.h>", '#include "softhap/softhap.h"', "int main(void) {"]
+    for name in constants:
+        lines.append('    printf("%s %%lld\\n", (long long)(%s));' % (name, name))
+    lines += ["    return 0;", "}"]
+    program = compile_c(cc, "\n".join(lines) + "\n", tmp_path / "constants")
+    output = subprocess.run([str(program)], capture_output=True, text=True, check=True).stdout
+    from_c = {name: int(value) for name, value in (line.split() for line in output.splitlines())}
+    assert from_c == constants
+
+
+def test_every_header_enum_constant_is_mirrored():
+    text = (INCLUDE_DIR / "softhap" / "softhap.h").read_text()
+    declared = set()
+    for body in re.findall(r"typedef enum \w+ \{(.*?)\}", text, flags=re.S):
+        declared.update(re.findall(r"^\s*(SH_[A-Z0-9_]+)\s*=", body, flags=re.M))
+    assert declared == set(_python_constants()) - {"SH_VERSION", "SH_STATIC_HISTORY"}

@@ -15,6 +15,7 @@ WARNING_NAMES = [
     "SH_WARN_INVERTED",
     "SH_WARN_CAPACITY",
     "SH_WARN_FORCE_CLAMPED",
+    "SH_WARN_LOCKING",
 ]
 
 
@@ -35,6 +36,8 @@ def test_empty_world_steps_and_reports():
         assert set(report) == {
             "wall_seconds", "substeps", "dt_critical", "kinetic_energy", "elastic_energy",
             "potential_energy", "warnings", "warning_bits", "unstable_body_count",
+            "newton_iterations", "linear_iterations", "newton_residual", "factorize_seconds",
+            "solve_seconds",
         }
         with pytest.raises(AttributeError):
             report.no_such_field

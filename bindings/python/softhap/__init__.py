@@ -18,7 +18,7 @@ from ._errors import Error, status_name
 from ._lib import SH_VERSION, FeatureKind, Status, WarningKind, version_string
 from ._loaded import lib as _c_library
 from ._loaded import status_string
-from ._record import BodyInfo, MeshInfo, StepReport
+from ._record import BodyInfo, MeshInfo, StaticReport, StepReport
 from .mesh import Mesh
 from .world import Body, World
 
@@ -49,6 +49,7 @@ __all__ = [
     "Mesh",
     "MeshInfo",
     "SH_VERSION",
+    "StaticReport",
     "Status",
     "StepReport",
     "WarningKind",

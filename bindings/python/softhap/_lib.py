@@ -72,9 +72,10 @@ class WarningKind(enum.IntEnum):
     SH_WARN_INVERTED = 2
     SH_WARN_CAPACITY = 3
     SH_WARN_FORCE_CLAMPED = 4
+    SH_WARN_LOCKING = 5
 
 
-SH_WARN_COUNT = 5
+SH_WARN_COUNT = 6
 
 
 class FeatureKind(enum.IntEnum):
@@ -89,7 +90,17 @@ INTEGRATORS = {
     "symplectic_euler": 1,
     "rk2": 2,
     "rk4": 3,
+    "implicit_euler": 4,
 }
+
+LINEAR_SOLVERS = {
+    "default": 0,
+    "cholmod": 1,
+    "ldlt": 2,
+    "cg": 3,
+}
+
+SH_STATIC_HISTORY = 64
 
 UNSTABLE_POLICIES = {
     "reject": 0,
@@ -154,6 +165,23 @@ class sh_step_report(Structure):
         ("potential_energy", c_double),
         ("warnings", c_uint32),
         ("unstable_body_count", c_int32),
+        ("newton_iterations", c_int32),
+        ("linear_iterations", c_int32),
+        ("newton_residual", c_double),
+        ("factorize_seconds", c_double),
+        ("solve_seconds", c_double),
+    ]
+
+
+class sh_implicit_settings(Structure):
+    """Mirror of struct sh_implicit_settings."""
+
+    _fields_ = [
+        ("linear_solver", c_int),
+        ("newton_max_iterations", c_int32),
+        ("newton_tolerance", c_double),
+        ("cg_tolerance", c_double),
+        ("cg_max_iterations", c_int32),
     ]
 
 
@@ -180,6 +208,7 @@ class sh_fem_body_def(Structure):
         ("damping_mass", c_double),
         ("damping_stiffness", c_double),
         ("runaway_speed", c_double),
+        ("implicit", sh_implicit_settings),
     ]
 
 
@@ -216,6 +245,7 @@ class sh_spring_body_def(Structure):
         ("on_unstable", c_int),
         ("damping_mass", c_double),
         ("runaway_speed", c_double),
+        ("implicit", sh_implicit_settings),
     ]
 
 
@@ -232,6 +262,32 @@ class sh_body_info(Structure):
     ]
 
 
+class sh_static_def(Structure):
+    """Mirror of struct sh_static_def."""
+
+    _fields_ = [
+        ("internal_init", c_uint32),
+        ("tolerance", c_double),
+        ("max_iterations", c_int32),
+        ("load_steps", c_int32),
+        ("linear_solver", c_int),
+    ]
+
+
+class sh_static_report(Structure):
+    """Mirror of struct sh_static_report."""
+
+    _fields_ = [
+        ("iterations", c_int32),
+        ("load_steps", c_int32),
+        ("converged", c_int32),
+        ("history_count", c_int32),
+        ("residual", c_double),
+        ("residual_history", c_double * SH_STATIC_HISTORY),
+        ("wall_seconds", c_double),
+    ]
+
+
 # Every struct the header declares that the bindings use, by C name (for the layout test).
 STRUCTS = {
     "sh_mesh_info": sh_mesh_info,
@@ -242,6 +298,9 @@ STRUCTS = {
     "sh_spring_params": sh_spring_params,
     "sh_spring_body_def": sh_spring_body_def,
     "sh_body_info": sh_body_info,
+    "sh_implicit_settings": sh_implicit_settings,
+    "sh_static_def": sh_static_def,
+    "sh_static_report": sh_static_report,
 }
 
 # ------------------------------------------------------------------------------------------------
@@ -304,6 +363,12 @@ PROTOTYPES = {
     "sh_body_get_elastic_forces": (_status, [_handle, sh_body_id, _pd, c_int64]),
     "sh_body_get_elastic_energy": (_status, [_handle, sh_body_id, _pd]),
     "sh_body_write_vtu": (_status, [_handle, sh_body_id, c_char_p]),
+    # static equilibrium
+    "sh_static_def_default": (None, [POINTER(sh_static_def)]),
+    "sh_world_solve_static": (
+        _status,
+        [_handle, POINTER(sh_static_def), POINTER(sh_static_report)],
+    ),
 }
 
 # ------------------------------------------------------------------------------------------------

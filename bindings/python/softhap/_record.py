@@ -37,6 +37,13 @@ class StepReport(Record):
 
     Fields: wall_seconds (s), substeps, dt_critical (s), kinetic_energy, elastic_energy,
     potential_energy (J), warnings (a frozenset of warning names raised in this step, e.g.
-    {"SH_WARN_SUBSTEPPED"}), warning_bits (the raw bit mask, bit 1 << sh_warning) and
-    unstable_body_count.
+    {"SH_WARN_SUBSTEPPED"}), warning_bits (the raw bit mask, bit 1 << sh_warning),
+    unstable_body_count, and for implicit bodies newton_iterations, linear_iterations,
+    newton_residual, factorize_seconds and solve_seconds (s).
     """
+
+
+class StaticReport(Record):
+    """What World.solve_static did (sh_static_report): iterations, load_steps, converged
+    (bool), residual (final largest relative residual), residual_history (array of the relative
+    residual after each iteration) and wall_seconds (s)."""

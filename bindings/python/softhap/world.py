@@ -8,6 +8,7 @@ from . import _arrays
 from ._errors import Error
 from ._lib import (
     INTEGRATORS,
+    LINEAR_SOLVERS,
     MATERIAL_MODELS,
     SH_WARN_COUNT,
     SPRING_LAWS,
@@ -18,11 +19,13 @@ from ._lib import (
     sh_body_info,
     sh_fem_body_def,
     sh_spring_body_def,
+    sh_static_def,
+    sh_static_report,
     sh_step_report,
     sh_world_def,
 )
 from ._loaded import check, closed_error, last_error_message, lib, status_string
-from ._record import BodyInfo, StepReport
+from ._record import BodyInfo, StaticReport, StepReport
 from .mesh import Mesh
 
 # Which sh_spring_params fields each law reads (damping is read by every law).
@@ -58,7 +61,39 @@ def _step_report(raw):
         warnings=_warning_names(raw.warnings),
         warning_bits=int(raw.warnings),
         unstable_body_count=raw.unstable_body_count,
+        newton_iterations=raw.newton_iterations,
+        linear_iterations=raw.linear_iterations,
+        newton_residual=raw.newton_residual,
+        factorize_seconds=raw.factorize_seconds,
+        solve_seconds=raw.solve_seconds,
     )
+
+
+def _static_report(raw):
+    count = max(0, min(int(raw.history_count), len(raw.residual_history)))
+    return StaticReport(
+        iterations=raw.iterations,
+        load_steps=raw.load_steps,
+        converged=bool(raw.converged),
+        residual=raw.residual,
+        residual_history=np.array(raw.residual_history[:count], dtype=np.float64),
+        wall_seconds=raw.wall_seconds,
+    )
+
+
+def _set_implicit(settings, linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
+                  cg_max_iterations):
+    """Fill an sh_implicit_settings from keyword arguments (None keeps the C default)."""
+    if linear_solver is not None:
+        settings.linear_solver = _choose(linear_solver, LINEAR_SOLVERS, "linear_solver")
+    if newton_max_iterations is not None:
+        settings.newton_max_iterations = _arrays.count(newton_max_iterations, "newton_max_iterations")
+    if newton_tolerance is not None:
+        settings.newton_tolerance = float(newton_tolerance)
+    if cg_tolerance is not None:
+        settings.cg_tolerance = float(cg_tolerance)
+    if cg_max_iterations is not None:
+        settings.cg_max_iterations = _arrays.count(cg_max_iterations, "cg_max_iterations")
 
 
 def _default_material():
@@ -174,6 +209,39 @@ class World:
         report = _step_report(raw) if status == Status.SH_ERR_UNSTABLE else None
         raise Error(status, message, "sh_world_step", report=report)
 
+    def solve_static(self, tolerance=None, max_iterations=None, load_steps=None, linear_solver=None):
+        """Move every body to static equilibrium under gravity and its external forces, fixed
+        and prescribed nodes held (sh_world_solve_static); velocities become zero. Returns a
+        StaticReport: iterations, load_steps, converged, residual, residual_history (array),
+        wall_seconds.
+
+        None keeps the C default of sh_static_def_default: tolerance 1e-10 (relative residual),
+        max_iterations 50 (Newton iterations per load step), load_steps 1, linear_solver
+        "default". A body with no fixed node raises softhap.Error SH_ERR_SOLVER; an unreached
+        tolerance raises SH_ERR_NOT_CONVERGED, with the report as ``err.report`` if the library
+        filled it (else None). On any error every body keeps its previous state.
+        """
+        handle = self._require_handle("sh_world_solve_static")
+        definition = sh_static_def()
+        lib.sh_static_def_default(ctypes.byref(definition))
+        if tolerance is not None:
+            definition.tolerance = float(tolerance)
+        if max_iterations is not None:
+            definition.max_iterations = _arrays.count(max_iterations, "max_iterations")
+        if load_steps is not None:
+            definition.load_steps = _arrays.count(load_steps, "load_steps")
+        if linear_solver is not None:
+            definition.linear_solver = _choose(linear_solver, LINEAR_SOLVERS, "linear_solver")
+        raw = sh_static_report()
+        raw.iterations = -1  # sentinel: tells whether the library wrote the report
+        status = lib.sh_world_solve_static(handle, ctypes.byref(definition), ctypes.byref(raw))
+        if status == Status.SH_OK:
+            return _static_report(raw)
+        message = last_error_message() or status_string(status)
+        written = raw.iterations >= 0
+        report = _static_report(raw) if written and status == Status.SH_ERR_NOT_CONVERGED else None
+        raise Error(status, message, "sh_world_solve_static", report=report)
+
     # -- bodies ----------------------------------------------------------------------------
 
     def add_fem_body(
@@ -188,6 +256,11 @@ class World:
         damping_stiffness=None,
         on_unstable=None,
         runaway_speed=None,
+        linear_solver=None,
+        newton_max_iterations=None,
+        newton_tolerance=None,
+        cg_tolerance=None,
+        cg_max_iterations=None,
     ):
         """Add a tetrahedral FEM body whose rest shape is mesh (copied) and return its Body.
 
@@ -195,11 +268,16 @@ class World:
           model: "stvk" (default), "linear", "corotational" or "neohookean";
           young: Young's modulus (Pa), default 3000; poisson: Poisson's ratio, default 0.45;
           density: kg/m^3, default 1000;
-          integrator: "symplectic_euler" (default), "forward_euler", "rk2" or "rk4";
+          integrator: "symplectic_euler" (default), "forward_euler", "rk2", "rk4" or
+          "implicit_euler";
           damping_mass: Rayleigh alpha (1/s), default 0; damping_stiffness: Rayleigh beta (s),
           default 0;
           on_unstable: "substep" (default) or "reject" for steps above the critical step;
-          runaway_speed: a node faster than this (m/s) rolls the step back, default 1e4.
+          runaway_speed: a node faster than this (m/s) rolls the step back, default 1e4;
+          implicit_euler only (sh_implicit_settings): linear_solver "default" (CHOLMOD when
+          built in, else "ldlt"), "cholmod", "ldlt" or "cg"; newton_max_iterations (default 1:
+          one linearised solve per step); newton_tolerance (default 1e-6); cg_tolerance
+          (default 1e-8); cg_max_iterations (default 2000).
         Unknown names raise ValueError; invalid values raise softhap.Error
         (SH_ERR_INVALID_ARGUMENT).
         """
@@ -227,6 +305,8 @@ class World:
             definition.damping_stiffness = float(damping_stiffness)
         if runaway_speed is not None:
             definition.runaway_speed = float(runaway_speed)
+        _set_implicit(definition.implicit, linear_solver, newton_max_iterations, newton_tolerance,
+                      cg_tolerance, cg_max_iterations)
         body = sh_body_id()
         check(
             lib.sh_world_add_fem_body(handle, ctypes.byref(definition), ctypes.byref(body)),
@@ -251,6 +331,11 @@ class World:
         a=None,
         b=None,
         table=None,
+        linear_solver=None,
+        newton_max_iterations=None,
+        newton_tolerance=None,
+        cg_tolerance=None,
+        cg_max_iterations=None,
     ):
         """Add a mass-spring body and return its Body. Rest lengths are the initial lengths.
 
@@ -265,7 +350,8 @@ class World:
             "table": table, rows of (strain, force N), strain strictly increasing;
             every law also takes damping c (N s/m).
         mass: a scalar mass per node (kg, default 1e-3) or an array of n masses.
-        integrator, on_unstable, damping_mass (1/s), runaway_speed (m/s): as add_fem_body.
+        integrator, on_unstable, damping_mass (1/s), runaway_speed (m/s) and the implicit
+            settings (linear_solver, newton_max_iterations, ...): as add_fem_body.
         Unknown names raise ValueError; invalid values raise softhap.Error.
         """
         handle = self._require_handle("sh_world_add_spring_body")
@@ -330,6 +416,8 @@ class World:
             definition.damping_mass = float(damping_mass)
         if runaway_speed is not None:
             definition.runaway_speed = float(runaway_speed)
+        _set_implicit(definition.implicit, linear_solver, newton_max_iterations, newton_tolerance,
+                      cg_tolerance, cg_max_iterations)
 
         body = sh_body_id()
         status = lib.sh_world_add_spring_body(handle, ctypes.byref(definition), ctypes.byref(body))

@@ -88,7 +88,8 @@ SH_API const char* sh_last_error_message(void);
 typedef enum sh_warning {
     SH_WARN_UNSTABLE = 0,       /**< a step was rejected or rolled back as unstable */
     SH_WARN_SUBSTEPPED = 1,     /**< a step was split into sub-steps to stay below dt_crit */
-    SH_WARN_INVERTED = 2,       /**< an element had det F <= 0 during a step */
+    SH_WARN_INVERTED = 2,       /**< an element had det F <= 0 at a force evaluation of a step
+                                     (counted once per step) */
     SH_WARN_CAPACITY = 3,       /**< a fixed capacity clamped a result */
     SH_WARN_FORCE_CLAMPED = 4,  /**< an output force was clamped */
     SH_WARN_LOCKING = 5,        /**< a material with nu > 0.45 was given to linear tets, which
@@ -503,7 +504,8 @@ typedef struct sh_static_report {
  *  K(x_i) dx = f_ext + f(x_i) with backtracking line search on the potential energy, one sparse
  *  solve for linear materials. Positions are updated in place and velocities zeroed. A body
  *  with no fixed node (singular K) is SH_ERR_SOLVER; SH_ERR_NOT_CONVERGED if the tolerance is
- *  not reached; on any error every body keeps its previous state. report may be NULL.
+ *  not reached; on any error every body keeps its previous state and report (if not NULL)
+ *  still tells what was tried (converged = 0).
  *  Thread: sim. Alloc: may. */
 SH_API sh_status sh_world_solve_static(sh_world* world, const sh_static_def* def,
                                        sh_static_report* report);

@@ -67,6 +67,9 @@ public:
     /// True for FEM bodies.
     virtual bool is_fem() const = 0;
 
+    /// Elements with det F <= 0 at the last internal-force evaluation (0 for springs).
+    virtual int32_t inverted_elements() const { return 0; }
+
     /// Writes the current shape (element cells, velocity point data) as .vtu.
     void write_vtu(const std::string& path) const;
 

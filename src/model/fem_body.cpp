@@ -164,9 +164,11 @@ void for_each_model(const vec<TetBlock>* blocks, Visit&& visit) {
 
 void FemBody::add_internal_forces(const double* xs, const double* vs, double* f) const {
     const double* damped_v = damping_stiffness_ > 0.0 ? vs : nullptr;
+    int32_t inverted = 0;
     for_each_model(blocks_, [&](auto material, const vec<TetBlock>& blocks) {
-        add_fem_forces<decltype(material)>(blocks.data(), blocks.size(), xs, damped_v, damping_stiffness_, f);
+        inverted += add_fem_forces<decltype(material)>(blocks.data(), blocks.size(), xs, damped_v, damping_stiffness_, f);
     });
+    inverted_elements_ = inverted;
 }
 
 double FemBody::elastic_energy(const double* xs) const {

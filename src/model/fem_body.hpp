@@ -27,6 +27,7 @@ public:
     int nodes_per_element() const override { return 4; }
     int32_t element_count() const override { return static_cast<int32_t>(volume_.size()); }
     bool is_fem() const override { return true; }
+    int32_t inverted_elements() const override { return inverted_elements_; }
 
 private:
     /// Adopts materials (one per tet): masses, blocks and the stable step, all or nothing.
@@ -40,6 +41,7 @@ private:
     vec<TetBlock> blocks_[4];    ///< per sh_material_model
     double damping_stiffness_;
     double stable_step_ = 0.0;   ///< 2/omega_max at rest, with stiffness damping
+    mutable int32_t inverted_elements_ = 0;  ///< det F <= 0 at the last force evaluation
 };
 
 }  // namespace sh

@@ -100,11 +100,13 @@ SH_INLINE Mat3L gather_edges(const TetBlock& b, const double* p) {
 
 /// The force loop; Damped adds -beta K(x) v through the material's differential.
 template <class Material, bool Damped>
-void add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const double* x, const double* v,
-                         double beta, double* f) {
+int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const double* x, const double* v,
+                            double beta, double* f) {
+    Lanes inverted = Lanes{};  // per lane: elements with det F <= 0 (unused lanes weigh 0)
     for (size_t k = 0; k < block_count; ++k) {
         const TetBlock& b = blocks[k];
         const Mat3L F = mul(gather_edges(b, x), b.Bm);
+        inverted += select(det(F) <= 0.0 && b.mu_w != 0.0, splat(1.0), Lanes{});
         typename Material::State state;
         Mat3L P = Material::stress(F, b.lambda_w, b.mu_w, state);  // -V0 P
         if (Damped) {
@@ -119,17 +121,17 @@ void add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const doubl
         scatter_add_xyz<true>(f, b.node[0], H.m[0][0] + H.m[0][1] + H.m[0][2], H.m[1][0] + H.m[1][1] + H.m[1][2],
                               H.m[2][0] + H.m[2][1] + H.m[2][2]);
     }
+    return static_cast<int32_t>(lane_sum(inverted));
 }
 
 /// Adds the elastic forces of blocks at positions x into f; when v is not null, adds the
-/// stiffness-proportional damping force -beta K(x) v as well.
+/// stiffness-proportional damping force -beta K(x) v as well. Returns the number of elements
+/// with det F <= 0 (inverted or flat).
 template <class Material>
-void add_fem_forces(const TetBlock* blocks, size_t block_count, const double* x, const double* v, double beta,
-                    double* f) {
-    if (v)
-        add_fem_forces_loop<Material, true>(blocks, block_count, x, v, beta, f);
-    else
-        add_fem_forces_loop<Material, false>(blocks, block_count, x, nullptr, 0.0, f);
+int32_t add_fem_forces(const TetBlock* blocks, size_t block_count, const double* x, const double* v, double beta,
+                       double* f) {
+    if (v) return add_fem_forces_loop<Material, true>(blocks, block_count, x, v, beta, f);
+    return add_fem_forces_loop<Material, false>(blocks, block_count, x, nullptr, 0.0, f);
 }
 
 /// Elastic energy of blocks at positions x (J).

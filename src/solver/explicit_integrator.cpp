@@ -77,6 +77,8 @@ void integrate(Body& body, double h, const double g[3]) {
             }
             break;
         }
+        case SH_INTEGRATOR_IMPLICIT_EULER:  // stepped by step_implicit, never here
+            break;
     }
 }
 

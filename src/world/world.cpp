@@ -113,6 +113,7 @@ void World::step(double dt, sh_step_report* report) {
         r.factorize_seconds += result.factorize_seconds;
         r.solve_seconds += result.solve_seconds;
         if (result.substeps > 1) r.warnings |= 1u << SH_WARN_SUBSTEPPED;
+        if (slot.body->inverted_elements() > 0) r.warnings |= 1u << SH_WARN_INVERTED;
         if (!result.stable) {
             r.warnings |= 1u << SH_WARN_UNSTABLE;
             ++r.unstable_body_count;
@@ -123,6 +124,7 @@ void World::step(double dt, sh_step_report* report) {
         }
     }
     if (r.warnings & (1u << SH_WARN_SUBSTEPPED)) ++warnings[SH_WARN_SUBSTEPPED];
+    if (r.warnings & (1u << SH_WARN_INVERTED)) ++warnings[SH_WARN_INVERTED];
     warnings[SH_WARN_UNSTABLE] += static_cast<uint64_t>(r.unstable_body_count);
 
     if (report) {
@@ -164,6 +166,8 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
     } catch (...) {
         for (Slot& slot : slots_)
             if (slot.body) restore_start_state(*slot.body);
+        r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (report) *report = r;  // what was tried, for the host's diagnosis
         throw;
     }
     r.converged = 1;

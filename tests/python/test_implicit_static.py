@@ -194,11 +194,6 @@ def test_static_not_converged_keeps_state(meshes):
         np.testing.assert_array_equal(body.positions, before)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="C API gap: sh_world_solve_static does not fill the report when it returns "
-    "SH_ERR_NOT_CONVERGED (world.cpp writes *report only on success)",
-)
 def test_static_not_converged_error_carries_the_report(meshes):
     world, body = unconverged_liver(meshes)
     with world:

@@ -67,8 +67,12 @@ public:
     /// True for FEM bodies.
     virtual bool is_fem() const = 0;
 
-    /// Elements with det F <= 0 at the last internal-force evaluation (0 for springs).
+    /// Most elements with det F <= 0 at one internal-force evaluation since the last
+    /// clear_inverted_elements (0 for springs).
     virtual int32_t inverted_elements() const { return 0; }
+
+    /// Starts a new count for inverted_elements (at the start of each step).
+    virtual void clear_inverted_elements() {}
 
     /// Writes the current shape (element cells, velocity point data) as .vtu.
     void write_vtu(const std::string& path) const;

@@ -168,7 +168,7 @@ void FemBody::add_internal_forces(const double* xs, const double* vs, double* f)
     for_each_model(blocks_, [&](auto material, const vec<TetBlock>& blocks) {
         inverted += add_fem_forces<decltype(material)>(blocks.data(), blocks.size(), xs, damped_v, damping_stiffness_, f);
     });
-    inverted_elements_ = inverted;
+    inverted_elements_ = std::max(inverted_elements_, inverted);
 }
 
 double FemBody::elastic_energy(const double* xs) const {

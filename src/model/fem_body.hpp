@@ -28,6 +28,7 @@ public:
     int32_t element_count() const override { return static_cast<int32_t>(volume_.size()); }
     bool is_fem() const override { return true; }
     int32_t inverted_elements() const override { return inverted_elements_; }
+    void clear_inverted_elements() override { inverted_elements_ = 0; }
 
 private:
     /// Adopts materials (one per tet): masses, blocks and the stable step, all or nothing.
@@ -41,7 +42,7 @@ private:
     vec<TetBlock> blocks_[4];    ///< per sh_material_model
     double damping_stiffness_;
     double stable_step_ = 0.0;   ///< 2/omega_max at rest, with stiffness damping
-    mutable int32_t inverted_elements_ = 0;  ///< det F <= 0 at the last force evaluation
+    mutable int32_t inverted_elements_ = 0;  ///< most elements with det F <= 0 at one evaluation
 };
 
 }  // namespace sh

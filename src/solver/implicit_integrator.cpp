@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace sh {
 namespace {
@@ -20,6 +21,20 @@ LinearSolverKind solver_kind(sh_linear_solver kind) {
         case SH_LINEAR_SOLVER_CG: return LinearSolverKind::ConjugateGradient;
         default: return (sh_build_features() & SH_FEATURE_CHOLMOD) ? LinearSolverKind::Cholmod : LinearSolverKind::Ldlt;
     }
+}
+
+// Round-off level of the residual dt |f|: forces are computed from position differences that
+// carry an error of about eps |x|, which the stiffness turns into eps |x| K_dd per DOF. system
+// holds dt^2 K (+ damping) here, whose diagonal gives K_dd.
+double residual_roundoff(const SparseSystem& system, const vec<double>& x, double dt) {
+    double largest = 0.0;
+    for (const double c : x) largest = std::max(largest, std::fabs(c));
+    double sum = 0.0;
+    for (int32_t d = 0; d < system.dof_count(); ++d) {
+        const double k = system.values()[static_cast<size_t>(system.diagonal_slot(d))] / dt;
+        sum += k * k;
+    }
+    return 64.0 * std::numeric_limits<double>::epsilon() * largest * std::sqrt(sum);
 }
 
 double norm(const vec<double>& a) {
@@ -80,7 +95,7 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
     // Newton on g(v) = M (v - v0) - dt F(x0 + dt v, v) over the free DOFs, from v = v0.
     const int max_iterations = std::max(1, s.newton_max_iterations);
     double* a = w.a[0].data();
-    double residual0 = 0.0;
+    double residual0 = 0.0, roundoff_floor = 0.0;
     double applied_load = 0.0;  // |f_ext + m g| over the free DOFs (N)
     for (int32_t d = 0; d < dofs; ++d) {
         const size_t j = static_cast<size_t>(global[static_cast<size_t>(d)]);
@@ -101,8 +116,9 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
         const double r = norm(state.residual);
         if (iteration == 0) residual0 = std::max(r, dt * applied_load);
         if (iteration > 0) result.newton_residual = residual0 > 0.0 ? r / residual0 : 0.0;
-        // Converged: small against the first residual or the applied load's impulse.
-        if (residual0 == 0.0 || (iteration > 0 && r <= s.newton_tolerance * residual0)) {
+        // Converged: small against the first residual or the applied load's impulse, or down
+        // to the round-off of the element forces themselves.
+        if (residual0 == 0.0 || (iteration > 0 && r <= std::max(s.newton_tolerance * residual0, roundoff_floor))) {
             converged = true;
             break;
         }
@@ -110,6 +126,7 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
 
         state.system.clear_values();
         body.add_tangent(body.x.data(), dt * dt, dt, state.system);
+        if (iteration == 0) roundoff_floor = residual_roundoff(state.system, body.x, dt);
         state.system.add_diagonal(state.diagonal.data(), 1.0);
         try {
             state.solver->factorize(state.system);

@@ -99,6 +99,7 @@ void World::step(double dt, sh_step_report* report) {
         Slot& slot = slots_[index];
         if (!slot.body) continue;
         BodyStepResult result;
+        slot.body->clear_inverted_elements();
         if (slot.body->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER) {
             if (!slot.implicit) slot.implicit = sh::create<ImplicitState>();
             result = step_implicit(*slot.body, *slot.implicit, dt, gravity);

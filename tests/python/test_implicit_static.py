@@ -173,6 +173,7 @@ def test_static_without_fixed_nodes_is_a_solver_error_and_changes_nothing():
         with pytest.raises(softhap.Error) as info:
             world.solve_static()
         assert info.value.status_name == "SH_ERR_SOLVER"
+        assert info.value.report is not None and info.value.report.converged is False
         np.testing.assert_array_equal(body.positions, UNIT_TET)
 
 
@@ -212,5 +213,6 @@ def test_static_def_values_are_checked_by_the_library():
             with pytest.raises(softhap.Error) as info:
                 world.solve_static(**bad)
             assert info.value.status_name == "SH_ERR_INVALID_ARGUMENT", bad
+            assert info.value.report is None  # rejected before anything was tried
         with pytest.raises(ValueError):
             world.solve_static(linear_solver="qr")

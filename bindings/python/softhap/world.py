@@ -218,8 +218,9 @@ class World:
         None keeps the C default of sh_static_def_default: tolerance 1e-10 (relative residual),
         max_iterations 50 (Newton iterations per load step), load_steps 1, linear_solver
         "default". A body with no fixed node raises softhap.Error SH_ERR_SOLVER; an unreached
-        tolerance raises SH_ERR_NOT_CONVERGED, with the report as ``err.report`` if the library
-        filled it (else None). On any error every body keeps its previous state.
+        tolerance raises SH_ERR_NOT_CONVERGED. On any error every body keeps its previous
+        state, and ``err.report`` is the report of what was tried (converged False) when the
+        library filled it (it does not for rejected arguments), else None.
         """
         handle = self._require_handle("sh_world_solve_static")
         definition = sh_static_def()
@@ -238,8 +239,7 @@ class World:
         if status == Status.SH_OK:
             return _static_report(raw)
         message = last_error_message() or status_string(status)
-        written = raw.iterations >= 0
-        report = _static_report(raw) if written and status == Status.SH_ERR_NOT_CONVERGED else None
+        report = _static_report(raw) if raw.iterations >= 0 else None
         raise Error(status, message, "sh_world_solve_static", report=report)
 
     # -- bodies ----------------------------------------------------------------------------

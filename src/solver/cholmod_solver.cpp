@@ -1,0 +1,222 @@
+// CHOLMOD backend: sparse Cholesky of the SparseSystem's upper triangle, wrapped in place (no copy
+// of the system per step). One cholmod_common per solver; the symbolic analysis (ordering,
+// elimination tree, supernodes) is kept in the cholmod_factor and reused by every factorize until
+// the pattern changes; solves reuse CHOLMOD's solution and workspace (cholmod_solve2).
+#if SOFTHAP_WITH_CHOLMOD
+
+#include "solver/linear_solver.hpp"
+
+#include "core/error.hpp"
+
+#include <cholmod.h>
+
+#include <cstring>
+
+namespace sh {
+namespace {
+
+const char* cholmod_status_text(int status) {
+    switch (status) {
+        case CHOLMOD_OK: return "ok";
+        case CHOLMOD_NOT_INSTALLED: return "method not installed";
+        case CHOLMOD_OUT_OF_MEMORY: return "out of memory";
+        case CHOLMOD_TOO_LARGE: return "problem too large";
+        case CHOLMOD_INVALID: return "invalid input";
+        case CHOLMOD_GPU_PROBLEM: return "GPU problem";
+        case CHOLMOD_NOT_POSDEF: return "not positive definite";
+        case CHOLMOD_DSMALL: return "tiny diagonal";
+        default: return "unknown status";
+    }
+}
+
+class CholmodSolver final : public LinearSolver {
+public:
+    CholmodSolver(CholmodMode mode, CholmodOrdering ordering) {
+        cholmod_start(&common_);
+        common_.print = 0;  // never print (errors come back as sh::Error)
+        common_.error_handler = nullptr;
+        switch (mode) {
+            case CholmodMode::Automatic: common_.supernodal = CHOLMOD_AUTO; break;
+            case CholmodMode::Supernodal: common_.supernodal = CHOLMOD_SUPERNODAL; break;
+            case CholmodMode::Simplicial: common_.supernodal = CHOLMOD_SIMPLICIAL; break;
+        }
+        switch (ordering) {
+            case CholmodOrdering::Default: break;
+            case CholmodOrdering::Amd: set_single_ordering(CHOLMOD_AMD); break;
+            case CholmodOrdering::Metis: set_single_ordering(CHOLMOD_METIS); break;
+            case CholmodOrdering::NestedDissection: set_single_ordering(CHOLMOD_NESDIS); break;
+        }
+        // Keep the factor as computed (supernodal LL^T or simplicial LDL^T): no conversion pass.
+        common_.final_asis = 1;
+    }
+
+    ~CholmodSolver() override {
+        free_all();
+        cholmod_finish(&common_);
+    }
+
+    CholmodSolver(const CholmodSolver&) = delete;
+    CholmodSolver& operator=(const CholmodSolver&) = delete;
+
+    const char* name() const override { return "cholmod"; }
+    const char* method() const override {
+        if (!factor_ || factor_->xtype == CHOLMOD_PATTERN) return "cholmod (not factorised)";
+        if (factor_->is_super) return "cholmod supernodal LL^T";
+        return factor_->is_ll ? "cholmod simplicial LL^T" : "cholmod simplicial LDL^T";
+    }
+    int64_t factor_nonzeros() const override {
+        if (!factor_) return 0;
+        if (factor_->is_super) return static_cast<int64_t>(factor_->xsize);  // incl. supernode padding
+        const int* nz = static_cast<const int*>(factor_->nz);
+        int64_t total = 0;
+        for (size_t j = 0; nz && j < factor_->n; ++j) total += nz[j];
+        return total;
+    }
+
+    void analyze(const SparseSystem& a) override {
+        const double t0 = solver_detail::now_seconds();
+        free_all();
+        if (a.dof_count() > 0) {
+            cholmod_sparse matrix = wrap(a);
+            factor_ = cholmod_analyze(&matrix, &common_);
+            check(factor_ != nullptr, "symbolic analysis");
+        }
+        analysed_id_ = a.pattern_id();
+        analyze_seconds = solver_detail::now_seconds() - t0;
+    }
+
+    void factorize(const SparseSystem& a) override {
+        const double t0 = solver_detail::now_seconds();
+        solver_detail::require_analysed(a, analysed_id_, name());
+        factorized_ = false;
+        if (a.dof_count() > 0) {
+            solver_detail::require_finite_values(a, name());
+            cholmod_sparse matrix = wrap(a);
+            const int ok = cholmod_factorize(&matrix, factor_, &common_);
+            size_t minor = factor_->minor;
+            if (ok && minor >= factor_->n && !factor_->is_super && !factor_->is_ll) {
+                // Simplicial LDL^T only stops at a zero pivot (an indefinite matrix factorises);
+                // we need positive definite, so check D: the first entry of each column of L.
+                const int* lp = static_cast<const int*>(factor_->p);
+                const double* lx = static_cast<const double*>(factor_->x);
+                for (size_t k = 0; k < factor_->n; ++k)
+                    if (!(lx[lp[k]] > 0.0)) {
+                        minor = k;
+                        break;
+                    }
+            }
+            if (common_.status == CHOLMOD_NOT_POSDEF || minor < factor_->n) {
+                // minor is the failing column of the permuted matrix P A P^T; Perm maps it back.
+                const int* perm = static_cast<const int*>(factor_->Perm);
+                const int32_t column = perm && minor < factor_->n ? perm[minor] : static_cast<int32_t>(minor);
+                solver_detail::throw_not_positive_definite(
+                    a, column, name(),
+                    format("%s factorisation stopped at elimination step %zu", factor_->is_super ? "supernodal" : "simplicial",
+                           minor)
+                        .c_str());
+            }
+            check(ok != 0, "numeric factorisation");
+        }
+        factorized_ = true;
+        factorize_seconds = solver_detail::now_seconds() - t0;
+    }
+
+    int solve(const SparseSystem& a, const double* b, double* x) override {
+        const double t0 = solver_detail::now_seconds();
+        solver_detail::require_analysed(a, analysed_id_, name());
+        SH_REQUIRE(factorized_, SH_ERR_INTERNAL, "cholmod: solve before a successful factorize");
+        const size_t n = static_cast<size_t>(a.dof_count());
+        if (n > 0) {
+            // b wrapped in place; X, Y and E are kept between calls, so after the first solve
+            // cholmod_solve2 allocates nothing.
+            cholmod_dense rhs;
+            std::memset(&rhs, 0, sizeof rhs);
+            rhs.nrow = n;
+            rhs.ncol = 1;
+            rhs.nzmax = n;
+            rhs.d = n;
+            rhs.x = const_cast<double*>(b);
+            rhs.xtype = CHOLMOD_REAL;
+            rhs.dtype = CHOLMOD_DOUBLE;
+            if (work_y_ && !factor_->is_super && work_y_->nzmax >= 4 * n) {
+                // The simplicial solve asks for a 4 x n Y, then relabels it 1 x n for one right-hand
+                // side, so the next call would free and reallocate it; restore the shape it asks
+                // for (same memory, nzmax >= 4n) so Y really is reused.
+                work_y_->nrow = 4;
+                work_y_->ncol = n;
+                work_y_->d = 4;
+            }
+            const int ok = cholmod_solve2(CHOLMOD_A, factor_, &rhs, nullptr, &solution_, nullptr, &work_y_, &work_e_,
+                                          &common_);
+            check(ok != 0 && solution_ != nullptr, "solve");
+            std::memcpy(x, solution_->x, n * sizeof(double));
+            solver_detail::require_finite_solution(a, x, name());
+        }
+        solve_seconds = solver_detail::now_seconds() - t0;
+        return 1;
+    }
+
+private:
+    void set_single_ordering(int method) {
+        common_.nmethods = 1;
+        common_.method[0].ordering = method;
+        common_.postorder = 1;
+    }
+
+    // The system's upper triangle as a packed, sorted, stype = 1 CHOLMOD matrix over its arrays.
+    // CHOLMOD only reads an input matrix, so the const_casts are safe.
+    static cholmod_sparse wrap(const SparseSystem& a) {
+        cholmod_sparse m;
+        std::memset(&m, 0, sizeof m);
+        m.nrow = static_cast<size_t>(a.dof_count());
+        m.ncol = m.nrow;
+        m.nzmax = static_cast<size_t>(a.nonzero_count());
+        m.p = const_cast<int32_t*>(a.column_starts().data());
+        m.i = const_cast<int32_t*>(a.row_indices().data());
+        m.nz = nullptr;
+        m.x = const_cast<double*>(a.values().data());
+        m.z = nullptr;
+        m.stype = 1;
+        m.itype = CHOLMOD_INT;
+        m.xtype = CHOLMOD_REAL;
+        m.dtype = CHOLMOD_DOUBLE;
+        m.sorted = 1;
+        m.packed = 1;
+        return m;
+    }
+
+    void check(bool ok, const char* what) {
+        if (ok && common_.status >= CHOLMOD_OK) return;
+        const int status = common_.status;
+        if (status == CHOLMOD_OUT_OF_MEMORY) throw std::bad_alloc();
+        throw Error(status == CHOLMOD_TOO_LARGE ? SH_ERR_CAPACITY : SH_ERR_SOLVER,
+                    format("cholmod: %s failed: %s (status %d)", what, cholmod_status_text(status), status));
+    }
+
+    void free_all() {
+        if (factor_) cholmod_free_factor(&factor_, &common_);
+        if (solution_) cholmod_free_dense(&solution_, &common_);
+        if (work_y_) cholmod_free_dense(&work_y_, &common_);
+        if (work_e_) cholmod_free_dense(&work_e_, &common_);
+        analysed_id_ = 0;
+        factorized_ = false;
+    }
+
+    cholmod_common common_;
+    cholmod_factor* factor_ = nullptr;
+    cholmod_dense* solution_ = nullptr;
+    cholmod_dense* work_y_ = nullptr;
+    cholmod_dense* work_e_ = nullptr;
+    uint64_t analysed_id_ = 0;
+    bool factorized_ = false;
+};
+
+}  // namespace
+
+LinearSolverPtr make_cholmod_solver(CholmodMode mode, CholmodOrdering ordering) {
+    return LinearSolverPtr(create<CholmodSolver>(mode, ordering));
+}
+
+}  // namespace sh
+
+#endif  // SOFTHAP_WITH_CHOLMOD

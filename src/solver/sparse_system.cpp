@@ -1,0 +1,271 @@
+#include "solver/sparse_system.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cinttypes>
+#include <climits>
+#include <cstdio>
+#include <cstring>
+
+namespace sh {
+namespace {
+
+std::atomic<uint64_t> g_next_pattern_id{1};
+
+// Largest nodes per element: local indices (3k)^2 - 1 must fit a uint16_t.
+constexpr int kMaxNodesPerElement = 85;
+
+}  // namespace
+
+void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, int nodes_per_element,
+                                 const int32_t* free_index, int32_t node_count, int32_t free_count) {
+    // Start empty, so a failure below (bad input, std::bad_alloc) leaves an empty system.
+    {
+        SparseSystem empty;
+        std::swap(*this, empty);
+    }
+
+    SH_REQUIRE(nodes_per_element >= 1 && nodes_per_element <= kMaxNodesPerElement, SH_ERR_INVALID_ARGUMENT,
+               "sparse system: nodes_per_element %d is not in [1, %d]", nodes_per_element, kMaxNodesPerElement);
+    SH_REQUIRE(node_count >= 0 && free_count >= 0 && free_count <= node_count, SH_ERR_INVALID_ARGUMENT,
+               "sparse system: free_count %d is not in [0, node_count = %d]", free_count, node_count);
+    SH_REQUIRE(free_count <= INT32_MAX / 3, SH_ERR_CAPACITY, "sparse system: %d free nodes exceed %d",
+               free_count, INT32_MAX / 3);
+    SH_REQUIRE(element_count == 0 || elements, SH_ERR_INVALID_ARGUMENT, "sparse system: elements is NULL");
+    SH_REQUIRE(node_count == 0 || free_index, SH_ERR_INVALID_ARGUMENT, "sparse system: free_index is NULL");
+    const size_t k = static_cast<size_t>(nodes_per_element);
+    SH_REQUIRE(element_count <= SIZE_MAX / k, SH_ERR_INVALID_ARGUMENT, "sparse system: element count overflows");
+
+    const size_t nfree = static_cast<size_t>(free_count);
+    const int32_t dofs = 3 * free_count;
+
+    // Free node -> node, checking that free_index is one-to-one onto [0, free_count).
+    vec<int32_t> dof_to_global(3 * nfree, -1);
+    for (int32_t i = 0; i < node_count; ++i) {
+        const int32_t f = free_index[i];
+        if (f == -1) continue;
+        SH_REQUIRE(f >= 0 && f < free_count, SH_ERR_INVALID_ARGUMENT,
+                   "sparse system: free_index[%d] = %d is not -1 or in [0, %d)", i, f, free_count);
+        SH_REQUIRE(dof_to_global[3 * static_cast<size_t>(f)] < 0, SH_ERR_INVALID_ARGUMENT,
+                   "sparse system: nodes %d and %d both have free index %d", dof_to_global[3 * static_cast<size_t>(f)] / 3,
+                   i, f);
+        for (int c = 0; c < 3; ++c) dof_to_global[3 * static_cast<size_t>(f) + c] = 3 * i + c;
+    }
+    for (size_t f = 0; f < nfree; ++f)
+        SH_REQUIRE(dof_to_global[3 * f] >= 0, SH_ERR_INVALID_ARGUMENT,
+                   "sparse system: no node has free index %zu (free_count %d)", f, free_count);
+    for (size_t i = 0; i < element_count * k; ++i)
+        SH_REQUIRE(elements[i] >= 0 && elements[i] < node_count, SH_ERR_INVALID_ARGUMENT,
+                   "sparse system: element %zu node %zu is %d, not in [0, %d)", i / k, i % k, elements[i], node_count);
+
+    // Node-block pattern of the strict upper triangle: for free column node J, the sorted free row
+    // nodes I < J sharing an element with it. Counted, filled, then sorted and deduplicated.
+    vec<size_t> block_start(nfree + 1, 0);
+    auto for_each_pair = [&](auto&& visit) {
+        for (size_t e = 0; e < element_count; ++e) {
+            const int32_t* en = elements + e * k;
+            for (size_t a = 0; a < k; ++a) {
+                const int32_t fa = free_index[en[a]];
+                if (fa < 0) continue;
+                for (size_t b = 0; b < k; ++b) {
+                    const int32_t fb = free_index[en[b]];
+                    if (fb > fa) visit(fa, fb);  // row fa < column fb
+                }
+            }
+        }
+    };
+    for_each_pair([&](int32_t, int32_t col) { ++block_start[static_cast<size_t>(col) + 1]; });
+    for (size_t j = 0; j < nfree; ++j) block_start[j + 1] += block_start[j];
+    vec<int32_t> block_rows(block_start[nfree]);
+    {
+        vec<size_t> fill(block_start.begin(), block_start.end() - 1);
+        for_each_pair([&](int32_t row, int32_t col) { block_rows[fill[static_cast<size_t>(col)]++] = row; });
+    }
+    size_t unique_blocks = 0;
+    for (size_t j = 0; j < nfree; ++j) {
+        int32_t* first = block_rows.data() + block_start[j];
+        int32_t* last = block_rows.data() + block_start[j + 1];
+        std::sort(first, last);
+        last = std::unique(first, last);
+        const size_t start = unique_blocks;
+        for (int32_t* p = first; p != last; ++p) block_rows[unique_blocks++] = *p;
+        block_start[j] = start;
+    }
+    block_start[nfree] = unique_blocks;
+    block_rows.resize(unique_blocks);
+
+    const uint64_t nnz = 6 * static_cast<uint64_t>(nfree) + 9 * static_cast<uint64_t>(unique_blocks);
+    SH_REQUIRE(nnz <= static_cast<uint64_t>(INT32_MAX), SH_ERR_CAPACITY,
+               "sparse system: %" PRIu64 " stored entries exceed 2^31 - 1", nnz);
+
+    // Expand node blocks to DOF columns: column 3J+c holds rows 3I..3I+2 of each block row I < J,
+    // then the diagonal block's rows 3J..3J+c (so the diagonal entry comes last).
+    vec<int32_t> column_starts(static_cast<size_t>(dofs) + 1);
+    vec<int32_t> row_indices(static_cast<size_t>(nnz));
+    {
+        int32_t p = 0;
+        for (size_t j = 0; j < nfree; ++j) {
+            for (int c = 0; c < 3; ++c) {
+                column_starts[3 * j + c] = p;
+                for (size_t b = block_start[j]; b < block_start[j + 1]; ++b)
+                    for (int r = 0; r < 3; ++r) row_indices[static_cast<size_t>(p++)] = 3 * block_rows[b] + r;
+                for (int r = 0; r <= c; ++r) row_indices[static_cast<size_t>(p++)] = 3 * static_cast<int32_t>(j) + r;
+            }
+        }
+        column_starts[static_cast<size_t>(dofs)] = p;
+    }
+
+    // Element scatter map, one record per 3x3 block. Local node pair (a, b) with free indices
+    // I <= J maps Ke's block (rows 3a.., columns 3b..) to the global block (3I.., 3J..): entry
+    // (r, s) goes to slot column_start(3J+s) + 3 * (position of I among column J's block rows) + r,
+    // the diagonal block (I == J) coming after all block rows and keeping only r <= s. Pairs with
+    // I > J are left out: their entries lie in the lower triangle (the pair (b, a) supplies them).
+    // That is exactly "local (p, q) is added when g(p) <= g(q)", also for a repeated node.
+    const size_t n3 = 3 * k;
+    vec<size_t> block_record_start(element_count + 1, 0);
+    auto element_blocks = [&](size_t e, auto&& visit) {
+        const int32_t* en = elements + e * k;
+        for (size_t a = 0; a < k; ++a) {
+            const int32_t fi = free_index[en[a]];
+            if (fi < 0) continue;
+            for (size_t b = 0; b < k; ++b) {
+                const int32_t fj = free_index[en[b]];
+                if (fj < fi) continue;  // also skips fj == -1
+                visit(a, b, fi, fj);
+            }
+        }
+    };
+    for (size_t e = 0; e < element_count; ++e) {
+        size_t count = 0;
+        element_blocks(e, [&](size_t, size_t, int32_t, int32_t) { ++count; });
+        block_record_start[e + 1] = block_record_start[e] + count;
+    }
+    vec<BlockRecord> block_records(block_record_start[element_count]);
+    for (size_t e = 0; e < element_count; ++e) {
+        size_t i = block_record_start[e];
+        element_blocks(e, [&](size_t a, size_t b, int32_t fi, int32_t fj) {
+            const size_t j = static_cast<size_t>(fj);
+            const int32_t* rows = block_rows.data() + block_start[j];
+            const size_t count = block_start[j + 1] - block_start[j];
+            const size_t pos = fi == fj ? count : static_cast<size_t>(std::lower_bound(rows, rows + count, fi) - rows);
+            BlockRecord& rec = block_records[i++];
+            for (size_t c = 0; c < 3; ++c) rec.slot[c] = column_starts[3 * j + c] + static_cast<int32_t>(3 * pos);
+            rec.local = static_cast<uint16_t>(3 * a * n3 + 3 * b);
+            rec.diagonal = fi == fj ? 1 : 0;
+        });
+    }
+
+    vec<double> values(static_cast<size_t>(nnz), 0.0);
+
+    dof_count_ = dofs;
+    element_count_ = element_count;
+    nodes_per_element_ = nodes_per_element;
+    column_starts_.swap(column_starts);
+    row_indices_.swap(row_indices);
+    values_.swap(values);
+    dof_to_global_.swap(dof_to_global);
+    local_size_ = static_cast<int32_t>(n3);
+    block_record_start_.swap(block_record_start);
+    block_records_.swap(block_records);
+    pattern_id_ = g_next_pattern_id.fetch_add(1);
+}
+
+void SparseSystem::clear_values() { std::fill(values_.begin(), values_.end(), 0.0); }
+
+void SparseSystem::add_element(size_t element, const double* Ke, double scale) {
+    SH_REQUIRE(element < element_count_, SH_ERR_INTERNAL, "sparse system: element %zu of %zu", element,
+               element_count_);
+    double* v = values_.data();
+    const size_t m = static_cast<size_t>(local_size_);
+    const BlockRecord* rec = block_records_.data() + block_record_start_[element];
+    const BlockRecord* end = block_records_.data() + block_record_start_[element + 1];
+    for (; rec != end; ++rec) {
+        const double* k = Ke + rec->local;
+        if (!rec->diagonal) {
+            for (int s = 0; s < 3; ++s) {
+                double* col = v + rec->slot[s];
+                col[0] += scale * k[s];
+                col[1] += scale * k[m + s];
+                col[2] += scale * k[2 * m + s];
+            }
+        } else {
+            v[rec->slot[0]] += scale * k[0];
+            v[rec->slot[1]] += scale * k[1];
+            v[rec->slot[1] + 1] += scale * k[m + 1];
+            v[rec->slot[2]] += scale * k[2];
+            v[rec->slot[2] + 1] += scale * k[m + 2];
+            v[rec->slot[2] + 2] += scale * k[2 * m + 2];
+        }
+    }
+}
+
+void SparseSystem::add_diagonal(const double* diag, double scale) {
+    double* v = values_.data();
+    const int32_t* cs = column_starts_.data();
+    for (int32_t d = 0; d < dof_count_; ++d) v[cs[d + 1] - 1] += scale * diag[d];
+}
+
+void SparseSystem::add_node_block(int32_t free_node, const double* K3, double scale) {
+    SH_REQUIRE(free_node >= 0 && free_node < free_node_count(), SH_ERR_INTERNAL,
+               "sparse system: free node %d of %d", free_node, free_node_count());
+    double* v = values_.data();
+    for (int s = 0; s < 3; ++s) {
+        const int32_t col = 3 * free_node + s;
+        // The diagonal block's rows 3J..3J+s are the last s+1 entries of column 3J+s.
+        const int32_t first = column_starts_[static_cast<size_t>(col) + 1] - (s + 1);
+        for (int r = 0; r <= s; ++r) v[first + r] += scale * K3[3 * r + s];
+    }
+}
+
+void SparseSystem::multiply(const double* x, double* y) const {
+    const int32_t* cs = column_starts_.data();
+    const int32_t* ri = row_indices_.data();
+    const double* v = values_.data();
+    // Column j touches y[i] for rows i < j (already assigned) and assigns y[j]; later columns
+    // only add to it. The diagonal is the last entry of each column.
+    for (int32_t j = 0; j < dof_count_; ++j) {
+        const int32_t diag = cs[j + 1] - 1;
+        const double xj = x[j];
+        double dot = 0.0;
+        for (int32_t p = cs[j]; p < diag; ++p) {
+            const int32_t i = ri[p];
+            dot += v[p] * x[i];
+            y[i] += v[p] * xj;
+        }
+        y[j] = dot + v[diag] * xj;
+    }
+}
+
+int32_t SparseSystem::first_nonfinite_column() const {
+    // Integer exponent test: vectorises, unlike a floating-point reduction.
+    constexpr uint64_t kExponent = 0x7ff0000000000000ull;
+    const double* v = values_.data();
+    const size_t n = values_.size();
+    uint64_t bad = 0;
+    for (size_t i = 0; i < n; ++i) {
+        uint64_t bits;
+        std::memcpy(&bits, v + i, sizeof bits);
+        bad |= static_cast<uint64_t>((bits & kExponent) == kExponent);
+    }
+    if (!bad) return -1;
+    for (int32_t j = 0; j < dof_count_; ++j)
+        for (int32_t p = column_starts_[static_cast<size_t>(j)]; p < column_starts_[static_cast<size_t>(j) + 1]; ++p) {
+            uint64_t bits;
+            std::memcpy(&bits, v + p, sizeof bits);
+            if ((bits & kExponent) == kExponent) return j;
+        }
+    return -1;
+}
+
+void SparseSystem::describe_dof(int32_t d, char* out, size_t size) const {
+    if (d >= 0 && d < dof_count_) {
+        const int32_t g = dof_to_global_[static_cast<size_t>(d)];
+        std::snprintf(out, size, "free DOF %d (node %d, component %c)", d, g / 3, "xyz"[g % 3]);
+    } else {
+        std::snprintf(out, size, "free DOF %d", d);
+    }
+}
+
+}  // namespace sh

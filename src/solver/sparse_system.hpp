@@ -1,0 +1,93 @@
+// The symmetric sparse system of implicit steps and static solves: a matrix over the free degrees
+// of freedom (3 per free node), stored as its upper triangle in compressed sparse columns, with a
+// precomputed scatter map from element matrices to value slots.
+#pragma once
+
+#include "core/memory.hpp"
+
+#include <cstddef>
+#include <cstdint>
+
+namespace sh {
+
+/// Symmetric matrix over the free DOFs (3 per free node), stored as its upper triangle in
+/// compressed sparse columns (CSC) with sorted row indices. Pattern from element connectivity.
+///
+/// Free DOF d = 3 * free_index[node] + c (c = x, y, z). Every free node has its full 3x3
+/// diagonal block (6 stored entries) even if no element uses it, and two free nodes sharing an
+/// element have a full 3x3 off-diagonal block (9 stored entries), so
+/// nonzero_count() = 6 * free nodes + 9 * (pairs of free nodes sharing an element).
+/// The diagonal entry of each column is the last entry of that column.
+class SparseSystem {
+public:
+    /// Builds the pattern. elements: element_count x nodes_per_element node indices (2 for springs,
+    /// 4 for tets). free_index[i] = position of node i among the free nodes, or -1 if node i is fixed,
+    /// prescribed or an orphan (its rows/columns are left out). free_count = number of free nodes.
+    /// Also builds, for each element, the map from its local (3k x 3k) upper-triangle entries to
+    /// value slots, so add_element is a straight scatter.
+    /// Throws SH_ERR_INVALID_ARGUMENT for a node index out of range or a free_index that is not a
+    /// one-to-one map onto [0, free_count), SH_ERR_CAPACITY if the matrix would exceed 2^31 - 1
+    /// stored entries. Values are zero afterwards. Allocates; on failure the system is empty.
+    void build_pattern(const int32_t* elements, size_t element_count, int nodes_per_element,
+                       const int32_t* free_index, int32_t node_count, int32_t free_count);
+    int32_t dof_count() const { return dof_count_; }  ///< 3 * free_count
+    int64_t nonzero_count() const { return static_cast<int64_t>(row_indices_.size()); }  ///< stored (upper) entries
+    void clear_values();                 ///< all values to 0
+    /// Adds scale * Ke for element e; Ke is (3k x 3k) row-major, symmetric (only its upper part, in the
+    /// global ordering, is read); rows/cols of constrained nodes are skipped.
+    /// Precisely: local entry (p, q) is added to global entry (g(p), g(q)) when both are free
+    /// DOFs and g(p) <= g(q), so a full symmetric Ke gives the exact global sum.
+    void add_element(size_t element, const double* Ke, double scale);
+    /// Adds diag[d] to diagonal entry d, for d < dof_count() (lumped mass, per-DOF terms).
+    void add_diagonal(const double* diag, double scale);
+    /// y = A x (full symmetric product from the upper triangle); x, y of dof_count().
+    void multiply(const double* x, double* y) const;
+    const vec<int32_t>& column_starts() const { return column_starts_; }  ///< dof_count()+1
+    const vec<int32_t>& row_indices() const { return row_indices_; }
+    const vec<double>& values() const { return values_; }
+    vec<double>& values() { return values_; }
+    /// Per free DOF d: the global DOF 3*node+c it stands for; and the inverse via free_index.
+    const vec<int32_t>& dof_to_global() const { return dof_to_global_; }
+
+    // ---- additions -------------------------------------------------------------------------
+
+    int32_t free_node_count() const { return dof_count_ / 3; }  ///< free_count of build_pattern
+    size_t element_count() const { return element_count_; }     ///< as given to build_pattern
+    int nodes_per_element() const { return nodes_per_element_; } ///< as given to build_pattern
+    /// Changes on every build_pattern (unique across systems): solvers check that the system they
+    /// factorize is the one they analysed.
+    uint64_t pattern_id() const { return pattern_id_; }
+    /// Value slot of diagonal entry d (the last entry of column d).
+    int32_t diagonal_slot(int32_t d) const { return column_starts_[static_cast<size_t>(d) + 1] - 1; }
+    /// Adds scale * K3 (3x3 row-major, symmetric; its upper part is read) to the diagonal block of
+    /// free node free_node (e.g. a contact or tool-coupling stiffness on one node).
+    void add_node_block(int32_t free_node, const double* K3, double scale);
+    /// 3x3 block records in the element scatter map (10 per tet with all nodes free).
+    size_t scatter_block_count() const { return block_records_.size(); }
+    /// -1 if every value is finite, else the column of the first non-finite value.
+    int32_t first_nonfinite_column() const;
+    /// Human-readable name of free DOF d for messages: "free DOF d (node n, component c)".
+    void describe_dof(int32_t d, char* out, size_t size) const;
+
+private:
+    int32_t dof_count_ = 0;
+    size_t element_count_ = 0;
+    int nodes_per_element_ = 0;
+    uint64_t pattern_id_ = 0;
+    vec<int32_t> column_starts_;
+    vec<int32_t> row_indices_;
+    vec<double> values_;
+    vec<int32_t> dof_to_global_;
+    // Element scatter map: records [block_record_start_[e], block_record_start_[e+1]) of element
+    // e, one per local node pair (a, b) whose global block (I, J) has I <= J.
+    struct BlockRecord {
+        int32_t slot[3];   // value slot of global entry (3I, 3J + s); rows 3I+1, 3I+2 follow it
+        uint16_t local;    // Ke offset of the block: 3a * 3k + 3b
+        uint16_t diagonal; // 1 if I == J (only its upper part r <= s is added)
+    };
+    int32_t local_size_ = 0;  // 3k
+    vec<size_t> block_record_start_;
+    vec<BlockRecord> block_records_;
+};
+
+}  // namespace sh

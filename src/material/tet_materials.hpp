@@ -73,6 +73,8 @@ SH_INLINE Mat3L full(const Sym3L& s) {
 /// Small-strain linear elasticity: eps = sym(F) - I, P = 2 mu eps + lambda tr(eps) I.
 struct LinearMaterial {
     struct State {};
+    /// det F after stress() (for the inverted-element count).
+    static SH_INLINE Lanes jacobian(const Mat3L& F, const State&) { return det(F); }
     static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State&) {
         return full(isotropic_law(sym_part(F, 1.0), lambda, mu));
     }
@@ -89,6 +91,7 @@ struct StvkMaterial {
     struct State {
         Sym3L S;
     };
+    static SH_INLINE Lanes jacobian(const Mat3L& F, const State&) { return det(F); }
     /// sym(A^T B) for the differential (A^T B + B^T A)/2 of F^T F / 2.
     static SH_INLINE Sym3L sym_tn(const Mat3L& a, const Mat3L& b) {
         auto dot = [&](int i, int j) { return a.m[0][i] * b.m[0][j] + a.m[1][i] * b.m[1][j] + a.m[2][i] * b.m[2][j]; };
@@ -109,7 +112,6 @@ struct StvkMaterial {
         return E;
     }
     static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State& state) {
-#ifdef SH_STVK_FOLD
         // S = 2 mu E + lambda tr(E) I with E = (C - I)/2, C = F^T F: S = mu (C - I) + lambda tr(E) I.
         auto dot = [&](int i, int j) { return F.m[0][i] * F.m[0][j] + F.m[1][i] * F.m[1][j] + F.m[2][i] * F.m[2][j]; };
         const Lanes c0 = dot(0, 0), c1 = dot(1, 1), c2 = dot(2, 2);
@@ -120,9 +122,6 @@ struct StvkMaterial {
         state.S.o[0] = mu * dot(0, 1);
         state.S.o[1] = mu * dot(0, 2);
         state.S.o[2] = mu * dot(1, 2);
-        return mul_sym(F, state.S);
-#endif
-        state.S = isotropic_law(green_strain(F), lambda, mu);
         return mul_sym(F, state.S);
     }
     static SH_INLINE Mat3L differential(const Mat3L& F, const State& state, const Mat3L& dF, Lanes lambda, Lanes mu) {
@@ -143,6 +142,7 @@ struct CorotationalMaterial {
     struct State {
         Mat3L R;
     };
+    static SH_INLINE Lanes jacobian(const Mat3L& F, const State&) { return det(F); }
     static SH_INLINE Mat3L rotated_stress(const Mat3L& R, const Mat3L& G, Lanes lambda, Lanes mu, bool subtract_identity) {
         const Sym3L eps = sym_part(mul_tn(R, G), subtract_identity ? 1.0 : 0.0);
         return mul_sym(R, isotropic_law(eps, lambda, mu));
@@ -167,6 +167,7 @@ struct NeoHookeanMaterial {
         Mat3L cof;
         Lanes ic, j;
     };
+    static SH_INLINE Lanes jacobian(const Mat3L&, const State& state) { return state.j; }
     /// m, l and alpha; alpha only depends on the ratio mu/lambda, and lanes with lambda = mu = 0
     /// (block padding) get alpha = 1 so that they stay finite (and, having zero moduli, inert).
     static SH_INLINE void parameters(Lanes lambda, Lanes mu, Lanes& m, Lanes& l, Lanes& alpha) {

@@ -102,13 +102,19 @@ void FemBody::rebuild(vec<sh_material> materials) {
         vec<uint32_t> members;
         for (const uint32_t t : order)
             if (materials[t].model == model) members.push_back(t);
+        // Lane l of block k takes the (l * nb + k)-th tet along the curve: each lane walks its
+        // own stretch of the curve, so consecutive blocks reuse the nodes of the previous one
+        // lane by lane, while the kLanes tets of a block lie far apart and rarely share a node
+        // (the scatter's node updates within a block are then independent).
+        const size_t m = members.size(), nb = (m + kLanes - 1) / kLanes;
         vec<TetBlock>& blocks = new_blocks[model];
-        blocks.assign((members.size() + kLanes - 1) / kLanes, TetBlock{});
-        for (size_t k = 0; k < members.size(); k += kLanes) {
-            TetBlock& b = blocks[k / kLanes];
+        blocks.assign(nb, TetBlock{});
+        for (size_t k = 0; k < nb; ++k) {
+            TetBlock& b = blocks[k];
             for (int l = 0; l < kLanes; ++l) {
-                const bool used = k + l < members.size();
-                const size_t t = members[used ? k + l : k];  // unused lanes repeat a real tet, weightless
+                const size_t slot = static_cast<size_t>(l) * nb + k;
+                const bool used = slot < m;
+                const size_t t = members[used ? slot : k];  // unused lanes repeat lane 0's tet, weightless
                 for (int i = 0; i < 3; ++i)
                     for (int j = 0; j < 3; ++j) b.Bm.m[i][j][l] = inverse_rest_[9 * t + 3 * i + j];
                 const double weight = used ? -volume_[t] : 0.0;

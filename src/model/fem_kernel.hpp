@@ -3,12 +3,13 @@
 // the forces on nodes 1..3 and f0 = -(f1 + f2 + f3). The blocks carry -V0 lambda and -V0 mu,
 // so Material::stress directly returns -V0 P (see TetBlock).
 //
-// Node data (x, v, f) is 3 doubles per node. With AVX-512 a node's xyz is read with one masked
-// 256-bit load and the kLanes rows are transposed in registers; forces go back per node as an
-// (x, y) pair and a z, each a plain load-add-store. (One masked 256-bit read-modify-write per
-// node would be fewer instructions, but tets share nodes, and a load of a node whose masked
-// store is still in flight cannot be forwarded from it: that variant ran 40% slower.)
-// Elsewhere the lanes are filled and drained one double at a time.
+// Node data (x, v, f) is 3 doubles per node. With AVX-512 a node's xyz is read, and its force
+// added, with one masked 256-bit load (and store) per node and lane, the kLanes rows being
+// transposed in registers. Zen 4 does not forward a masked store to a later load of the same
+// node, so tets of one block that share a node would stall on each other: FemBody::rebuild
+// puts tets far apart along its locality curve into the lanes of a block, and the next
+// block's updates of the same nodes come after the stores have retired. Elsewhere the lanes
+// are filled and drained one double at a time.
 #pragma once
 
 #include "model/tet_block.hpp"
@@ -41,20 +42,29 @@ SH_INLINE void gather_xyz(const double* p, const int32_t* idx, Lanes& x, Lanes& 
 /// share a node). Subtract: f -= instead.
 template <bool Subtract>
 SH_INLINE void scatter_add_xyz(double* f, const int32_t* idx, Lanes x, Lanes y, Lanes z) {
-    // The arrays only name the lanes: GCC keeps them in registers (extracts). Forcing them
-    // through memory was slower: Zen 4 does not forward a 512-bit store to the narrower
-    // reloads at other offsets.
-    alignas(64) double xy_even[8], xy_odd[8], zs[8];
-    _mm512_store_pd(xy_even, _mm512_unpacklo_pd(x, y));  // x0 y0 x2 y2 x4 y4 x6 y6
-    _mm512_store_pd(xy_odd, _mm512_unpackhi_pd(x, y));   // x1 y1 x3 y3 x5 y5 x7 y7
-    _mm512_store_pd(zs, z);
+    const __m512d t0 = _mm512_unpacklo_pd(x, y);  // x0 y0 | x2 y2 | x4 y4 | x6 y6
+    const __m512d t1 = _mm512_unpackhi_pd(x, y);  // x1 y1 | x3 y3 | x5 y5 | x7 y7
+    // Two rows (x, y, z, pad) per register: indices 0-7 pick from t, 8-15 from z.
+    const __m512d r02 = _mm512_permutex2var_pd(t0, _mm512_set_epi64(10, 10, 3, 2, 8, 8, 1, 0), z);
+    const __m512d r46 = _mm512_permutex2var_pd(t0, _mm512_set_epi64(14, 14, 7, 6, 12, 12, 5, 4), z);
+    const __m512d r13 = _mm512_permutex2var_pd(t1, _mm512_set_epi64(11, 11, 3, 2, 9, 9, 1, 0), z);
+    const __m512d r57 = _mm512_permutex2var_pd(t1, _mm512_set_epi64(15, 15, 7, 6, 13, 13, 5, 4), z);
+    const __m256d rows[8] = {_mm512_castpd512_pd256(r02), _mm512_castpd512_pd256(r13),
+                             _mm512_extractf64x4_pd(r02, 1), _mm512_extractf64x4_pd(r13, 1),
+                             _mm512_castpd512_pd256(r46), _mm512_castpd512_pd256(r57),
+                             _mm512_extractf64x4_pd(r46, 1), _mm512_extractf64x4_pd(r57, 1)};
     for (int l = 0; l < 8; ++l) {
         double* q = f + 3 * static_cast<ptrdiff_t>(idx[l]);
-        const __m128d d = _mm_load_pd((l & 1 ? xy_odd : xy_even) + 2 * (l >> 1));
-        const __m128d old = _mm_loadu_pd(q);
-        _mm_storeu_pd(q, Subtract ? _mm_sub_pd(old, d) : _mm_add_pd(old, d));
-        q[2] = Subtract ? q[2] - zs[l] : q[2] + zs[l];
+        const __m256d old = _mm256_maskz_loadu_pd(0x7, q);  // never touches the double after z
+        _mm256_mask_storeu_pd(q, 0x7, Subtract ? _mm256_sub_pd(old, rows[l]) : _mm256_add_pd(old, rows[l]));
     }
+}
+
+/// Lanes with det <= 0 among those with weight != 0 (a NaN det is not counted).
+SH_INLINE int32_t count_non_positive(Lanes det, Lanes weight) {
+    const __m512d zero = _mm512_setzero_pd();
+    const __mmask8 m = _mm512_cmp_pd_mask(det, zero, _CMP_LE_OQ) & _mm512_cmp_pd_mask(weight, zero, _CMP_NEQ_UQ);
+    return __builtin_popcount(static_cast<unsigned>(m));
 }
 
 #else
@@ -84,6 +94,12 @@ SH_INLINE void scatter_add_xyz(double* f, const int32_t* idx, Lanes x, Lanes y, 
     }
 }
 
+SH_INLINE int32_t count_non_positive(Lanes det, Lanes weight) {
+    int32_t n = 0;
+    for (int l = 0; l < kLanes; ++l) n += det[l] <= 0.0 && weight[l] != 0.0;
+    return n;
+}
+
 #endif
 
 /// Per-lane edge matrix [p1 - p0, p2 - p0, p3 - p0] of the block's tets for node array p.
@@ -102,13 +118,13 @@ SH_INLINE Mat3L gather_edges(const TetBlock& b, const double* p) {
 template <class Material, bool Damped>
 int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const double* x, const double* v,
                             double beta, double* f) {
-    Lanes inverted = Lanes{};  // per lane: elements with det F <= 0 (unused lanes weigh 0)
+    int32_t inverted = 0;  // elements with det F <= 0 (unused lanes weigh 0)
     for (size_t k = 0; k < block_count; ++k) {
         const TetBlock& b = blocks[k];
         const Mat3L F = mul(gather_edges(b, x), b.Bm);
-        inverted += select(det(F) <= 0.0 && b.mu_w != 0.0, splat(1.0), Lanes{});
         typename Material::State state;
         Mat3L P = Material::stress(F, b.lambda_w, b.mu_w, state);  // -V0 P
+        inverted += count_non_positive(Material::jacobian(F, state), b.mu_w);
         if (Damped) {
             const Mat3L dF = mul(gather_edges(b, v), b.Bm);
             const Mat3L dP = Material::differential(F, state, dF, b.lambda_w, b.mu_w);
@@ -121,7 +137,7 @@ int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const do
         scatter_add_xyz<true>(f, b.node[0], H.m[0][0] + H.m[0][1] + H.m[0][2], H.m[1][0] + H.m[1][1] + H.m[1][2],
                               H.m[2][0] + H.m[2][1] + H.m[2][2]);
     }
-    return static_cast<int32_t>(lane_sum(inverted));
+    return inverted;
 }
 
 /// Adds the elastic forces of blocks at positions x into f; when v is not null, adds the

@@ -4,7 +4,7 @@ PYTHON ?= python3
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-c test-python test-reduced demo bench clean
+.PHONY: all deps build test test-c test-python test-reduced demo bench report clean
 
 all: build
 
@@ -35,6 +35,16 @@ demo: build
 
 bench: build
 	$(BUILD)/bench/softhap_bench
+
+# Error against run time (bench/accuracy.c, a few minutes on 2 cores): JSON lines, then tables and
+# PNG plots in report/. matplotlib is needed only here and installed on demand. One OpenMP thread
+# per worker process: the accuracy bench runs two of them.
+report: build
+	@$(PYTHON) -c "import matplotlib" 2>/dev/null || $(PYTHON) -m pip install -q matplotlib </dev/null || \
+	  $(PYTHON) -m pip install -q --break-system-packages matplotlib </dev/null
+	@mkdir -p report
+	OMP_NUM_THREADS=1 $(BUILD)/bench/softhap_bench accuracy > report/accuracy.jsonl
+	$(PYTHON) scripts/report.py report/accuracy.jsonl report/
 
 clean:
 	rm -rf build build-no-cholmod build-no-ccd

@@ -3,6 +3,7 @@
  *
  *   softhap_bench [FILTER] [--steps N] [--meshes DIR]      FEM materials and springs
  *   softhap_bench integrators [FILTER] [--steps N]          forward/symplectic Euler, RK2, RK4
+ *   softhap_bench accuracy [--quick] [--jobs N]             error against run time (accuracy.c)
  *
  * Each case builds a world with one body from a mesh in ../shared/meshes (scaled so its largest
  * extent is kMeshSize), gravity on, the highest 1% of the nodes fixed, dt = kDtFraction * dt_crit
@@ -18,6 +19,8 @@
  */
 #define _GNU_SOURCE
 #include <softhap/softhap.h>
+
+#include "accuracy.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -376,6 +379,7 @@ static int file_exists(const char* dir, const char* name) {
 }
 
 int main(int argc, char** argv) {
+    if (argc > 1 && strcmp(argv[1], "accuracy") == 0) return run_accuracy(argc - 1, argv + 1);
     const char* filter = NULL;
     int integrators = 0;
     for (int i = 1; i < argc; ++i) {

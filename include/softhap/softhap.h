@@ -479,7 +479,8 @@ SH_API sh_status sh_body_write_vtu(const sh_world* world, sh_body_id body, const
 /** Settings of sh_world_solve_static. Initialise with sh_static_def_default. */
 typedef struct sh_static_def {
     uint32_t internal_init;         /**< set by sh_static_def_default; do not touch */
-    double tolerance;               /**< stop when |residual| / |applied load| is below; 1e-10 */
+    double tolerance;               /**< stop when |residual| / |applied load| is below this or
+                                         below the round-off of the internal forces; 1e-10 */
     int32_t max_iterations;         /**< Newton iterations per load step; default 50 */
     int32_t load_steps;             /**< apply the loads in this many equal increments; 1 */
     sh_linear_solver linear_solver; /**< default SH_LINEAR_SOLVER_DEFAULT */

@@ -23,20 +23,6 @@ LinearSolverKind solver_kind(sh_linear_solver kind) {
     }
 }
 
-// Round-off level of the residual dt |f|: forces are computed from position differences that
-// carry an error of about eps |x|, which the stiffness turns into eps |x| K_dd per DOF. system
-// holds dt^2 K (+ damping) here, whose diagonal gives K_dd.
-double residual_roundoff(const SparseSystem& system, const vec<double>& x, double dt) {
-    double largest = 0.0;
-    for (const double c : x) largest = std::max(largest, std::fabs(c));
-    double sum = 0.0;
-    for (int32_t d = 0; d < system.dof_count(); ++d) {
-        const double k = system.values()[static_cast<size_t>(system.diagonal_slot(d))] / dt;
-        sum += k * k;
-    }
-    return 64.0 * std::numeric_limits<double>::epsilon() * largest * std::sqrt(sum);
-}
-
 double norm(const vec<double>& a) {
     double s = 0.0;
     for (double v : a) s += v * v;
@@ -44,6 +30,17 @@ double norm(const vec<double>& a) {
 }
 
 }  // namespace
+
+double force_roundoff(const SparseSystem& system, const vec<double>& x, double scale) {
+    double largest = 0.0;
+    for (const double c : x) largest = std::max(largest, std::fabs(c));
+    double sum = 0.0;
+    for (int32_t d = 0; d < system.dof_count(); ++d) {
+        const double k = scale * system.values()[static_cast<size_t>(system.diagonal_slot(d))];
+        sum += k * k;
+    }
+    return 64.0 * std::numeric_limits<double>::epsilon() * largest * std::sqrt(sum);
+}
 
 int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_implicit_settings& s) {
     const int32_t n = body.node_count();
@@ -126,7 +123,7 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
 
         state.system.clear_values();
         body.add_tangent(body.x.data(), dt * dt, dt, state.system);
-        if (iteration == 0) roundoff_floor = residual_roundoff(state.system, body.x, dt);
+        if (iteration == 0) roundoff_floor = force_roundoff(state.system, body.x, 1.0 / dt);  // system: dt^2 K
         state.system.add_diagonal(state.diagonal.data(), 1.0);
         try {
             state.solver->factorize(state.system);

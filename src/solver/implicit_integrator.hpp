@@ -26,6 +26,11 @@ struct ImplicitState {
 /// state (SH_ERR_UNSTABLE) the body is restored and result.status says why.
 BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double gravity[3]);
 
+/// Round-off level of internal forces computed at positions x: they come from position
+/// differences that carry about eps |x|, which a stiffness turns into eps |x| K_dd per DOF.
+/// system holds K / scale (its diagonal times scale is K_dd); the result is in force units.
+double force_roundoff(const SparseSystem& system, const vec<double>& x, double scale);
+
 /// Rebuilds state's pattern, solver and symbolic analysis if body's free nodes changed since
 /// the last call. Returns the number of free DOFs.
 int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_implicit_settings& settings);

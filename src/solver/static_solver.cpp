@@ -72,9 +72,12 @@ void solve_static_body(Body& body, const double g[3], const sh_static_def& def, 
         const double factor = static_cast<double>(load_step) / def.load_steps;
         double r = out_of_balance(body, state, g, factor, scratch, residual) / load_norm;
         bool converged = r <= def.tolerance;
+        double floor = 0.0;
         for (int32_t iteration = 0; iteration < def.max_iterations && !converged; ++iteration) {
             state.system.clear_values();
             body.add_tangent(body.x.data(), 1.0, 0.0, state.system);
+            // Below the round-off of the internal forces the residual cannot fall further.
+            floor = std::max(floor, force_roundoff(state.system, body.x, 1.0) / load_norm);
             state.solver->factorize(state.system);
             state.solver->solve(state.system, residual.data(), step.data());
             double slope = 0.0;  // d potential / d alpha at alpha = 0
@@ -93,7 +96,7 @@ void solve_static_body(Body& body, const double g[3], const sh_static_def& def, 
             }
             ++report.iterations;
             if (report.history_count < SH_STATIC_HISTORY) report.residual_history[report.history_count++] = r;
-            converged = r <= def.tolerance;
+            converged = r <= std::max(def.tolerance, floor);
             require(std::isfinite(r), SH_ERR_SOLVER, "the Newton iteration produced a non-finite state");
         }
         report.residual = std::max(report.residual, r);

@@ -74,8 +74,8 @@ void require_finite_solution(const SparseSystem& a, const double* x, const char*
         if (!std::isfinite(x[i])) {
             char dof[96];
             a.describe_dof(static_cast<int32_t>(i), dof, sizeof dof);
-            throw Error(SH_ERR_SOLVER, format("%s: non-finite solution at %s (non-finite right-hand side or "
-                                              "singular matrix)", backend, dof));
+            throw Error(SH_ERR_SOLVER, format("%s: non-finite solution at free DOF %zu (%s): non-finite "
+                                              "right-hand side or singular matrix", backend, i, dof));
         }
 }
 

@@ -262,9 +262,9 @@ int32_t SparseSystem::first_nonfinite_column() const {
 void SparseSystem::describe_dof(int32_t d, char* out, size_t size) const {
     if (d >= 0 && d < dof_count_) {
         const int32_t g = dof_to_global_[static_cast<size_t>(d)];
-        std::snprintf(out, size, "free DOF %d (node %d, component %c)", d, g / 3, "xyz"[g % 3]);
+        std::snprintf(out, size, "node %d, component %c", g / 3, "xyz"[g % 3]);
     } else {
-        std::snprintf(out, size, "free DOF %d", d);
+        std::snprintf(out, size, "no such free DOF");
     }
 }
 

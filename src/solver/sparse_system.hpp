@@ -66,7 +66,7 @@ public:
     size_t scatter_block_count() const { return block_records_.size(); }
     /// -1 if every value is finite, else the column of the first non-finite value.
     int32_t first_nonfinite_column() const;
-    /// Human-readable name of free DOF d for messages: "free DOF d (node n, component c)".
+    /// The node and component free DOF d stands for, for messages: "node n, component x".
     void describe_dof(int32_t d, char* out, size_t size) const;
 
 private:

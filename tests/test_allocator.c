@@ -126,42 +126,6 @@ static int setup_install(void** state) {
 /* ------------------------------------------------------------------------------------------ */
 /* Scenes                                                                                       */
 
-/* Box node and tet arrays like sh_test_box, without creating the mesh (so that the creation's
- * status can be checked under failure injection). The caller frees both. */
-static void box_arrays(double lx, double ly, double lz, int nx, int ny, int nz, double** out_nodes,
-                       int32_t* out_node_count, int32_t** out_tets, int32_t* out_tet_count) {
-    const int px = nx + 1, py = ny + 1, pz = nz + 1;
-    const int node_count = px * py * pz, tet_count = 6 * nx * ny * nz;
-    double* nodes = malloc(sizeof(double) * 3 * (size_t)node_count);
-    int32_t* tets = malloc(sizeof(int32_t) * 4 * (size_t)tet_count);
-    assert_non_null(nodes);
-    assert_non_null(tets);
-    for (int k = 0; k < pz; ++k)
-        for (int j = 0; j < py; ++j)
-            for (int i = 0; i < px; ++i) {
-                double* p = &nodes[3 * (size_t)((k * py + j) * px + i)];
-                p[0] = lx * i / nx;
-                p[1] = ly * j / ny;
-                p[2] = lz * k / nz;
-            }
-    static const int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-    int t = 0;
-    for (int k = 0; k < nz; ++k)
-        for (int j = 0; j < ny; ++j)
-            for (int i = 0; i < nx; ++i) {
-                const int c[8] = {(k * py + j) * px + i,           (k * py + j) * px + i + 1,
-                                  (k * py + j + 1) * px + i + 1,   (k * py + j + 1) * px + i,
-                                  ((k + 1) * py + j) * px + i,     ((k + 1) * py + j) * px + i + 1,
-                                  ((k + 1) * py + j + 1) * px + i + 1, ((k + 1) * py + j + 1) * px + i};
-                for (int s = 0; s < 6; ++s, ++t)
-                    for (int a = 0; a < 4; ++a) tets[4 * t + a] = c[kuhn[s][a]];
-            }
-    *out_nodes = nodes;
-    *out_node_count = node_count;
-    *out_tets = tets;
-    *out_tet_count = tet_count;
-}
-
 /* The nodes of the box with x == 0 (the first node of every row). */
 static int32_t x0_nodes(int nx, int ny, int nz, int32_t* out) {
     int32_t count = 0;
@@ -623,7 +587,9 @@ static void test_failing_allocator(void** state) {
     double* nodes;
     int32_t* tets;
     int32_t node_count, tet_count;
-    box_arrays(0.02, 0.01, 0.01, 2, 1, 1, &nodes, &node_count, &tets, &tet_count);
+    sh_test_box_arrays(0.02, 0.01, 0.01, 2, 1, 1, &nodes, &node_count, &tets, &tet_count);
+    assert_non_null(nodes);
+    assert_non_null(tets);
     assert_true(node_count <= 64);
 
     /* How many allocations the whole scene takes when nothing fails. */

@@ -56,11 +56,17 @@ sh_mesh* sh_test_unit_tet(double s) {
     return mesh;
 }
 
-sh_mesh* sh_test_box(double lx, double ly, double lz, int nx, int ny, int nz) {
+void sh_test_box_arrays(double lx, double ly, double lz, int nx, int ny, int nz, double** out_nodes,
+                        int32_t* out_node_count, int32_t** out_tets, int32_t* out_tet_count) {
     const int px = nx + 1, py = ny + 1, pz = nz + 1;
     const int node_count = px * py * pz, tet_count = 6 * nx * ny * nz;
     double* nodes = malloc(sizeof(double) * 3 * (size_t)node_count);
     int32_t* tets = malloc(sizeof(int32_t) * 4 * (size_t)tet_count);
+    *out_nodes = nodes;
+    *out_node_count = node_count;
+    *out_tets = tets;
+    *out_tet_count = tet_count;
+    if (nodes == NULL || tets == NULL) return;
     for (int k = 0; k < pz; ++k)
         for (int j = 0; j < py; ++j)
             for (int i = 0; i < px; ++i) {
@@ -83,9 +89,27 @@ sh_mesh* sh_test_box(double lx, double ly, double lz, int nx, int ny, int nz) {
                 for (int s = 0; s < 6; ++s, ++t)
                     for (int a = 0; a < 4; ++a) tets[4 * t + a] = c[kuhn[s][a]];
             }
+}
+
+sh_mesh* sh_test_box(double lx, double ly, double lz, int nx, int ny, int nz) {
+    double* nodes;
+    int32_t* tets;
+    int32_t node_count, tet_count;
+    sh_test_box_arrays(lx, ly, lz, nx, ny, nz, &nodes, &node_count, &tets, &tet_count);
     sh_mesh* mesh = NULL;
     sh_test_assert_status(sh_mesh_create(nodes, node_count, tets, tet_count, &mesh), SH_OK, "sh_mesh_create", __FILE__, __LINE__);
     free(nodes);
     free(tets);
     return mesh;
+}
+
+void sh_test_stiff_implicit_def(sh_fem_body_def* def, const sh_mesh* mesh, sh_material_model model) {
+    sh_fem_body_def_default(def);
+    def->mesh = mesh;
+    def->material.model = model;
+    def->material.young = 1e9;
+    def->material.poisson = 0.3;
+    def->integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+    def->implicit.newton_max_iterations = 10;
+    def->implicit.newton_tolerance = 1e-10;
 }

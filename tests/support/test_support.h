@@ -42,4 +42,13 @@ sh_mesh* sh_test_unit_tet(double s);
 /** An axis-aligned box [0,lx]x[0,ly]x[0,lz] split into nx*ny*nz cubes of 6 tets each. */
 sh_mesh* sh_test_box(double lx, double ly, double lz, int nx, int ny, int nz);
 
+/** The node and tet arrays of sh_test_box, without creating the mesh. The caller frees both
+ *  (either may be NULL if allocation failed; the counts are set regardless). */
+void sh_test_box_arrays(double lx, double ly, double lz, int nx, int ny, int nz, double** out_nodes,
+                        int32_t* out_node_count, int32_t** out_tets, int32_t* out_tet_count);
+
+/** Fills def with the defaults and a stiff (E = 1 GPa, nu = 0.3) FEM body on mesh with the given
+ *  material model, integrated by implicit Euler with at most 10 Newton iterations to 1e-10. */
+void sh_test_stiff_implicit_def(sh_fem_body_def* def, const sh_mesh* mesh, sh_material_model model);
+
 #endif

@@ -198,14 +198,7 @@ static void test_stiff_cube_energy_never_grows(void** state) {
     for (int model = 0; model < 4; ++model) {
         sh_world* world = sh_test_world(-9.81);
         sh_fem_body_def def;
-        sh_fem_body_def_default(&def);
-        def.mesh = cube;
-        def.material.model = (sh_material_model)model;
-        def.material.young = 1e9;
-        def.material.poisson = 0.3;
-        def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
-        def.implicit.newton_max_iterations = 10;
-        def.implicit.newton_tolerance = 1e-10;
+        sh_test_stiff_implicit_def(&def, cube, (sh_material_model)model);
         sh_body_id body;
         assert_ok(sh_world_add_fem_body(world, &def, &body));
         assert_ok(sh_body_fix_nodes(world, body, bottom, nb));

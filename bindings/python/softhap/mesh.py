@@ -6,11 +6,12 @@ import numpy as np
 
 from . import _arrays
 from ._lib import sh_mesh_info
-from ._loaded import check, closed_error, lib
+from ._handle import OwnedHandle
+from ._loaded import check, lib
 from ._record import MeshInfo
 
 
-class Mesh:
+class Mesh(OwnedHandle):
     """An immutable tetrahedral mesh: nodes (m), tets reoriented to positive volume and the
     outward surface. Wraps sh_mesh.
 
@@ -18,6 +19,9 @@ class Mesh:
     copy what they need, so a mesh may be closed once the bodies are made. The C object is freed
     by close(), by leaving a ``with`` block, or when the Mesh is garbage collected.
     """
+
+    _kind = "mesh"
+    _destroy = "sh_mesh_destroy"
 
     def __init__(self, nodes, tets):
         """Create a mesh from nodes (n x 3 floats, m) and tets (m x 4 zero-based node indices).
@@ -78,43 +82,6 @@ class Mesh:
         mesh._handle = out.value
         del offset
         return mesh
-
-    # -- lifetime --------------------------------------------------------------------------
-
-    def close(self):
-        """Destroy the C mesh now. Safe to call more than once; later use raises softhap.Error."""
-        handle, self._handle = self._handle, None
-        if handle is not None:
-            check(lib.sh_mesh_destroy(handle), "sh_mesh_destroy")
-
-    @property
-    def closed(self):
-        """True once close() has been called."""
-        return self._handle is None
-
-    def __enter__(self):
-        """Use the mesh in a ``with`` block; it is closed at the end."""
-        return self
-
-    def __exit__(self, *exc_info):
-        """Close the mesh at the end of a ``with`` block."""
-        self.close()
-        return False
-
-    def __del__(self):
-        """Free the C mesh if close() was not called."""
-        handle = getattr(self, "_handle", None)
-        if handle is not None:
-            self._handle = None
-            try:
-                lib.sh_mesh_destroy(handle)
-            except Exception:  # interpreter shutdown: ctypes may already be torn down
-                pass
-
-    def _require_handle(self, function):
-        if self._handle is None:
-            raise closed_error("mesh", function)
-        return self._handle
 
     def __repr__(self):
         if self._handle is None:

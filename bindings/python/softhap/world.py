@@ -24,6 +24,7 @@ from ._lib import (
     sh_step_report,
     sh_world_def,
 )
+from ._handle import OwnedHandle
 from ._loaded import check, closed_error, last_error_message, lib, status_string
 from ._record import BodyInfo, StaticReport, StepReport
 from .mesh import Mesh
@@ -96,6 +97,23 @@ def _set_implicit(settings, linear_solver, newton_max_iterations, newton_toleran
         settings.cg_max_iterations = _arrays.count(cg_max_iterations, "cg_max_iterations")
 
 
+def _set_body_options(definition, integrator, on_unstable, damping_mass, runaway_speed,
+                      linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
+                      cg_max_iterations):
+    """Fill the options sh_fem_body_def and sh_spring_body_def share from keyword arguments
+    (None keeps the C default)."""
+    if integrator is not None:
+        definition.integrator = _choose(integrator, INTEGRATORS, "integrator")
+    if on_unstable is not None:
+        definition.on_unstable = _choose(on_unstable, UNSTABLE_POLICIES, "on_unstable")
+    if damping_mass is not None:
+        definition.damping_mass = float(damping_mass)
+    if runaway_speed is not None:
+        definition.runaway_speed = float(runaway_speed)
+    _set_implicit(definition.implicit, linear_solver, newton_max_iterations, newton_tolerance,
+                  cg_tolerance, cg_max_iterations)
+
+
 def _default_material():
     """The material sh_fem_body_def_default chooses (StVK, 3 kPa, 0.45, 1000 kg/m^3)."""
     definition = sh_fem_body_def()
@@ -103,13 +121,16 @@ def _default_material():
     return definition.material
 
 
-class World:
+class World(OwnedHandle):
     """A simulation world (sh_world): owns bodies and steps them.
 
     World(gravity=(0, 0, -9.81)) creates one. The C world and all its bodies are freed by
     close(), at the end of a ``with`` block, or when the World is garbage collected (a Body
     keeps its World alive).
     """
+
+    _kind = "world"
+    _destroy = "sh_world_destroy"
 
     def __init__(self, gravity=(0.0, 0.0, -9.81)):
         """Create a world with the given gravitational acceleration (3 floats, m/s^2)."""
@@ -129,38 +150,7 @@ class World:
     def close(self):
         """Destroy the C world and all its bodies now. Safe to call more than once; later use of
         the world or of its Body objects raises softhap.Error (SH_ERR_INVALID_HANDLE)."""
-        handle, self._handle = self._handle, None
-        if handle is not None:
-            check(lib.sh_world_destroy(handle), "sh_world_destroy")
-
-    @property
-    def closed(self):
-        """True once close() has been called."""
-        return self._handle is None
-
-    def __enter__(self):
-        """Use the world in a ``with`` block; it is closed at the end."""
-        return self
-
-    def __exit__(self, *exc_info):
-        """Close the world at the end of a ``with`` block."""
-        self.close()
-        return False
-
-    def __del__(self):
-        """Free the C world if close() was not called."""
-        handle = getattr(self, "_handle", None)
-        if handle is not None:
-            self._handle = None
-            try:
-                lib.sh_world_destroy(handle)
-            except Exception:  # interpreter shutdown: ctypes may already be torn down
-                pass
-
-    def _require_handle(self, function=None):
-        if self._handle is None:
-            raise closed_error("world", function)
-        return self._handle
+        OwnedHandle.close(self)
 
     def __repr__(self):
         state = "closed" if self._handle is None else "gravity=%r" % (self._gravity,)
@@ -295,18 +285,11 @@ class World:
             definition.material.poisson = float(poisson)
         if density is not None:
             definition.material.density = float(density)
-        if integrator is not None:
-            definition.integrator = _choose(integrator, INTEGRATORS, "integrator")
-        if on_unstable is not None:
-            definition.on_unstable = _choose(on_unstable, UNSTABLE_POLICIES, "on_unstable")
-        if damping_mass is not None:
-            definition.damping_mass = float(damping_mass)
         if damping_stiffness is not None:
             definition.damping_stiffness = float(damping_stiffness)
-        if runaway_speed is not None:
-            definition.runaway_speed = float(runaway_speed)
-        _set_implicit(definition.implicit, linear_solver, newton_max_iterations, newton_tolerance,
-                      cg_tolerance, cg_max_iterations)
+        _set_body_options(definition, integrator, on_unstable, damping_mass, runaway_speed,
+                          linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
+                          cg_max_iterations)
         body = sh_body_id()
         check(
             lib.sh_world_add_fem_body(handle, ctypes.byref(definition), ctypes.byref(body)),
@@ -408,16 +391,9 @@ class World:
                 mass_array = _arrays.float_array(mass, "mass", (node_count,))
                 keep_alive.append(mass_array)
                 definition.node_masses = _arrays.double_ptr(mass_array)
-        if integrator is not None:
-            definition.integrator = _choose(integrator, INTEGRATORS, "integrator")
-        if on_unstable is not None:
-            definition.on_unstable = _choose(on_unstable, UNSTABLE_POLICIES, "on_unstable")
-        if damping_mass is not None:
-            definition.damping_mass = float(damping_mass)
-        if runaway_speed is not None:
-            definition.runaway_speed = float(runaway_speed)
-        _set_implicit(definition.implicit, linear_solver, newton_max_iterations, newton_tolerance,
-                      cg_tolerance, cg_max_iterations)
+        _set_body_options(definition, integrator, on_unstable, damping_mass, runaway_speed,
+                          linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
+                          cg_max_iterations)
 
         body = sh_body_id()
         status = lib.sh_world_add_spring_body(handle, ctypes.byref(definition), ctypes.byref(body))
@@ -518,6 +494,14 @@ class Body:
     def _node_vectors(self, value, name):
         return _arrays.float_array(value, name, (self.node_count, 3))
 
+    def _write_node_vectors(self, function_name, value, name):
+        handle = self._world_handle(function_name)
+        array = self._node_vectors(value, name)
+        check(
+            getattr(lib, function_name)(handle, self._id, _arrays.double_ptr(array), array.shape[0]),
+            function_name,
+        )
+
     @property
     def positions(self):
         """Node positions, an (n, 3) array (m). Reading returns a copy; assigning an (n, 3)
@@ -526,12 +510,7 @@ class Body:
 
     @positions.setter
     def positions(self, value):
-        handle = self._world_handle("sh_body_set_positions")
-        array = self._node_vectors(value, "positions")
-        check(
-            lib.sh_body_set_positions(handle, self._id, _arrays.double_ptr(array), array.shape[0]),
-            "sh_body_set_positions",
-        )
+        self._write_node_vectors("sh_body_set_positions", value, "positions")
 
     @property
     def velocities(self):
@@ -541,14 +520,7 @@ class Body:
 
     @velocities.setter
     def velocities(self, value):
-        handle = self._world_handle("sh_body_set_velocities")
-        array = self._node_vectors(value, "velocities")
-        check(
-            lib.sh_body_set_velocities(
-                handle, self._id, _arrays.double_ptr(array), array.shape[0]
-            ),
-            "sh_body_set_velocities",
-        )
+        self._write_node_vectors("sh_body_set_velocities", value, "velocities")
 
     @property
     def masses(self):

@@ -97,6 +97,38 @@ static void move_a_bit(sh_world* world) {
     for (int i = 0; i < 5; ++i) assert_ok(sh_world_step(world, 1e-4, NULL));
 }
 
+/* Fixture: a world with an FEM body on a one-cube box (6 tets, 8 nodes), stepped a little
+ * (and, for setup_moved_box_and_spring, a two-node spring body added before the steps). */
+typedef struct moved_box {
+    sh_world* world;
+    sh_mesh* mesh;
+    sh_body_id body;
+    sh_body_id spring;
+} moved_box;
+
+static int open_moved_box(void** state, int with_spring) {
+    static moved_box box;
+    moved_box* s = &box;
+    s->world = make_world();
+    s->mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
+    s->body = add_fem(s->world, s->mesh);
+    s->spring = with_spring ? add_two_node_spring(s->world) : SH_NULL_BODY;
+    move_a_bit(s->world);
+    *state = s;
+    return 0;
+}
+
+static int setup_moved_box(void** state) { return open_moved_box(state, 0); }
+
+static int setup_moved_box_and_spring(void** state) { return open_moved_box(state, 1); }
+
+static int teardown_moved_box(void** state) {
+    moved_box* s = *state;
+    assert_ok(sh_mesh_destroy(s->mesh));
+    assert_ok(sh_world_destroy(s->world));
+    return 0;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* Version, status strings, last error                                                          */
 
@@ -658,60 +690,54 @@ static void test_material_validation_in_def(void** state) {
 }
 
 static void test_material_validation_in_set_material(void** state) {
-    (void)state;
-    sh_world* world = make_world();
-    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1); /* 6 tets */
-    const sh_body_id body = add_fem(world, mesh);
-    move_a_bit(world);
-    const int32_t n = node_count_of(world, body);
+    const moved_box* s = *state;
+    const int32_t n = node_count_of(s->world, s->body);
     double masses_before[8], masses_after[8];
     assert_int_equal(n, 8);
-    assert_ok(sh_body_get_masses(world, body, masses_before, n));
-    double* x = copy_positions(world, body);
-    double* v = copy_velocities(world, body);
+    assert_ok(sh_body_get_masses(s->world, s->body, masses_before, n));
+    double* x = copy_positions(s->world, s->body);
+    double* v = copy_velocities(s->world, s->body);
     double energy_before, energy_after;
-    assert_ok(sh_body_get_elastic_energy(world, body, &energy_before));
+    assert_ok(sh_body_get_elastic_energy(s->world, s->body, &energy_before));
 
     const int32_t all[6] = {0, 1, 2, 3, 4, 5};
     for (size_t i = 0; i < sizeof k_bad_materials / sizeof k_bad_materials[0]; ++i) {
         const sh_material m = {SH_MATERIAL_STVK, k_bad_materials[i].young, k_bad_materials[i].poisson,
                                k_bad_materials[i].density};
-        assert_error(sh_body_set_material(world, body, all, 6, &m), SH_ERR_INVALID_ARGUMENT,
+        assert_error(sh_body_set_material(s->world, s->body, all, 6, &m), SH_ERR_INVALID_ARGUMENT,
                      k_bad_materials[i].needle);
     }
     const sh_material good = {SH_MATERIAL_NEOHOOKEAN, 2e4, 0.4, 2000};
     const sh_material bad_model = {(sh_material_model)-1, 2e4, 0.4, 2000};
-    assert_error(sh_body_set_material(world, body, all, 6, &bad_model), SH_ERR_INVALID_ARGUMENT, "model");
+    assert_error(sh_body_set_material(s->world, s->body, all, 6, &bad_model), SH_ERR_INVALID_ARGUMENT, "model");
     /* Element indices out of range: nothing changes, even for the valid indices before it. */
     const int32_t out_of_range_high[3] = {0, 1, 6};
     const int32_t out_of_range_low[2] = {2, -1};
     const int32_t huge[1] = {INT32_MAX};
-    assert_error(sh_body_set_material(world, body, out_of_range_high, 3, &good), SH_ERR_INVALID_ARGUMENT, "elements[2]");
-    assert_error(sh_body_set_material(world, body, out_of_range_low, 2, &good), SH_ERR_INVALID_ARGUMENT, "elements[1]");
-    assert_error(sh_body_set_material(world, body, huge, 1, &good), SH_ERR_INVALID_ARGUMENT, "elements[0]");
-    assert_error(sh_body_set_material(world, body, all, -1, &good), SH_ERR_INVALID_ARGUMENT, "element_count");
+    assert_error(sh_body_set_material(s->world, s->body, out_of_range_high, 3, &good), SH_ERR_INVALID_ARGUMENT, "elements[2]");
+    assert_error(sh_body_set_material(s->world, s->body, out_of_range_low, 2, &good), SH_ERR_INVALID_ARGUMENT, "elements[1]");
+    assert_error(sh_body_set_material(s->world, s->body, huge, 1, &good), SH_ERR_INVALID_ARGUMENT, "elements[0]");
+    assert_error(sh_body_set_material(s->world, s->body, all, -1, &good), SH_ERR_INVALID_ARGUMENT, "element_count");
 
     /* Failed calls changed neither masses nor the state nor the stiffness. */
-    assert_ok(sh_body_get_masses(world, body, masses_after, n));
+    assert_ok(sh_body_get_masses(s->world, s->body, masses_after, n));
     assert_memory_equal(masses_after, masses_before, sizeof(double) * (size_t)n);
-    assert_state_is(world, body, x, v);
-    assert_ok(sh_body_get_elastic_energy(world, body, &energy_after));
+    assert_state_is(s->world, s->body, x, v);
+    assert_ok(sh_body_get_elastic_energy(s->world, s->body, &energy_after));
     assert_memory_equal(&energy_after, &energy_before, sizeof(double));
 
     /* The valid call does change the masses (density doubled on every element). */
-    assert_ok(sh_body_set_material(world, body, all, 6, &good));
-    assert_ok(sh_body_get_masses(world, body, masses_after, n));
+    assert_ok(sh_body_set_material(s->world, s->body, all, 6, &good));
+    assert_ok(sh_body_get_masses(s->world, s->body, masses_after, n));
     for (int32_t i = 0; i < n; ++i) assert_close(masses_after[i], 2.0 * masses_before[i], 1e-12);
 
-    /* sh_body_set_material on a mass-spring body is unsupported. */
-    const sh_body_id spring = add_two_node_spring(world);
+    /* sh_body_set_material on a mass-spring s->body is unsupported. */
+    const sh_body_id spring = add_two_node_spring(s->world);
     const int32_t zero = 0;
-    assert_error(sh_body_set_material(world, spring, &zero, 1, &good), SH_ERR_UNSUPPORTED, "spring");
+    assert_error(sh_body_set_material(s->world, spring, &zero, 1, &good), SH_ERR_UNSUPPORTED, "spring");
 
     free(x);
     free(v);
-    assert_ok(sh_mesh_destroy(mesh));
-    assert_ok(sh_world_destroy(world));
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -872,47 +898,36 @@ static void test_spring_def_errors(void** state) {
 /* Stepping and state                                                                           */
 
 static void test_step_rejects_bad_dt(void** state) {
-    (void)state;
-    sh_world* world = make_world();
-    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
-    const sh_body_id body = add_fem(world, mesh);
-    const sh_body_id spring = add_two_node_spring(world);
-    move_a_bit(world);
-    double* x = copy_positions(world, body);
-    double* v = copy_velocities(world, body);
-    double* xs = copy_positions(world, spring);
-    double* vs = copy_velocities(world, spring);
+    const moved_box* s = *state;
+    double* x = copy_positions(s->world, s->body);
+    double* v = copy_velocities(s->world, s->body);
+    double* xs = copy_positions(s->world, s->spring);
+    double* vs = copy_velocities(s->world, s->spring);
     uint64_t warnings_before[SH_WARN_COUNT], warnings_after[SH_WARN_COUNT];
-    assert_ok(sh_world_get_warnings(world, warnings_before));
+    assert_ok(sh_world_get_warnings(s->world, warnings_before));
 
     const double bad[] = {0.0, -0.0, -1e-3, NAN, -NAN, INFINITY, -INFINITY};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         sh_step_report report;
-        assert_error(sh_world_step(world, bad[i], &report), SH_ERR_INVALID_ARGUMENT, "dt");
-        assert_error(sh_world_step(world, bad[i], NULL), SH_ERR_INVALID_ARGUMENT, "dt");
+        assert_error(sh_world_step(s->world, bad[i], &report), SH_ERR_INVALID_ARGUMENT, "dt");
+        assert_error(sh_world_step(s->world, bad[i], NULL), SH_ERR_INVALID_ARGUMENT, "dt");
     }
-    assert_state_is(world, body, x, v);
-    assert_state_is(world, spring, xs, vs);
-    assert_ok(sh_world_get_warnings(world, warnings_after));
+    assert_state_is(s->world, s->body, x, v);
+    assert_state_is(s->world, s->spring, xs, vs);
+    assert_ok(sh_world_get_warnings(s->world, warnings_after));
     assert_memory_equal(warnings_after, warnings_before, sizeof warnings_before);
 
     free(x);
     free(v);
     free(xs);
     free(vs);
-    assert_ok(sh_mesh_destroy(mesh));
-    assert_ok(sh_world_destroy(world));
 }
 
 static void test_set_state_rejects_non_finite_and_wrong_counts(void** state) {
-    (void)state;
-    sh_world* world = make_world();
-    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
-    const sh_body_id body = add_fem(world, mesh);
-    move_a_bit(world);
-    const int32_t n = node_count_of(world, body);
-    double* x = copy_positions(world, body);
-    double* v = copy_velocities(world, body);
+    const moved_box* s = *state;
+    const int32_t n = node_count_of(s->world, s->body);
+    double* x = copy_positions(s->world, s->body);
+    double* v = copy_velocities(s->world, s->body);
     double* input = malloc(sizeof(double) * 3 * (size_t)n);
     assert_non_null(input);
     const double non_finite[] = {NAN, INFINITY, -INFINITY};
@@ -922,60 +937,54 @@ static void test_set_state_rejects_non_finite_and_wrong_counts(void** state) {
         memcpy(input, x, sizeof(double) * 3 * (size_t)n);
         for (int32_t i = 0; i < 3 * n; ++i) input[i] += 1e-3;
         input[3 * n - 1] = non_finite[k];
-        assert_error(sh_body_set_positions(world, body, input, n), SH_ERR_INVALID_ARGUMENT, "positions");
-        assert_error(sh_body_set_velocities(world, body, input, n), SH_ERR_INVALID_ARGUMENT, "velocities");
-        assert_error(sh_body_set_external_forces(world, body, input, n), SH_ERR_INVALID_ARGUMENT, "forces");
+        assert_error(sh_body_set_positions(s->world, s->body, input, n), SH_ERR_INVALID_ARGUMENT, "positions");
+        assert_error(sh_body_set_velocities(s->world, s->body, input, n), SH_ERR_INVALID_ARGUMENT, "velocities");
+        assert_error(sh_body_set_external_forces(s->world, s->body, input, n), SH_ERR_INVALID_ARGUMENT, "forces");
         const int32_t node = 3;
         const double target[3] = {0.0, non_finite[k], 0.0};
-        assert_error(sh_body_prescribe_positions(world, body, &node, target, 1), SH_ERR_INVALID_ARGUMENT,
+        assert_error(sh_body_prescribe_positions(s->world, s->body, &node, target, 1), SH_ERR_INVALID_ARGUMENT,
                      "positions");
-        assert_state_is(world, body, x, v);
+        assert_state_is(s->world, s->body, x, v);
     }
     /* Wrong node counts. */
     memcpy(input, x, sizeof(double) * 3 * (size_t)n);
     const int32_t wrong[] = {n - 1, n + 1, 0, -1, INT32_MIN};
     for (size_t k = 0; k < sizeof wrong / sizeof wrong[0]; ++k) {
-        assert_error(sh_body_set_positions(world, body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT, "node_count");
-        assert_error(sh_body_set_velocities(world, body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT, "node_count");
-        assert_error(sh_body_set_external_forces(world, body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT,
+        assert_error(sh_body_set_positions(s->world, s->body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT, "node_count");
+        assert_error(sh_body_set_velocities(s->world, s->body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT, "node_count");
+        assert_error(sh_body_set_external_forces(s->world, s->body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT,
                      "node_count");
-        assert_error(sh_body_set_node_damping(world, body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT, "node_count");
+        assert_error(sh_body_set_node_damping(s->world, s->body, input, wrong[k]), SH_ERR_INVALID_ARGUMENT, "node_count");
     }
     /* Bad node damping coefficients. */
     double coefficients[8] = {1, 1, 1, 1, 1, 1, 1, -1};
     assert_int_equal(n, 8);
-    assert_error(sh_body_set_node_damping(world, body, coefficients, n), SH_ERR_INVALID_ARGUMENT, "coefficients[7]");
+    assert_error(sh_body_set_node_damping(s->world, s->body, coefficients, n), SH_ERR_INVALID_ARGUMENT, "coefficients[7]");
     coefficients[7] = NAN;
-    assert_error(sh_body_set_node_damping(world, body, coefficients, n), SH_ERR_INVALID_ARGUMENT, "coefficients[7]");
+    assert_error(sh_body_set_node_damping(s->world, s->body, coefficients, n), SH_ERR_INVALID_ARGUMENT, "coefficients[7]");
     /* Bad gravity. */
     const double bad_gravity[3] = {0, NAN, 0};
-    assert_error(sh_world_set_gravity(world, bad_gravity), SH_ERR_INVALID_ARGUMENT, "gravity");
+    assert_error(sh_world_set_gravity(s->world, bad_gravity), SH_ERR_INVALID_ARGUMENT, "gravity");
 
-    assert_state_is(world, body, x, v);
+    assert_state_is(s->world, s->body, x, v);
 
     /* A good set_positions does change them (so the comparisons above are meaningful). */
     for (int32_t i = 0; i < 3 * n; ++i) input[i] = x[i] + 1e-3;
-    assert_ok(sh_body_set_positions(world, body, input, n));
-    double* x_after = copy_positions(world, body);
+    assert_ok(sh_body_set_positions(s->world, s->body, input, n));
+    double* x_after = copy_positions(s->world, s->body);
     assert_memory_equal(x_after, input, sizeof(double) * 3 * (size_t)n);
 
     free(x_after);
     free(input);
     free(x);
     free(v);
-    assert_ok(sh_mesh_destroy(mesh));
-    assert_ok(sh_world_destroy(world));
 }
 
 static void test_get_capacity_too_small(void** state) {
-    (void)state;
-    sh_world* world = make_world();
-    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
-    const sh_body_id body = add_fem(world, mesh);
-    move_a_bit(world);
-    const int32_t n = node_count_of(world, body);
+    const moved_box* s = *state;
+    const int32_t n = node_count_of(s->world, s->body);
     sh_mesh_info info;
-    assert_ok(sh_mesh_get_info(mesh, &info));
+    assert_ok(sh_mesh_get_info(s->mesh, &info));
     enum { SENTINEL_COUNT = 256 };
     double out[SENTINEL_COUNT], sentinel[SENTINEL_COUNT];
     int32_t iout[SENTINEL_COUNT], isentinel[SENTINEL_COUNT];
@@ -1014,53 +1023,45 @@ static void test_get_capacity_too_small(void** state) {
         }                                                                                       \
     } while (0)
 
-    CHECK_D(sh_body_get_positions(world, body, out, cap), 3 * n);
-    CHECK_D(sh_body_get_velocities(world, body, out, cap), 3 * n);
-    CHECK_D(sh_body_get_masses(world, body, out, cap), n);
-    CHECK_D(sh_body_get_elastic_forces(world, body, out, cap), 3 * n);
-    CHECK_D(sh_mesh_get_nodes(mesh, out, cap), 3 * info.node_count);
-    CHECK_I(sh_mesh_get_tets(mesh, iout, cap), 4 * info.tet_count);
-    CHECK_I(sh_mesh_get_edges(mesh, iout, cap), 2 * info.edge_count);
-    CHECK_I(sh_mesh_get_surface_triangles(mesh, iout, cap), 3 * info.surface_triangle_count);
+    CHECK_D(sh_body_get_positions(s->world, s->body, out, cap), 3 * n);
+    CHECK_D(sh_body_get_velocities(s->world, s->body, out, cap), 3 * n);
+    CHECK_D(sh_body_get_masses(s->world, s->body, out, cap), n);
+    CHECK_D(sh_body_get_elastic_forces(s->world, s->body, out, cap), 3 * n);
+    CHECK_D(sh_mesh_get_nodes(s->mesh, out, cap), 3 * info.node_count);
+    CHECK_I(sh_mesh_get_tets(s->mesh, iout, cap), 4 * info.tet_count);
+    CHECK_I(sh_mesh_get_edges(s->mesh, iout, cap), 2 * info.edge_count);
+    CHECK_I(sh_mesh_get_surface_triangles(s->mesh, iout, cap), 3 * info.surface_triangle_count);
 #undef CHECK_D
 #undef CHECK_I
-    assert_ok(sh_mesh_destroy(mesh));
-    assert_ok(sh_world_destroy(world));
 }
 
 static void test_fix_nodes_out_of_range_changes_nothing(void** state) {
-    (void)state;
-    sh_world* world = make_world();
-    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
-    const sh_body_id body = add_fem(world, mesh);
-    move_a_bit(world);
-    double* x = copy_positions(world, body);
-    double* v = copy_velocities(world, body);
+    const moved_box* s = *state;
+    double* x = copy_positions(s->world, s->body);
+    double* v = copy_velocities(s->world, s->body);
     sh_body_info info;
 
     const int32_t high[3] = {0, 1, 8};
     const int32_t negative[2] = {0, -1};
-    assert_error(sh_body_fix_nodes(world, body, high, 3), SH_ERR_INVALID_ARGUMENT, "nodes[2]");
-    assert_error(sh_body_fix_nodes(world, body, negative, 2), SH_ERR_INVALID_ARGUMENT, "nodes[1]");
-    assert_error(sh_body_fix_nodes(world, body, high, -1), SH_ERR_INVALID_ARGUMENT, "count");
+    assert_error(sh_body_fix_nodes(s->world, s->body, high, 3), SH_ERR_INVALID_ARGUMENT, "nodes[2]");
+    assert_error(sh_body_fix_nodes(s->world, s->body, negative, 2), SH_ERR_INVALID_ARGUMENT, "nodes[1]");
+    assert_error(sh_body_fix_nodes(s->world, s->body, high, -1), SH_ERR_INVALID_ARGUMENT, "count");
     const double targets[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    assert_error(sh_body_prescribe_positions(world, body, high, targets, 3), SH_ERR_INVALID_ARGUMENT, "nodes[2]");
-    assert_ok(sh_body_get_info(world, body, &info));
+    assert_error(sh_body_prescribe_positions(s->world, s->body, high, targets, 3), SH_ERR_INVALID_ARGUMENT, "nodes[2]");
+    assert_ok(sh_body_get_info(s->world, s->body, &info));
     assert_int_equal(info.fixed_node_count, 0); /* nodes 0 and 1 were not fixed either */
-    assert_state_is(world, body, x, v);          /* their velocities were not zeroed */
+    assert_state_is(s->world, s->body, x, v);          /* their velocities were not zeroed */
 
     /* The valid part alone fixes them; out-of-range release changes nothing. */
-    assert_ok(sh_body_fix_nodes(world, body, high, 2));
-    assert_ok(sh_body_get_info(world, body, &info));
+    assert_ok(sh_body_fix_nodes(s->world, s->body, high, 2));
+    assert_ok(sh_body_get_info(s->world, s->body, &info));
     assert_int_equal(info.fixed_node_count, 2);
-    assert_error(sh_body_release_nodes(world, body, high, 3), SH_ERR_INVALID_ARGUMENT, "nodes[2]");
-    assert_ok(sh_body_get_info(world, body, &info));
+    assert_error(sh_body_release_nodes(s->world, s->body, high, 3), SH_ERR_INVALID_ARGUMENT, "nodes[2]");
+    assert_ok(sh_body_get_info(s->world, s->body, &info));
     assert_int_equal(info.fixed_node_count, 2);
 
     free(x);
     free(v);
-    assert_ok(sh_mesh_destroy(mesh));
-    assert_ok(sh_world_destroy(world));
 }
 
 /* A battery of failing calls on a moving body: none of them changes its state or the other
@@ -1193,12 +1194,12 @@ int main(void) {
         cmocka_unit_test(test_body_id_of_another_populated_world),
         cmocka_unit_test(test_uninitialized_defs),
         cmocka_unit_test(test_material_validation_in_def),
-        cmocka_unit_test(test_material_validation_in_set_material),
+        cmocka_unit_test_setup_teardown(test_material_validation_in_set_material, setup_moved_box, teardown_moved_box),
         cmocka_unit_test(test_spring_def_errors),
-        cmocka_unit_test(test_step_rejects_bad_dt),
-        cmocka_unit_test(test_set_state_rejects_non_finite_and_wrong_counts),
-        cmocka_unit_test(test_get_capacity_too_small),
-        cmocka_unit_test(test_fix_nodes_out_of_range_changes_nothing),
+        cmocka_unit_test_setup_teardown(test_step_rejects_bad_dt, setup_moved_box_and_spring, teardown_moved_box),
+        cmocka_unit_test_setup_teardown(test_set_state_rejects_non_finite_and_wrong_counts, setup_moved_box, teardown_moved_box),
+        cmocka_unit_test_setup_teardown(test_get_capacity_too_small, setup_moved_box, teardown_moved_box),
+        cmocka_unit_test_setup_teardown(test_fix_nodes_out_of_range_changes_nothing, setup_moved_box, teardown_moved_box),
         cmocka_unit_test(test_failed_calls_leave_state_intact),
         cmocka_unit_test(test_mesh_create_misuse),
         cmocka_unit_test(test_write_vtu_to_unwritable_path),

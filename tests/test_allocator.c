@@ -134,6 +134,15 @@ static int32_t x0_nodes(int nx, int ny, int nz, int32_t* out) {
     return count;
 }
 
+/* A world created from sh_world_def_default. */
+static sh_world* default_world(void) {
+    sh_world_def world_def;
+    sh_world_def_default(&world_def);
+    sh_world* world = NULL;
+    assert_ok(sh_world_create(&world_def, &world));
+    return world;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* Tests                                                                                        */
 
@@ -144,10 +153,7 @@ static void test_counting_allocator_sees_everything_freed(void** state) {
     const long long live_bytes = g.live_bytes;
     assert_int_equal(live_blocks, 0);
 
-    sh_world_def world_def;
-    sh_world_def_default(&world_def);
-    sh_world* world = NULL;
-    assert_ok(sh_world_create(&world_def, &world));
+    sh_world* world = default_world();
     sh_mesh* mesh = sh_test_box(0.04, 0.02, 0.02, 4, 2, 2);
     sh_fem_body_def def;
     sh_fem_body_def_default(&def);
@@ -213,10 +219,7 @@ static void test_restore_default_allocator(void** state) {
     assert_int_equal(g.live_blocks, 0); /* nothing of ours is alive: switching is safe */
     assert_ok(sh_set_allocator(NULL));
     reset_counts();
-    sh_world_def world_def;
-    sh_world_def_default(&world_def);
-    sh_world* world = NULL;
-    assert_ok(sh_world_create(&world_def, &world));
+    sh_world* world = default_world();
     sh_mesh* mesh = sh_test_unit_tet(0.01);
     sh_fem_body_def def;
     sh_fem_body_def_default(&def);
@@ -310,78 +313,87 @@ static void touch_bodies(sh_world* world, const sh_body_id* bodies, int count, c
     }
 }
 
+/* The scene of the Alloc: none step tests: a 3 x 1 x 1 box (3 cm) with its x == 0 nodes
+ * fixed, as every body add_bodies makes for two integrators. The mesh is destroyed (bodies do
+ * not need it); then the counts are reset, live_blocks is what is live once the scene is built. */
+typedef struct box_bodies {
+    sh_world* world;
+    int32_t fixed[16];
+    sh_body_id bodies[16];
+    int count;
+    long live_blocks;
+} box_bodies;
+
+static box_bodies open_box_bodies(sh_integrator first, sh_integrator second) {
+    box_bodies scene;
+    reset_counts();
+    scene.world = sh_test_world(-9.81);
+    sh_mesh* mesh = sh_test_box(0.03, 0.01, 0.01, 3, 1, 1);
+    const int32_t fixed_count = x0_nodes(3, 1, 1, scene.fixed);
+    const sh_integrator integrators[2] = {first, second};
+    scene.count = add_bodies(scene.world, mesh, scene.fixed, fixed_count, integrators, 2, scene.bodies);
+    assert_ok(sh_mesh_destroy(mesh));
+    reset_counts();
+    scene.live_blocks = g.live_blocks;
+    return scene;
+}
+
+/* No allocation or free since reset_counts, and as many live blocks as before. */
+static void assert_nothing_allocated(long live_blocks) {
+    assert_int_equal(g.attempts, 0);
+    assert_int_equal(g.frees, 0);
+    assert_int_equal(g.live_blocks, live_blocks);
+}
+
+/* Destroys world and checks that nothing is left live and the allocator's books balance. */
+static void destroy_world_checking_leaks(sh_world* world) {
+    assert_ok(sh_world_destroy(world));
+    assert_int_equal(g.live_blocks, 0);
+    assert_allocator_sane();
+}
+
 /* "Alloc: none once the scene is built": sh_world_step, with and without a report, with
  * sub-stepping, with every material model and spring law, and the Alloc: none queries,
  * allocate nothing through the installed allocator. Symplectic Euler and RK4 bodies. */
 static void test_step_allocates_nothing(void** state) {
     (void)state;
-    reset_counts();
-    sh_world* world = sh_test_world(-9.81);
-    sh_mesh* mesh = sh_test_box(0.03, 0.01, 0.01, 3, 1, 1);
-    int32_t fixed[16];
-    const int32_t fixed_count = x0_nodes(3, 1, 1, fixed);
-    const sh_integrator integrators[2] = {SH_INTEGRATOR_SYMPLECTIC_EULER, SH_INTEGRATOR_RK4};
-    sh_body_id bodies[16];
-    const int count = add_bodies(world, mesh, fixed, fixed_count, integrators, 2, bodies);
-    assert_ok(sh_mesh_destroy(mesh)); /* bodies do not need it */
-
+    const box_bodies scene = open_box_bodies(SH_INTEGRATOR_SYMPLECTIC_EULER, SH_INTEGRATOR_RK4);
     /* The scene is built: from here on, nothing may allocate. */
-    reset_counts();
-    const long live_blocks = g.live_blocks;
     sh_step_report report;
-    for (int i = 0; i < 100; ++i) assert_ok(sh_world_step(world, 1e-3, NULL));
-    for (int i = 0; i < 100; ++i) assert_ok(sh_world_step(world, 1e-3, &report));
+    for (int i = 0; i < 100; ++i) assert_ok(sh_world_step(scene.world, 1e-3, NULL));
+    for (int i = 0; i < 100; ++i) assert_ok(sh_world_step(scene.world, 1e-3, &report));
     assert_true(report.kinetic_energy > 0.0);
     /* A step well above dt_crit sub-steps (SH_UNSTABLE_SUBSTEP): still no allocation. */
-    assert_ok(sh_world_step(world, 20.0 * report.dt_critical, &report));
+    assert_ok(sh_world_step(scene.world, 20.0 * report.dt_critical, &report));
     assert_true(report.substeps > 1);
-    touch_bodies(world, bodies, count, fixed);
-    for (int i = 0; i < 10; ++i) assert_ok(sh_world_step(world, 1e-3, &report));
+    touch_bodies(scene.world, scene.bodies, scene.count, scene.fixed);
+    for (int i = 0; i < 10; ++i) assert_ok(sh_world_step(scene.world, 1e-3, &report));
 
     if (g.attempts != 0)
         print_error("%zu allocations (%zu frees) during steps and Alloc: none calls\n", g.attempts, g.frees);
-    assert_int_equal(g.attempts, 0);
-    assert_int_equal(g.frees, 0);
-    assert_int_equal(g.live_blocks, live_blocks);
+    assert_nothing_allocated(scene.live_blocks);
 
-    assert_ok(sh_world_destroy(world));
-    assert_int_equal(g.live_blocks, 0);
-    assert_allocator_sane();
+    destroy_world_checking_leaks(scene.world);
 }
 
 /* Same with forward Euler and RK2 bodies, which may blow up and be rolled back
  * (SH_ERR_UNSTABLE): the rollback path allocates nothing either. */
 static void test_step_with_rollbacks_allocates_nothing(void** state) {
     (void)state;
-    reset_counts();
-    sh_world* world = sh_test_world(-9.81);
-    sh_mesh* mesh = sh_test_box(0.03, 0.01, 0.01, 3, 1, 1);
-    int32_t fixed[16];
-    const int32_t fixed_count = x0_nodes(3, 1, 1, fixed);
-    const sh_integrator integrators[2] = {SH_INTEGRATOR_FORWARD_EULER, SH_INTEGRATOR_RK2};
-    sh_body_id bodies[16];
-    const int count = add_bodies(world, mesh, fixed, fixed_count, integrators, 2, bodies);
-    assert_ok(sh_mesh_destroy(mesh));
-
-    reset_counts();
-    const long live_blocks = g.live_blocks;
+    const box_bodies scene = open_box_bodies(SH_INTEGRATOR_FORWARD_EULER, SH_INTEGRATOR_RK2);
     sh_step_report report;
     int unstable = 0;
     for (int i = 0; i < 200; ++i) {
-        const sh_status status = sh_world_step(world, 1e-3, i % 2 ? &report : NULL);
+        const sh_status status = sh_world_step(scene.world, 1e-3, i % 2 ? &report : NULL);
         assert_true(status == SH_OK || status == SH_ERR_UNSTABLE);
         unstable += status == SH_ERR_UNSTABLE;
     }
-    touch_bodies(world, bodies, count, fixed);
+    touch_bodies(scene.world, scene.bodies, scene.count, scene.fixed);
     if (g.attempts != 0)
         print_error("%zu allocations (%zu frees) during steps (%d unstable) and Alloc: none calls\n", g.attempts,
                     g.frees, unstable);
-    assert_int_equal(g.attempts, 0);
-    assert_int_equal(g.frees, 0);
-    assert_int_equal(g.live_blocks, live_blocks);
-    assert_ok(sh_world_destroy(world));
-    assert_int_equal(g.live_blocks, 0);
-    assert_allocator_sane();
+    assert_nothing_allocated(scene.live_blocks);
+    destroy_world_checking_leaks(scene.world);
 }
 
 /* sh_world_remove_body is tagged Alloc: none: removing bodies (the first removal included)
@@ -401,9 +413,7 @@ static void test_remove_body_allocates_nothing(void** state) {
     if (g.attempts != 0) print_error("sh_world_remove_body: %zu allocation(s) for 4 removals\n", g.attempts);
     const size_t attempts = g.attempts;
     assert_ok(sh_mesh_destroy(mesh));
-    assert_ok(sh_world_destroy(world));
-    assert_int_equal(g.live_blocks, 0);
-    assert_allocator_sane();
+    destroy_world_checking_leaks(world);
     assert_int_equal(attempts, 0);
 }
 
@@ -412,10 +422,7 @@ static void test_remove_body_allocates_nothing(void** state) {
 static void test_rejected_step_allocates_nothing(void** state) {
     (void)state;
     reset_counts();
-    sh_world_def world_def;
-    sh_world_def_default(&world_def);
-    sh_world* world = NULL;
-    assert_ok(sh_world_create(&world_def, &world));
+    sh_world* world = default_world();
     sh_mesh* mesh = sh_test_box(0.01, 0.01, 0.01, 1, 1, 1);
     sh_fem_body_def def;
     sh_fem_body_def_default(&def);
@@ -431,9 +438,7 @@ static void test_rejected_step_allocates_nothing(void** state) {
     assert_int_equal(report.unstable_body_count, 1);
     assert_int_equal(g.attempts, 0);
     assert_ok(sh_mesh_destroy(mesh));
-    assert_ok(sh_world_destroy(world));
-    assert_int_equal(g.live_blocks, 0);
-    assert_allocator_sane();
+    destroy_world_checking_leaks(world);
 }
 
 /* SH_ERR_OUT_OF_MEMORY means "nothing was changed": sh_body_set_material failing on any of
@@ -488,10 +493,16 @@ static void test_set_material_out_of_memory_changes_nothing(void** state) {
     /* The successful call does change them. */
     assert_ok(sh_body_get_masses(world, body, masses_now, 64));
     assert_true(memcmp(masses_now, masses, sizeof(double) * (size_t)info.node_count) != 0);
-    assert_ok(sh_world_destroy(world));
-    assert_int_equal(g.live_blocks, 0);
-    assert_allocator_sane();
+    destroy_world_checking_leaks(world);
     assert_int_equal(failures, 0);
+}
+
+/* sh_world_add_spring_body into a garbage id: on failure the id must be SH_NULL_BODY. */
+static sh_status add_spring_body_or_null(sh_world* world, const sh_spring_body_def* def, sh_body_id* body) {
+    *body = 42;
+    const sh_status status = sh_world_add_spring_body(world, def, body);
+    if (status != SH_OK) assert_true(*body == SH_NULL_BODY);
+    return status;
 }
 
 /* The scene of the failure-injection test: every creation call, each may fail with
@@ -545,23 +556,15 @@ static sh_status build_and_destroy_scene(const double* nodes, int32_t node_count
     sh_spring_body_def spring;
     sh_spring_body_def_default(&spring);
     spring.mesh = mesh;
-    body = 42;
-    status = sh_world_add_spring_body(world, &spring, &body);
-    if (status != SH_OK) {
-        assert_true(body == SH_NULL_BODY);
-        goto done;
-    }
+    status = add_spring_body_or_null(world, &spring, &body);
+    if (status != SH_OK) goto done;
     ++stage;
     const double table[6] = {-0.1, -1.0, 0.0, 0.0, 0.1, 1.0};
     spring.params.law = SH_SPRING_TABLE;
     spring.params.table = table;
     spring.params.table_rows = 3;
-    body = 42;
-    status = sh_world_add_spring_body(world, &spring, &body);
-    if (status != SH_OK) {
-        assert_true(body == SH_NULL_BODY);
-        goto done;
-    }
+    status = add_spring_body_or_null(world, &spring, &body);
+    if (status != SH_OK) goto done;
     ++stage;
     status = sh_world_remove_body(world, body);
     if (status != SH_OK) goto done;

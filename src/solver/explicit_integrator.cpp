@@ -16,6 +16,39 @@ namespace {
 // More sub-steps than this means dt_crit is unreasonably small for dt: reject instead.
 constexpr double kMaxSubsteps = 1 << 20;
 
+#if defined(__AVX512F__)
+// Node loops take eight nodes (24 doubles, three registers) at a time. Per-node values are
+// spread to the xyz layout with permutes; r is the register (doubles 8r .. 8r+7 of the chunk).
+inline __m512d spread_nodes(__m512d per_node, int r) {
+    static const int64_t kIndex[3][8] = {{0, 0, 0, 1, 1, 1, 2, 2}, {2, 3, 3, 3, 4, 4, 4, 5}, {5, 5, 6, 6, 6, 7, 7, 7}};
+    return _mm512_permutexvar_pd(_mm512_loadu_si512(kIndex[r]), per_node);
+}
+
+// g[k] at the doubles of register r of a chunk.
+inline __m512d spread_gravity(const double g[3], int r) {
+    alignas(64) double lanes[8];
+    for (int l = 0; l < 8; ++l) lanes[l] = g[(8 * r + l) % 3];
+    return _mm512_load_pd(lanes);
+}
+
+// The runaway test as a conservative per-component bound: |v_k| <= 0.57 limit gives
+// speed^2 <= 0.975 limit^2, |x_k| <= DBL_MAX/4 keeps x0 + x1 + x2 finite. A chunk that fails it
+// gets the exact per-node test.
+inline __mmask8 outside_bounds(__m512d x, __m512d v, __m512d v_bound) {
+    return _mm512_cmp_pd_mask(_mm512_abs_pd(v), v_bound, _CMP_NLE_UQ) |
+           _mm512_cmp_pd_mask(_mm512_abs_pd(x), _mm512_set1_pd(0.25 * DBL_MAX), _CMP_NLE_UQ);
+}
+#endif
+
+// The runaway test of node i: too fast or not finite.
+inline bool node_insane(const double* x, const double* v, size_t i, double limit2) {
+    const double* xi = &x[3 * i];
+    const double* vi = &v[3 * i];
+    const double speed2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
+    // NaN fails every comparison, so !(a <= b) also catches it.
+    return !(speed2 <= limit2 && std::isfinite(xi[0] + xi[1] + xi[2]));
+}
+
 // y = x + h z over n values.
 void axpy(double* y, const double* x, double h, const double* z, size_t n) {
     for (size_t i = 0; i < n; ++i) y[i] = x[i] + h * z[i];
@@ -85,15 +118,22 @@ void integrate(Body& body, double h, const double g[3]) {
 bool state_is_sane(const Body& body) {
     const double limit2 = body.settings.runaway_speed * body.settings.runaway_speed;
     const size_t n = body.mass.size();
-    bool sane = true;
-    for (size_t i = 0; i < n; ++i) {
-        const double* xi = &body.x[3 * i];
-        const double* vi = &body.v[3 * i];
-        const double speed2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
-        // NaN fails every comparison, so !(a <= b) also catches it.
-        sane &= speed2 <= limit2 && std::isfinite(xi[0] + xi[1] + xi[2]);
+    const double* x = body.x.data();
+    const double* v = body.v.data();
+    bool insane = false;
+    size_t i = 0;
+#if defined(__AVX512F__)
+    const __m512d v_bound = _mm512_set1_pd(0.57 * body.settings.runaway_speed);
+    for (; i + 8 <= n; i += 8) {
+        __mmask8 flagged = 0;
+        for (int r = 0; r < 3; ++r)
+            flagged |= outside_bounds(_mm512_loadu_pd(x + 3 * i + 8 * r), _mm512_loadu_pd(v + 3 * i + 8 * r), v_bound);
+        if (flagged)
+            for (size_t k = i; k < i + 8; ++k) insane |= node_insane(x, v, k, limit2);
     }
-    return sane;
+#endif
+    for (; i < n; ++i) insane |= node_insane(x, v, i, limit2);
+    return !insane;
 }
 
 }  // namespace
@@ -104,12 +144,30 @@ void compute_accelerations(const Body& body, const double* x, const double* v, c
     body.add_internal_forces(x, v, a);
     const double alpha = body.settings.damping_mass;
     const bool per_node = !body.node_damping.empty();
-    for (size_t i = 0; i < n; ++i) {
-        const double inv_m = body.inverse_mass[i];
+    const double* inv_mass = body.inverse_mass.data();
+    const double* fe = body.external_force.data();
+    size_t i = 0;
+#if defined(__AVX512F__)
+    const __m512d gv[3] = {spread_gravity(g, 0), spread_gravity(g, 1), spread_gravity(g, 2)};
+    const __m512d zero = _mm512_setzero_pd(), alpha_v = _mm512_set1_pd(alpha);
+    for (; i + 8 <= n; i += 8) {
+        const __m512d inv8 = _mm512_loadu_pd(inv_mass + i);
+        const __m512d c8 = per_node ? _mm512_add_pd(alpha_v, _mm512_loadu_pd(body.node_damping.data() + i)) : alpha_v;
+        for (int r = 0; r < 3; ++r) {
+            const size_t j = 3 * i + 8 * r;
+            const __m512d inv = spread_nodes(inv8, r), c = per_node ? spread_nodes(c8, r) : c8;
+            const __m512d load = _mm512_add_pd(_mm512_loadu_pd(a + j), _mm512_loadu_pd(fe + j));
+            const __m512d acc = _mm512_fnmadd_pd(c, _mm512_loadu_pd(v + j), _mm512_fmadd_pd(load, inv, gv[r]));
+            _mm512_storeu_pd(a + j, _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(inv, zero, _CMP_GT_OQ), acc));
+        }
+    }
+#endif
+    for (; i < n; ++i) {
+        const double inv_m = inv_mass[i];
         const double c = alpha + (per_node ? body.node_damping[i] : 0.0);
         for (int k = 0; k < 3; ++k) {
             const size_t j = 3 * i + k;
-            a[j] = inv_m > 0.0 ? (a[j] + body.external_force[j]) * inv_m + g[k] - c * v[j] : 0.0;
+            a[j] = inv_m > 0.0 ? (a[j] + fe[j]) * inv_m + g[k] - c * v[j] : 0.0;
         }
     }
 }
@@ -157,15 +215,6 @@ struct EulerPass {
           h(step), limit2(body.settings.runaway_speed * body.settings.runaway_speed),
           g{gravity[0], gravity[1], gravity[2]} {}
 
-    // The runaway test of state_is_sane for free node i.
-    bool node_insane(size_t i) const {
-        const double* xi = &x[3 * i];
-        const double* vi = &v[3 * i];
-        const double speed2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
-        // NaN fails every comparison, so !(a <= b) also catches it.
-        return !(speed2 <= limit2 && std::isfinite(xi[0] + xi[1] + xi[2]));
-    }
-
     // Node i alone; true if it is free and insane.
     bool node(size_t i) const {
         const double inv_m = inv_mass[i];
@@ -188,7 +237,7 @@ struct EulerPass {
             x[j] = xn;
             v[j] = is_free ? vn : 0.0;
         }
-        return is_free && node_insane(i);
+        return is_free && node_insane(x, v, i, limit2);
     }
 
     // All n nodes; true if all free nodes are sane.
@@ -196,26 +245,16 @@ struct EulerPass {
         bool insane = false;
         size_t i = 0;
 #if defined(__AVX512F__)
-        // Eight nodes (24 doubles, three registers) at a time. Per-node values are spread to
-        // the xyz layout with permutes; the runaway test is a conservative per-component bound
-        // (|v_k| <= 0.57 limit gives speed^2 <= 0.975 limit^2; |x_k| <= DBL_MAX/4 keeps the
-        // sum finite), and a chunk that fails it gets the exact per-node test.
-        const __m512i spread[3] = {_mm512_set_epi64(2, 2, 1, 1, 1, 0, 0, 0), _mm512_set_epi64(5, 4, 4, 4, 3, 3, 3, 2),
-                                   _mm512_set_epi64(7, 7, 7, 6, 6, 6, 5, 5)};
-        const __m512d gv[3] = {_mm512_set_pd(g[1], g[0], g[2], g[1], g[0], g[2], g[1], g[0]),
-                               _mm512_set_pd(g[0], g[2], g[1], g[0], g[2], g[1], g[0], g[2]),
-                               _mm512_set_pd(g[2], g[1], g[0], g[2], g[1], g[0], g[2], g[1])};
-        const __m512d hv = _mm512_set1_pd(h), zero = _mm512_setzero_pd();
-        const __m512d v_bound = _mm512_set1_pd(0.57 * std::sqrt(limit2)), x_bound = _mm512_set1_pd(0.25 * DBL_MAX);
-        const __m512d alpha_v = _mm512_set1_pd(alpha);
+        const __m512d gv[3] = {spread_gravity(g, 0), spread_gravity(g, 1), spread_gravity(g, 2)};
+        const __m512d hv = _mm512_set1_pd(h), zero = _mm512_setzero_pd(), alpha_v = _mm512_set1_pd(alpha);
+        const __m512d v_bound = _mm512_set1_pd(0.57 * std::sqrt(limit2));
         for (; i + 8 <= n; i += 8) {
             const __m512d inv8 = _mm512_loadu_pd(inv_mass + i);
             const __m512d c8 = PerNodeDamping ? _mm512_add_pd(alpha_v, _mm512_loadu_pd(node_damping + i)) : alpha_v;
             __mmask8 flagged = 0;
             for (int r = 0; r < 3; ++r) {
                 const size_t j = 3 * i + 8 * r;
-                const __m512d inv = _mm512_permutexvar_pd(spread[r], inv8);
-                const __m512d c = PerNodeDamping ? _mm512_permutexvar_pd(spread[r], c8) : c8;
+                const __m512d inv = spread_nodes(inv8, r), c = PerNodeDamping ? spread_nodes(c8, r) : c8;
                 const __mmask8 is_free = _mm512_cmp_pd_mask(inv, zero, _CMP_GT_OQ);
                 const __m512d xj = _mm512_loadu_pd(x + j), vj = _mm512_loadu_pd(v + j);
                 const __m512d load = _mm512_add_pd(_mm512_loadu_pd(f + j), _mm512_loadu_pd(fe + j));
@@ -233,11 +272,10 @@ struct EulerPass {
                 }
                 _mm512_storeu_pd(x + j, xn);
                 _mm512_storeu_pd(v + j, _mm512_maskz_mov_pd(is_free, vn));
-                flagged |= is_free & (_mm512_cmp_pd_mask(_mm512_abs_pd(vn), v_bound, _CMP_NLE_UQ) |
-                                      _mm512_cmp_pd_mask(_mm512_abs_pd(xn), x_bound, _CMP_NLE_UQ));
+                flagged |= is_free & outside_bounds(xn, vn, v_bound);
             }
             if (flagged)
-                for (size_t k = i; k < i + 8; ++k) insane |= inv_mass[k] > 0.0 && node_insane(k);
+                for (size_t k = i; k < i + 8; ++k) insane |= inv_mass[k] > 0.0 && node_insane(x, v, k, limit2);
         }
 #endif
         for (; i < n; ++i) insane |= node(i);
@@ -299,22 +337,35 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
 
     std::copy(body.x.begin(), body.x.end(), w.x0.begin());
     std::copy(body.v.begin(), body.v.end(), w.v0.begin());
-    const size_t n = body.mass.size();
-    for (size_t i = 0; i < n; ++i) {
-        if (!body.kinematic[i]) continue;
+    for_each_kinematic(body.kinematic, [&](size_t i) {
         for (int k = 0; k < 3; ++k) body.v[3 * i + k] = (body.target[3 * i + k] - body.x[3 * i + k]) / dt;
-    }
+    });
 
     const double h = dt / substeps;
     for (int32_t s = 0; s < result.substeps; ++s) integrate(body, h, g);
 
-    for (size_t i = 0; i < n; ++i) {
-        if (!body.kinematic[i] && body.mass[i] > 0.0) continue;
+    // Nodes that are not integrated: kinematic ones onto their targets, all at rest.
+    const size_t n = body.mass.size();
+    auto settle = [&](size_t i) {
         for (int k = 0; k < 3; ++k) {
             if (body.kinematic[i]) body.x[3 * i + k] = body.target[3 * i + k];
             body.v[3 * i + k] = 0.0;
         }
+    };
+    size_t i = 0;
+#if defined(__AVX512F__)
+    for (; i + 8 <= n; i += 8) {
+        uint64_t kinematic8;
+        std::memcpy(&kinematic8, &body.kinematic[i], sizeof kinematic8);
+        const __mmask8 massless =
+            _mm512_cmp_pd_mask(_mm512_loadu_pd(body.mass.data() + i), _mm512_setzero_pd(), _CMP_NGT_UQ);
+        if (!kinematic8 && !massless) continue;
+        for (size_t k = i; k < i + 8; ++k)
+            if (body.kinematic[k] || !(body.mass[k] > 0.0)) settle(k);
     }
+#endif
+    for (; i < n; ++i)
+        if (body.kinematic[i] || !(body.mass[i] > 0.0)) settle(i);
 
     if (!state_is_sane(body)) {
         std::copy(w.x0.begin(), w.x0.end(), body.x.begin());

@@ -40,13 +40,14 @@ Mat3L polar_rotation(const Mat3L& F) {
     for (int iteration = 0; iteration < 20; ++iteration) {
         const Mat3L C = cofactor(R);  // R^-T = C / det R
         const Lanes dr = R.m[0][0] * C.m[0][0] + R.m[0][1] * C.m[0][1] + R.m[0][2] * C.m[0][2];
-        const Lanes inv_det = 1.0 / dr;
         Lanes gamma = splat(1.0);  // Frobenius scaling speeds up the first iterations
-        Lanes c_scale = inv_det;
+        Lanes c_scale;
         if (iteration < 6) {
-            const Lanes rr = ddot(R, R), cc = ddot(C, C) * inv_det * inv_det;
-            gamma = lanes_sqrt(lanes_sqrt(cc / rr));
-            c_scale = inv_det / gamma;
+            // gamma = (|R^-T| / |R|)^(1/2) = (|C|^2 / (|R|^2 det^2))^(1/4); C scales by 1/(det gamma).
+            gamma = lanes_sqrt(lanes_sqrt(ddot(C, C) / (ddot(R, R) * dr * dr)));
+            c_scale = 1.0 / (dr * gamma);
+        } else {
+            c_scale = 1.0 / dr;
         }
         Mat3L next;
         Lanes change = Lanes{};
@@ -57,9 +58,14 @@ Mat3L polar_rotation(const Mat3L& F) {
                 change += diff * diff;
             }
         R = next;
-        double worst = 0.0;
-        for (int l = 0; l < kLanes; ++l) worst = change[l] > worst ? change[l] : worst;
-        if (worst < 1e-28) break;
+        // Converged when no lane changed by 1e-28 or more (NaN lanes do not hold the others up).
+        bool moving = false;
+#if defined(__AVX512F__)
+        moving = _mm512_cmp_pd_mask(change, _mm512_set1_pd(1e-28), _CMP_GE_OQ) != 0;
+#else
+        for (int l = 0; l < kLanes; ++l) moving |= change[l] >= 1e-28;
+#endif
+        if (!moving) break;
     }
 
     if (any_bad)

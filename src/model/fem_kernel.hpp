@@ -5,7 +5,7 @@
 //
 // Node data (x, v, f) is 3 doubles per node. With AVX-512 a node's xyz is read, and its force
 // added, with one masked 256-bit load (and store) per node and lane, the kLanes rows being
-// transposed in registers. Zen 4 does not forward a masked store to a later load of the same
+// transposed in registers (edges are formed on the rows, before the transpose). Zen 4 does not forward a masked store to a later load of the same
 // node, so tets of one block that share a node would stall on each other: FemBody::rebuild
 // puts tets far apart along its locality curve into the lanes of a block, and the next
 // block's updates of the same nodes come after the stores have retired. Elsewhere the lanes
@@ -20,22 +20,31 @@ namespace sh {
 
 #if defined(__AVX512F__)
 
-/// x, y, z lanes of the nodes idx[0..8) of node array p (3 doubles per node).
-SH_INLINE void gather_xyz(const double* p, const int32_t* idx, Lanes& x, Lanes& y, Lanes& z) {
+/// Per-lane edge matrix [p1 - p0, p2 - p0, p3 - p0] of the block's tets for node array p.
+/// Rows (x, y, z, 0) are read with one masked load per node (never touching the double after
+/// z), the edges are formed row by row, and the rows of each edge are transposed to lanes.
+SH_INLINE Mat3L gather_edges(const TetBlock& b, const double* p) {
     static_assert(kLanes == 8, "AVX-512 path assumes 8 double lanes");
-    // Row l = (x_l, y_l, z_l, 0); masked loads never touch the double after z.
-    auto row = [&](int l) { return _mm256_maskz_loadu_pd(0x7, p + 3 * static_cast<ptrdiff_t>(idx[l])); };
-    const __m512d a0 = _mm512_insertf64x4(_mm512_castpd256_pd512(row(0)), row(2), 1);
-    const __m512d a1 = _mm512_insertf64x4(_mm512_castpd256_pd512(row(1)), row(3), 1);
-    const __m512d a2 = _mm512_insertf64x4(_mm512_castpd256_pd512(row(4)), row(6), 1);
-    const __m512d a3 = _mm512_insertf64x4(_mm512_castpd256_pd512(row(5)), row(7), 1);
-    const __m512d t0 = _mm512_unpacklo_pd(a0, a1);  // x0 x1 | z0 z1 | x2 x3 | z2 z3
-    const __m512d t1 = _mm512_unpackhi_pd(a0, a1);  // y0 y1 | 0  0  | y2 y3 | 0  0
-    const __m512d t2 = _mm512_unpacklo_pd(a2, a3);  // x4 x5 | z4 z5 | x6 x7 | z6 z7
-    const __m512d t3 = _mm512_unpackhi_pd(a2, a3);  // y4 y5 | 0  0  | y6 y7 | 0  0
-    x = _mm512_shuffle_f64x2(t0, t2, 0x88);
-    y = _mm512_shuffle_f64x2(t1, t3, 0x88);
-    z = _mm512_shuffle_f64x2(t0, t2, 0xDD);
+    auto row = [&](int a, int l) { return _mm256_maskz_loadu_pd(0x7, p + 3 * static_cast<ptrdiff_t>(b.node[a][l])); };
+    __m256d r0[8];
+    for (int l = 0; l < 8; ++l) r0[l] = row(0, l);
+    Mat3L d;
+    for (int a = 1; a < 4; ++a) {
+        __m256d e[8];
+        for (int l = 0; l < 8; ++l) e[l] = _mm256_sub_pd(row(a, l), r0[l]);
+        const __m512d a0 = _mm512_insertf64x4(_mm512_castpd256_pd512(e[0]), e[2], 1);
+        const __m512d a1 = _mm512_insertf64x4(_mm512_castpd256_pd512(e[1]), e[3], 1);
+        const __m512d a2 = _mm512_insertf64x4(_mm512_castpd256_pd512(e[4]), e[6], 1);
+        const __m512d a3 = _mm512_insertf64x4(_mm512_castpd256_pd512(e[5]), e[7], 1);
+        const __m512d t0 = _mm512_unpacklo_pd(a0, a1);  // x0 x1 | z0 z1 | x2 x3 | z2 z3
+        const __m512d t1 = _mm512_unpackhi_pd(a0, a1);  // y0 y1 | 0  0  | y2 y3 | 0  0
+        const __m512d t2 = _mm512_unpacklo_pd(a2, a3);  // x4 x5 | z4 z5 | x6 x7 | z6 z7
+        const __m512d t3 = _mm512_unpackhi_pd(a2, a3);  // y4 y5 | 0  0  | y6 y7 | 0  0
+        d.m[0][a - 1] = _mm512_shuffle_f64x2(t0, t2, 0x88);
+        d.m[1][a - 1] = _mm512_shuffle_f64x2(t1, t3, 0x88);
+        d.m[2][a - 1] = _mm512_shuffle_f64x2(t0, t2, 0xDD);
+    }
+    return d;
 }
 
 /// f[3 n + i] += (x, y, z)_i of lane l for the nodes n = idx[l], in lane order (lanes may
@@ -100,8 +109,6 @@ SH_INLINE int32_t count_non_positive(Lanes det, Lanes weight) {
     return n;
 }
 
-#endif
-
 /// Per-lane edge matrix [p1 - p0, p2 - p0, p3 - p0] of the block's tets for node array p.
 SH_INLINE Mat3L gather_edges(const TetBlock& b, const double* p) {
     Lanes p0[3], pa[3];
@@ -113,6 +120,8 @@ SH_INLINE Mat3L gather_edges(const TetBlock& b, const double* p) {
     }
     return d;
 }
+
+#endif
 
 /// The force loop; Damped adds -beta K(x) v through the material's differential.
 template <class Material, bool Damped>

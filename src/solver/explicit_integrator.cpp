@@ -1,5 +1,8 @@
 #include "solver/explicit_integrator.hpp"
 
+#include "solver/node_checks.hpp"
+#include "solver/step_support.hpp"
+
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -31,23 +34,8 @@ inline __m512d spread_gravity(const double g[3], int r) {
     return _mm512_load_pd(lanes);
 }
 
-// The runaway test as a conservative per-component bound: |v_k| <= 0.57 limit gives
-// speed^2 <= 0.975 limit^2, |x_k| <= DBL_MAX/4 keeps x0 + x1 + x2 finite. A chunk that fails it
-// gets the exact per-node test.
-inline __mmask8 outside_bounds(__m512d x, __m512d v, __m512d v_bound) {
-    return _mm512_cmp_pd_mask(_mm512_abs_pd(v), v_bound, _CMP_NLE_UQ) |
-           _mm512_cmp_pd_mask(_mm512_abs_pd(x), _mm512_set1_pd(0.25 * DBL_MAX), _CMP_NLE_UQ);
-}
 #endif
 
-// The runaway test of node i: too fast or not finite.
-inline bool node_insane(const double* x, const double* v, size_t i, double limit2) {
-    const double* xi = &x[3 * i];
-    const double* vi = &v[3 * i];
-    const double speed2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
-    // NaN fails every comparison, so !(a <= b) also catches it.
-    return !(speed2 <= limit2 && std::isfinite(xi[0] + xi[1] + xi[2]));
-}
 
 // y = x + h z over n values.
 void axpy(double* y, const double* x, double h, const double* z, size_t n) {
@@ -115,26 +103,6 @@ void integrate(Body& body, double h, const double g[3]) {
     }
 }
 
-bool state_is_sane(const Body& body) {
-    const double limit2 = body.settings.runaway_speed * body.settings.runaway_speed;
-    const size_t n = body.mass.size();
-    const double* x = body.x.data();
-    const double* v = body.v.data();
-    bool insane = false;
-    size_t i = 0;
-#if defined(__AVX512F__)
-    const __m512d v_bound = _mm512_set1_pd(0.57 * body.settings.runaway_speed);
-    for (; i + 8 <= n; i += 8) {
-        __mmask8 flagged = 0;
-        for (int r = 0; r < 3; ++r)
-            flagged |= outside_bounds(_mm512_loadu_pd(x + 3 * i + 8 * r), _mm512_loadu_pd(v + 3 * i + 8 * r), v_bound);
-        if (flagged)
-            for (size_t k = i; k < i + 8; ++k) insane |= node_insane(x, v, k, limit2);
-    }
-#endif
-    for (; i < n; ++i) insane |= node_insane(x, v, i, limit2);
-    return !insane;
-}
 
 }  // namespace
 
@@ -174,21 +142,6 @@ void compute_accelerations(const Body& body, const double* x, const double* v, c
 
 namespace {
 
-// Calls visit(i) for every node i with kinematic[i] set; skips eight clear bytes at a time.
-template <class Visit>
-void for_each_kinematic(const vec<uint8_t>& kinematic, Visit&& visit) {
-    const size_t n = kinematic.size();
-    size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
-        uint64_t word;
-        std::memcpy(&word, &kinematic[i], sizeof word);
-        if (!word) continue;
-        for (size_t k = i; k < i + 8; ++k)
-            if (kinematic[k]) visit(k);
-    }
-    for (; i < n; ++i)
-        if (kinematic[i]) visit(i);
-}
 
 // One forward or symplectic Euler step of the whole body in one pass over the nodes, from the
 // internal forces already in w.a[0]: accelerations as compute_accelerations makes them, the
@@ -328,48 +281,22 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
             }
         });
         if (!sane) {
-            std::copy(w.x0.begin(), w.x0.end(), body.x.begin());
-            std::copy(w.v0.begin(), w.v0.end(), body.v.begin());
+            restore_start_state(body);
             result.stable = false;
         }
         return result;
     }
 
-    std::copy(body.x.begin(), body.x.end(), w.x0.begin());
-    std::copy(body.v.begin(), body.v.end(), w.v0.begin());
-    for_each_kinematic(body.kinematic, [&](size_t i) {
-        for (int k = 0; k < 3; ++k) body.v[3 * i + k] = (body.target[3 * i + k] - body.x[3 * i + k]) / dt;
-    });
+    save_start_state(body);
+    begin_kinematic_motion(body, dt);
 
     const double h = dt / substeps;
     for (int32_t s = 0; s < result.substeps; ++s) integrate(body, h, g);
 
-    // Nodes that are not integrated: kinematic ones onto their targets, all at rest.
-    const size_t n = body.mass.size();
-    auto settle = [&](size_t i) {
-        for (int k = 0; k < 3; ++k) {
-            if (body.kinematic[i]) body.x[3 * i + k] = body.target[3 * i + k];
-            body.v[3 * i + k] = 0.0;
-        }
-    };
-    size_t i = 0;
-#if defined(__AVX512F__)
-    for (; i + 8 <= n; i += 8) {
-        uint64_t kinematic8;
-        std::memcpy(&kinematic8, &body.kinematic[i], sizeof kinematic8);
-        const __mmask8 massless =
-            _mm512_cmp_pd_mask(_mm512_loadu_pd(body.mass.data() + i), _mm512_setzero_pd(), _CMP_NGT_UQ);
-        if (!kinematic8 && !massless) continue;
-        for (size_t k = i; k < i + 8; ++k)
-            if (body.kinematic[k] || !(body.mass[k] > 0.0)) settle(k);
-    }
-#endif
-    for (; i < n; ++i)
-        if (body.kinematic[i] || !(body.mass[i] > 0.0)) settle(i);
+    end_kinematic_motion(body);
 
-    if (!state_is_sane(body)) {
-        std::copy(w.x0.begin(), w.x0.end(), body.x.begin());
-        std::copy(w.v0.begin(), w.v0.end(), body.v.begin());
+    if (!body_state_is_sane(body)) {
+        restore_start_state(body);
         result.stable = false;
     }
     return result;

@@ -1,7 +1,10 @@
 #include "solver/step_support.hpp"
 
+#include "solver/node_checks.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace sh {
 
@@ -16,31 +19,54 @@ void restore_start_state(Body& body) {
 }
 
 void begin_kinematic_motion(Body& body, double dt) {
-    for (size_t i = 0; i < body.kinematic.size(); ++i)
-        if (body.kinematic[i])
-            for (int k = 0; k < 3; ++k) body.v[3 * i + k] = (body.target[3 * i + k] - body.x[3 * i + k]) / dt;
+    for_each_kinematic(body.kinematic, [&](size_t i) {
+        for (int k = 0; k < 3; ++k) body.v[3 * i + k] = (body.target[3 * i + k] - body.x[3 * i + k]) / dt;
+    });
 }
 
 void end_kinematic_motion(Body& body) {
-    for (size_t i = 0; i < body.kinematic.size(); ++i) {
-        if (!body.kinematic[i] && body.mass[i] > 0.0) continue;
+    const size_t n = body.mass.size();
+    auto settle = [&](size_t i) {
         for (int k = 0; k < 3; ++k) {
             if (body.kinematic[i]) body.x[3 * i + k] = body.target[3 * i + k];
             body.v[3 * i + k] = 0.0;
         }
+    };
+    size_t i = 0;
+#if defined(__AVX512F__)
+    for (; i + 8 <= n; i += 8) {
+        uint64_t kinematic8;
+        std::memcpy(&kinematic8, &body.kinematic[i], sizeof kinematic8);
+        const __mmask8 massless =
+            _mm512_cmp_pd_mask(_mm512_loadu_pd(body.mass.data() + i), _mm512_setzero_pd(), _CMP_NGT_UQ);
+        if (!kinematic8 && !massless) continue;
+        for (size_t k = i; k < i + 8; ++k)
+            if (body.kinematic[k] || !(body.mass[k] > 0.0)) settle(k);
     }
+#endif
+    for (; i < n; ++i)
+        if (body.kinematic[i] || !(body.mass[i] > 0.0)) settle(i);
 }
 
 bool body_state_is_sane(const Body& body) {
     const double limit2 = body.settings.runaway_speed * body.settings.runaway_speed;
-    bool sane = true;
-    for (size_t i = 0; i < body.mass.size(); ++i) {
-        const double* xi = &body.x[3 * i];
-        const double* vi = &body.v[3 * i];
-        // NaN fails every comparison, so a non-finite speed fails the first test too.
-        sane &= vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2] <= limit2 && std::isfinite(xi[0] + xi[1] + xi[2]);
+    const size_t n = body.mass.size();
+    const double* x = body.x.data();
+    const double* v = body.v.data();
+    bool insane = false;
+    size_t i = 0;
+#if defined(__AVX512F__)
+    const __m512d v_bound = _mm512_set1_pd(0.57 * body.settings.runaway_speed);
+    for (; i + 8 <= n; i += 8) {
+        __mmask8 flagged = 0;
+        for (int r = 0; r < 3; ++r)
+            flagged |= outside_bounds(_mm512_loadu_pd(x + 3 * i + 8 * r), _mm512_loadu_pd(v + 3 * i + 8 * r), v_bound);
+        if (flagged)
+            for (size_t k = i; k < i + 8; ++k) insane |= node_insane(x, v, k, limit2);
     }
-    return sane;
+#endif
+    for (; i < n; ++i) insane |= node_insane(x, v, i, limit2);
+    return !insane;
 }
 
 }  // namespace sh

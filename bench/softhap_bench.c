@@ -3,6 +3,7 @@
  *
  *   softhap_bench [FILTER] [--steps N] [--meshes DIR]      FEM materials and springs
  *   softhap_bench integrators [FILTER] [--steps N]          forward/symplectic Euler, RK2, RK4
+ *   softhap_bench implicit [FILTER] [--steps N]             implicit Euler step, direct vs CG
  *   softhap_bench accuracy [--quick] [--jobs N]             error against run time (accuracy.c)
  *
  * Each case builds a world with one body from a mesh in ../shared/meshes (scaled so its largest
@@ -48,6 +49,7 @@ static const int kMinSteps = 500, kMaxSteps = 2000, kWarmupSteps = 30;
 static const char* const kMeshes[] = {"Armadillo_Tetra_4406", "raptorTetra_8418", "raptorTetra_19409"};
 static const char* g_mesh_dir = NULL;
 static int g_steps = 0; /* --steps N; 0 = adaptive */
+static double g_factor_reuse = -1.0; /* implicit: --factor-reuse X; < 0 = the default */
 
 #define CHECK(expr)                                                                                 \
     do {                                                                                            \
@@ -183,7 +185,8 @@ static const body_kind kKinds[] = {{"linear", SH_MATERIAL_LINEAR},
                                    {"neohookean", SH_MATERIAL_NEOHOOKEAN},
                                    {"springs", -1}};
 
-static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_integrator integrator) {
+static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_integrator integrator,
+                           const sh_implicit_settings* implicit) {
     sh_body_id body = SH_NULL_BODY;
     if (model >= 0) {
         sh_fem_body_def def;
@@ -194,6 +197,7 @@ static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_i
         def.material.poisson = kPoisson;
         def.material.density = kDensity;
         def.integrator = integrator;
+        if (implicit) def.implicit = *implicit;
         CHECK(sh_world_add_fem_body(world, &def, &body));
     } else {
         /* A rod of section l^2 and length l has axial stiffness E l; nodes share the mass. */
@@ -204,6 +208,7 @@ static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_i
         def.params.stiffness = kYoung * m->mean_edge;
         def.node_mass = kDensity * m->info.volume / (m->info.node_count - m->info.orphan_node_count);
         def.integrator = integrator;
+        if (implicit) def.implicit = *implicit;
         CHECK(sh_world_add_spring_body(world, &def, &body));
     }
     CHECK(sh_body_fix_nodes(world, body, m->fixed, m->fixed_count));
@@ -316,7 +321,7 @@ static void run_case(const bench_mesh* m, const body_kind* kind, const char* fil
         sh_world_def_default(&wd);
         sh_world* world = NULL;
         CHECK(sh_world_create(&wd, &world));
-        const sh_body_id body = add_body(world, m, kind->model, SH_INTEGRATOR_SYMPLECTIC_EULER);
+        const sh_body_id body = add_body(world, m, kind->model, SH_INTEGRATOR_SYMPLECTIC_EULER, NULL);
         const double dt = kDtFraction * body_dt_crit(world, body);
         const timing t = time_steps(world, dt, with_report, with_report ? kReportSeconds : kCaseSeconds, NULL);
         uint64_t warnings[SH_WARN_COUNT];
@@ -347,7 +352,7 @@ static void run_integrators(const char* filter) {
         sh_world_def_default(&wd);
         sh_world* world = NULL;
         CHECK(sh_world_create(&wd, &world));
-        const sh_body_id body = add_body(world, &m, SH_MATERIAL_STVK, kIntegrators[k].integrator);
+        const sh_body_id body = add_body(world, &m, SH_MATERIAL_STVK, kIntegrators[k].integrator, NULL);
         const double dt = 0.1 * body_dt_crit(world, body);
         const reset_plan reset = {body, &m, zeros, 200};
         const timing t = time_steps(world, dt, 0, kCaseSeconds, &reset);
@@ -360,9 +365,86 @@ static void run_integrators(const char* filter) {
     free_mesh(&m);
 }
 
+/* The implicit Euler step on raptorTetra_19409 (gravity, highest 1% of the nodes fixed), dt =
+ * kImplicitDt, one linearised solve per step (the default), per material and linear solver. The
+ * body falls from rest and swings, so its stiffness changes from step to step. Per step: wall
+ * time, and from the step report the factorisation and solve times (assembly and the rest = wall -
+ * both). Steps whose report shows a factorisation are counted ("factorizations"). */
+static const double kImplicitDt = 0.01; /* s: a 100 Hz organ step */
+
+static void run_implicit(const char* filter) {
+    static const struct {
+        const char* name;
+        sh_linear_solver solver;
+    } kSolvers[] = {{"cholmod", SH_LINEAR_SOLVER_CHOLMOD}, {"ldlt", SH_LINEAR_SOLVER_LDLT}, {"cg", SH_LINEAR_SOLVER_CG}};
+    const int steps = g_steps > 0 ? g_steps : 100;
+    bench_mesh m;
+    if (!load_mesh("raptorTetra_19409", &m)) exit(1);
+    for (size_t j = 0; j < sizeof kKinds / sizeof kKinds[0]; ++j) {
+        for (size_t k = 0; k < sizeof kSolvers / sizeof kSolvers[0]; ++k) {
+            char name[256];
+            snprintf(name, sizeof name, "implicit/%s/%s/%s", kKinds[j].name, kSolvers[k].name, m.name);
+            if (!matches(name, filter)) continue;
+            if (kSolvers[k].solver == SH_LINEAR_SOLVER_CHOLMOD && !(sh_build_features() & SH_FEATURE_CHOLMOD)) continue;
+            sh_world_def wd;
+            sh_world_def_default(&wd);
+            sh_world* world = NULL;
+            CHECK(sh_world_create(&wd, &world));
+            sh_implicit_settings implicit;
+            {   /* the body def's defaults, with the solver chosen */
+                sh_fem_body_def def;
+                sh_fem_body_def_default(&def);
+                implicit = def.implicit;
+            }
+            implicit.linear_solver = kSolvers[k].solver;
+            if (g_factor_reuse >= 0.0) implicit.factor_reuse = g_factor_reuse;
+            add_body(world, &m, kKinds[j].model, SH_INTEGRATOR_IMPLICIT_EULER, &implicit);
+            double* wall = (double*)xmalloc(sizeof(double) * (size_t)steps);
+            double factorize = 0.0, solve = 0.0, first_step = 0.0;
+            int factorizations = 0, failed = 0;
+            long linear_iterations = 0;
+            sh_step_report report;
+            for (int s = -1; s < steps; ++s) { /* step -1: first step (analysis), reported apart */
+                const double t0 = now_ns();
+                const sh_status st = sh_world_step(world, kImplicitDt, &report);
+                const double ns = now_ns() - t0;
+                if (st != SH_OK) {
+                    if (!failed) fprintf(stderr, "softhap_bench: %s step %d: %s\n", name, s, sh_last_error_message());
+                    ++failed;
+                }
+                if (s < 0) {
+                    first_step = ns;
+                    continue;
+                }
+                wall[s] = ns;
+                factorize += report.factorize_seconds;
+                solve += report.solve_seconds;
+                factorizations += report.factorize_seconds > 0.0;
+                linear_iterations += report.linear_iterations;
+            }
+            double sum = 0.0;
+            for (int s = 0; s < steps; ++s) sum += wall[s];
+            qsort(wall, (size_t)steps, sizeof(double), cmp_double);
+            printf("{\"case\":\"%s\",\"tets\":%d,\"dofs\":%d,\"dt\":%g,\"median_ms\":%.3f,\"p99_ms\":%.3f,"
+                   "\"p999_ms\":%.3f,\"max_ms\":%.3f,\"mean_ms\":%.3f,\"min_ms\":%.3f,\"factorize_ms_mean\":%.3f,"
+                   "\"solve_ms_mean\":%.3f,\"other_ms_mean\":%.3f,\"factorizations\":%d,\"linear_iterations_mean\":%.2f,"
+                   "\"first_step_ms\":%.1f,\"steps\":%d,\"failed_steps\":%d}\n",
+                   name, m.info.tet_count, 3 * (m.info.node_count - m.info.orphan_node_count - m.fixed_count), kImplicitDt,
+                   median(wall, steps) * 1e-6, quantile(wall, steps, 0.99) * 1e-6, quantile(wall, steps, 0.999) * 1e-6,
+                   wall[steps - 1] * 1e-6, sum / steps * 1e-6, wall[0] * 1e-6, factorize / steps * 1e3,
+                   solve / steps * 1e3, (sum * 1e-9 - factorize - solve) / steps * 1e3, factorizations,
+                   (double)linear_iterations / steps, first_step * 1e-6, steps, failed);
+            fflush(stdout);
+            free(wall);
+            CHECK(sh_world_destroy(world));
+        }
+    }
+    free_mesh(&m);
+}
+
 static void usage(void) {
     fprintf(stderr,
-            "usage: softhap_bench [integrators] [FILTER] [--steps N] [--meshes DIR]\n"
+            "usage: softhap_bench [integrators|implicit] [FILTER] [--steps N] [--meshes DIR]\n"
             "  FILTER  keep the cases whose name contains it (e.g. stvk/raptorTetra_19409)\n"
             "  --steps N  timed steps per case (default: adaptive, %d..%d)\n"
             "  --meshes DIR  mesh folder (default $SOFTHAP_MESHES, " SOFTHAP_BENCH_MESH_DIR
@@ -381,7 +463,7 @@ static int file_exists(const char* dir, const char* name) {
 int main(int argc, char** argv) {
     if (argc > 1 && strcmp(argv[1], "accuracy") == 0) return run_accuracy(argc - 1, argv + 1);
     const char* filter = NULL;
-    int integrators = 0;
+    int integrators = 0, implicit = 0;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
             g_steps = atoi(argv[++i]);
@@ -389,13 +471,17 @@ int main(int argc, char** argv) {
                 usage();
                 return 2;
             }
+        } else if (strcmp(argv[i], "--factor-reuse") == 0 && i + 1 < argc) {
+            g_factor_reuse = atof(argv[++i]);
         } else if (strcmp(argv[i], "--meshes") == 0 && i + 1 < argc) {
             g_mesh_dir = argv[++i];
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage();
             return 0;
-        } else if (strcmp(argv[i], "integrators") == 0 && !integrators) {
+        } else if (strcmp(argv[i], "integrators") == 0 && !integrators && !implicit) {
             integrators = 1;
+        } else if (strcmp(argv[i], "implicit") == 0 && !integrators && !implicit) {
+            implicit = 1;
         } else if (!filter && argv[i][0] != '-') {
             filter = argv[i];
         } else {
@@ -430,6 +516,10 @@ int main(int argc, char** argv) {
     }
     if (integrators) {
         run_integrators(filter);
+        return 0;
+    }
+    if (implicit) {
+        run_implicit(filter);
         return 0;
     }
     for (size_t k = 0; k < sizeof kMeshes / sizeof kMeshes[0]; ++k) {

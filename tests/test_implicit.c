@@ -121,6 +121,103 @@ static void test_stiff_body_stable(void** state) {
     assert_ok(sh_mesh_destroy(box));
 }
 
+/* The exact backward Euler step of the oscillator along its axis with
+ * node damping c (force -c m v): (m (1 + h c) + h^2 k) v1 = m v0 - h k (x0 - L), x1 = x0 + h v1.
+ * The oscillator's axial stiffness is constant, so a kept factorisation is exact for it: every
+ * step matches this recursion to round-off, and the report shows a factorisation only on the
+ * first step and after dt or the damping changed. */
+static void test_factor_reuse_exact_and_invalidated(void** state) {
+    (void)state;
+    sh_world* world = sh_test_world(0.0);
+    const sh_body_id body = add_oscillator(world, SH_LINEAR_SOLVER_DEFAULT);
+    double x = kRest + kAmplitude, v = 0.0, c = 0.0;
+    const double phases[3][2] = {{1e-2, 0.0}, {3e-3, 0.0}, {3e-3, 5.0}}; /* (h, c) */
+    int total = 0;
+    for (int phase = 0; phase < 3; ++phase) {
+        const double h = phases[phase][0];
+        if (phases[phase][1] != c) {
+            c = phases[phase][1];
+            const double damping[2] = {c, c};
+            assert_ok(sh_body_set_node_damping(world, body, damping, 2));
+        }
+        for (int n = 0; n < 20; ++n) {
+            sh_step_report report;
+            assert_ok(sh_world_step(world, h, &report));
+            v = (kMass * v - h * kStiffness * (x - kRest)) / (kMass * (1.0 + h * c) + h * h * kStiffness);
+            x += h * v;
+            double xs[6], vs[6];
+            assert_ok(sh_body_get_positions(world, body, xs, 6));
+            assert_ok(sh_body_get_velocities(world, body, vs, 6));
+            assert_true(fabs(xs[3] - x) <= 1e-14 && fabs(vs[3] - v) <= 1e-12);
+            assert_int_equal(report.factorizations, n == 0 ? 1 : 0);
+            total += report.factorizations;
+        }
+    }
+    assert_int_equal(total, 3);
+    assert_ok(sh_world_destroy(world));
+}
+
+/* A StVK bar clamped at one end swings down under gravity (a tip drop over half its length). With
+ * Newton iterated to 1e-10, a kept factorisation changes only the path, not the answer: the
+ * positions match exact Newton (a factorisation per iteration) to 1e-9 of the bar's length,
+ * with fewer factorisations than iterations, and the linearised step with reuse refactorises
+ * when the rotation makes the kept tangent stale (more than once over the swing). */
+static void test_factor_reuse_nonlinear(void** state) {
+    (void)state;
+    const double length = 0.1;
+    sh_mesh* bar = sh_test_box(length, 0.01, 0.01, 10, 1, 1);
+    sh_mesh_info info;
+    assert_ok(sh_mesh_get_info(bar, &info));
+    const int n = info.node_count;
+    double* rest = malloc(sizeof(double) * 3 * n);
+    double* x[2] = {malloc(sizeof(double) * 3 * n), malloc(sizeof(double) * 3 * n)};
+    assert_ok(sh_mesh_get_nodes(bar, rest, 3 * n));
+    int32_t fixed[8];
+    int fixed_count = 0;
+    for (int i = 0; i < n; ++i)
+        if (rest[3 * i] < 1e-12) fixed[fixed_count++] = i;
+    int factorizations[3] = {0, 0, 0}, iterations[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k) { /* 0: exact Newton, 1: Newton with reuse, 2: linearised with reuse */
+        sh_world* world = sh_test_world(-9.81);
+        sh_fem_body_def def;
+        sh_fem_body_def_default(&def);
+        def.mesh = bar;
+        def.material.model = SH_MATERIAL_STVK;
+        def.material.young = 1e4;
+        def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+        def.implicit.newton_max_iterations = k < 2 ? 30 : 1;
+        def.implicit.newton_tolerance = 1e-10;
+        def.implicit.factor_reuse = k == 0 ? 0.0 : 0.25;
+        sh_body_id body;
+        assert_ok(sh_world_add_fem_body(world, &def, &body));
+        assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
+        for (int s = 0; s < 60; ++s) {
+            sh_step_report report;
+            assert_ok(sh_world_step(world, 5e-3, &report));
+            factorizations[k] += report.factorizations;
+            iterations[k] += report.newton_iterations;
+        }
+        assert_ok(sh_body_get_positions(world, body, x[k < 2 ? k : 0], 3 * n));
+        if (k == 1) {
+            double tip_drop = 0.0;
+            for (int j = 0; j < 3 * n; ++j) assert_true(fabs(x[1][j] - x[0][j]) <= 1e-9 * length);
+            for (int i = 0; i < n; ++i) tip_drop = fmax(tip_drop, -x[1][3 * i + 2]);
+            assert_true(tip_drop > 0.5 * length); /* a large rotation, not a small sag */
+        }
+        assert_ok(sh_world_destroy(world));
+    }
+    print_message("factorisations / Newton iterations over 60 steps: exact Newton %d / %d, reuse %d / %d, "
+                  "linearised with reuse %d / %d\n",
+                  factorizations[0], iterations[0], factorizations[1], iterations[1], factorizations[2], iterations[2]);
+    assert_int_equal(factorizations[0], iterations[0]);
+    assert_true(factorizations[1] < iterations[1]);
+    assert_true(factorizations[2] > 1 && factorizations[2] < 60);
+    free(rest);
+    free(x[0]);
+    free(x[1]);
+    assert_ok(sh_mesh_destroy(bar));
+}
+
 /* CHOLMOD, LDLT and CG give the same step on a deforming liver. */
 static void test_backends_agree(void** state) {
     (void)state;
@@ -146,6 +243,7 @@ static void test_backends_agree(void** state) {
         def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
         def.implicit.linear_solver = solvers[k];
         def.implicit.cg_tolerance = 1e-12;
+        def.implicit.factor_reuse = 0.0; /* every backend solves the same linearised systems */
         sh_body_id body;
         assert_ok(sh_world_add_fem_body(world, &def, &body));
         const int32_t clamp[6] = {0, 1, 2, 3, 4, 5};
@@ -167,6 +265,8 @@ int main(void) {
         cmocka_unit_test(test_oscillator_exact_decay),
         cmocka_unit_test(test_oscillator_order),
         cmocka_unit_test(test_stiff_body_stable),
+        cmocka_unit_test(test_factor_reuse_exact_and_invalidated),
+        cmocka_unit_test(test_factor_reuse_nonlinear),
         cmocka_unit_test(test_backends_agree),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -33,7 +33,7 @@ extern "C" {
 /** Major version: incremented on ABI-incompatible changes. */
 #define SH_VERSION_MAJOR 0
 /** Minor version: incremented when features are added compatibly. */
-#define SH_VERSION_MINOR 2
+#define SH_VERSION_MINOR 3
 /** Patch version: incremented for fixes. */
 #define SH_VERSION_PATCH 0
 /** Version this header declares: MAJOR*1000000 + MINOR*1000 + PATCH. */
@@ -198,6 +198,11 @@ typedef uint64_t sh_body_id;
 typedef struct sh_world_def {
     uint32_t internal_init; /**< set by sh_world_def_default; do not touch */
     double gravity[3];      /**< gravitational acceleration (m/s^2), default (0, 0, -9.81) */
+    int32_t error_estimate; /**< 1: every sh_world_step also takes each body over dt in two
+                                 half steps from the same start state and reports how far
+                                 apart the two results are (step doubling, see
+                                 sh_step_report.error_estimate); the state kept is still the
+                                 full step's. About doubles the step's cost. Default 0 (off) */
 } sh_world_def;
 
 /** Fill a world def with defaults. Thread: any. Alloc: none. */
@@ -232,6 +237,15 @@ typedef struct sh_step_report {
     double newton_residual;      /**< implicit bodies: largest final relative residual */
     double factorize_seconds;    /**< implicit bodies: time in sparse factorisations (s) */
     double solve_seconds;        /**< implicit bodies: time in sparse solves (s) */
+    int32_t factorizations;      /**< implicit bodies: sparse factorisations in this step (0
+                                      when every solve reused a kept factorisation) */
+    double error_estimate;       /**< with sh_world_def.error_estimate: the largest distance
+                                      (m) of any node between this step and two half steps
+                                      from the same start. It estimates the local error of
+                                      the step: for a method of order p the full step's error
+                                      is about 2^p / (2^p - 1) times it. -1 when off or when a
+                                      half step failed */
+    double error_estimate_seconds; /**< time spent on the half steps (s), 0 when off */
 } sh_step_report;
 
 /** Advance every body by dt seconds with its own integrator. A body whose step is rejected
@@ -280,6 +294,16 @@ typedef struct sh_implicit_settings {
                                          1e-9 m/s); default 1e-6 */
     double cg_tolerance;            /**< CG relative residual; default 1e-8 */
     int32_t cg_max_iterations;      /**< CG iteration cap; default 2000 */
+    double factor_reuse;            /**< direct solvers (CHOLMOD, LDLT): the factorisation of
+                                         M + dt D + dt^2 K is kept across Newton iterations and
+                                         steps while an update solved with it cuts the residual
+                                         |g| by at least this factor (|g_new| <= factor_reuse
+                                         |g|); a slower update is discarded and solved again
+                                         with a fresh factorisation at the same state. Changing
+                                         dt, the fixed nodes, a material or node damping also
+                                         refactorises. 0 = a new factorisation at every Newton
+                                         iteration (exact Newton); must be in [0, 1); default
+                                         0.25 */
 } sh_implicit_settings;
 
 /** What a step larger than the body's critical step does. */

@@ -37,6 +37,8 @@ sh_implicit_settings checked_implicit_settings(const sh_implicit_settings& in) {
                "def->implicit.cg_tolerance = %g, must be finite and > 0", in.cg_tolerance);
     SH_REQUIRE(in.cg_max_iterations >= 1, SH_ERR_INVALID_ARGUMENT,
                "def->implicit.cg_max_iterations = %d, must be >= 1", in.cg_max_iterations);
+    SH_REQUIRE(std::isfinite(in.factor_reuse) && in.factor_reuse >= 0.0 && in.factor_reuse < 1.0,
+               SH_ERR_INVALID_ARGUMENT, "def->implicit.factor_reuse = %g, must be in [0, 1)", in.factor_reuse);
     sh_implicit_settings out = in;
     out.linear_solver = static_cast<sh_linear_solver>(solver);
     return out;
@@ -49,6 +51,7 @@ sh_implicit_settings default_implicit_settings() {
     s.newton_tolerance = 1e-6;
     s.cg_tolerance = 1e-8;
     s.cg_max_iterations = 2000;
+    s.factor_reuse = 0.25;
     return s;
 }
 
@@ -87,6 +90,8 @@ SH_API sh_status sh_world_create(const sh_world_def* def, sh_world** out_world) 
         *out_world = nullptr;
         capi::require_initialised(def, "def");
         for (int k = 0; k < 3; ++k) capi::require_finite(def->gravity[k], "def->gravity");
+        SH_REQUIRE(def->error_estimate == 0 || def->error_estimate == 1, SH_ERR_INVALID_ARGUMENT,
+                   "def->error_estimate = %d, must be 0 or 1", def->error_estimate);
         sh_world* world = sh::create<sh_world>(*def);
         try {
             capi::register_handle(HandleKind::World, world);

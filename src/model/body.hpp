@@ -96,6 +96,9 @@ public:
     vec<double> target;          ///< 3 per node, where kinematic nodes go in the next step
     vec<double> external_force;  ///< 3 per node (N), held
     vec<double> node_damping;    ///< per-node viscous coefficient (1/s); empty if unused
+    /// Bumped whenever K or D change other than through x (a material change): a factorisation
+    /// kept by the implicit integrator is valid only for the version it was built at.
+    uint64_t stiffness_version = 0;
     IntegratorWorkspace workspace;
 };
 

@@ -59,6 +59,7 @@ public:
     CholmodSolver& operator=(const CholmodSolver&) = delete;
 
     const char* name() const override { return "cholmod"; }
+    bool is_direct() const override { return true; }
     const char* method() const override {
         if (!factor_ || factor_->xtype == CHOLMOD_PATTERN) return "cholmod (not factorised)";
         if (factor_->is_super) return "cholmod supernodal LL^T";

@@ -30,6 +30,7 @@ CscMap map_of(const SparseSystem& a) {
 class EigenLdltSolver final : public LinearSolver {
 public:
     const char* name() const override { return "eigen-ldlt"; }
+    bool is_direct() const override { return true; }
     const char* method() const override { return "eigen simplicial LDL^T (AMD)"; }
     int64_t factor_nonzeros() const override {  // strictly lower L plus D
         return factorized_ ? static_cast<int64_t>(ldlt_.matrixL().nestedExpression().nonZeros() + ldlt_.rows()) : 0;

@@ -21,6 +21,7 @@ struct BodyStepResult {
     double newton_residual = 0.0;   ///< implicit: final relative residual (-1 if not measured)
     double factorize_seconds = 0.0; ///< implicit: time in factorisations (s)
     double solve_seconds = 0.0;     ///< implicit: time in solves (s)
+    int32_t factorizations = 0;     ///< implicit: factorisations in this step
 };
 
 

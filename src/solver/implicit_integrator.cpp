@@ -59,7 +59,7 @@ int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_
     LinearSolverPtr solver = make_linear_solver(solver_kind(s.linear_solver), s.cg_tolerance, s.cg_max_iterations);
     if (free_count > 0) solver->analyze(system);
     const size_t dofs = 3 * static_cast<size_t>(free_count);
-    vec<double> residual(dofs), delta(dofs, 0.0), diagonal(dofs);
+    vec<double> residual(dofs), delta(dofs, 0.0), diagonal(dofs), previous_v(dofs), factor_diagonal(dofs);
     // Commit only once everything is built.
     state.system = std::move(system);
     state.solver = std::move(solver);
@@ -67,6 +67,9 @@ int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_
     state.residual.swap(residual);
     state.delta.swap(delta);
     state.diagonal.swap(diagonal);
+    state.previous_v.swap(previous_v);
+    state.factor_diagonal.swap(factor_diagonal);
+    state.factor_valid = false;
     state.free_count = free_count;
     return 3 * free_count;
 }
@@ -88,11 +91,11 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
         const double c = body.settings.damping_mass + (per_node ? body.node_damping[node] : 0.0);
         state.diagonal[static_cast<size_t>(d)] = body.mass[node] * (1.0 + dt * c);
     }
+    const bool reuse = s.factor_reuse > 0.0 && state.solver->is_direct();
+    bool factor_current = reuse && state.factor_valid && state.factor_dt == dt &&
+                          state.factor_stiffness_version == body.stiffness_version &&
+                          std::equal(state.diagonal.begin(), state.diagonal.end(), state.factor_diagonal.begin());
 
-    // Newton on g(v) = M (v - v0) - dt F(x0 + dt v, v) over the free DOFs, from v = v0.
-    const int max_iterations = std::max(1, s.newton_max_iterations);
-    double* a = w.a[0].data();
-    double residual0 = 0.0, roundoff_floor = 0.0;
     double applied_load = 0.0;  // |f_ext + m g| over the free DOFs (N)
     for (int32_t d = 0; d < dofs; ++d) {
         const size_t j = static_cast<size_t>(global[static_cast<size_t>(d)]);
@@ -101,75 +104,101 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
     }
     applied_load = std::sqrt(applied_load);
     const double gravity_norm = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-    result.newton_residual = -1.0;
-    bool converged = max_iterations == 1;
-    for (int iteration = 0;; ++iteration) {
+
+    // Newton on g(v) = M (v - v0) - dt F(x0 + dt v, v) over the free DOFs, from v = v0.
+    double* a = w.a[0].data();
+    auto residual_norm = [&] {
         for (size_t j = 0; j < n3; ++j) body.x[j] = w.x0[j] + dt * body.v[j];
         compute_accelerations(body, body.x.data(), body.v.data(), g, a);
         for (int32_t d = 0; d < dofs; ++d) {
             const size_t j = static_cast<size_t>(global[static_cast<size_t>(d)]);
             state.residual[static_cast<size_t>(d)] = body.mass[j / 3] * (body.v[j] - w.v0[j] - dt * a[j]);
         }
-        const double r = norm(state.residual);
-        if (iteration == 0) residual0 = std::max(r, dt * applied_load);
-        if (iteration > 0) result.newton_residual = residual0 > 0.0 ? r / residual0 : 0.0;
+        return norm(state.residual);
+    };
+    auto fail = [&](sh_status status, const char* reason) {
+        restore_start_state(body);
+        result.stable = false;
+        result.status = status;
+        result.reason = reason;
+        return result;
+    };
+
+    const int max_iterations = std::max(1, s.newton_max_iterations);
+    double r = residual_norm();
+    const double residual0 = std::max(r, dt * applied_load);
+    result.newton_residual = -1.0;
+    bool converged = residual0 == 0.0;
+    bool fresh = false;  // the factorisation is of the tangent at the current iterate
+    for (int iteration = 0; !converged;) {
         // Converged: small against the first residual or the applied load's impulse, or down
         // to the round-off of the element forces themselves.
-        if (residual0 == 0.0 || (iteration > 0 && r <= std::max(s.newton_tolerance * residual0, roundoff_floor))) {
+        if (iteration > 0 && r <= std::max(s.newton_tolerance * residual0, state.roundoff_floor)) {
             converged = true;
             break;
         }
         if (iteration == max_iterations) break;
 
-        state.system.clear_values();
-        body.add_tangent(body.x.data(), dt * dt, dt, state.system);
-        if (iteration == 0) roundoff_floor = force_roundoff(state.system, body.x, 1.0 / dt);  // system: dt^2 K
-        state.system.add_diagonal(state.diagonal.data(), 1.0);
         try {
-            state.solver->factorize(state.system);
+            if (!factor_current) {
+                state.factor_valid = false;
+                state.system.clear_values();
+                body.add_tangent(body.x.data(), dt * dt, dt, state.system);
+                state.roundoff_floor = force_roundoff(state.system, body.x, 1.0 / dt);  // system: dt^2 K
+                state.system.add_diagonal(state.diagonal.data(), 1.0);
+                state.solver->factorize(state.system);
+                result.factorize_seconds += state.solver->factorize_seconds;
+                ++result.factorizations;
+                state.factor_valid = reuse;
+                state.factor_dt = dt;
+                state.factor_stiffness_version = body.stiffness_version;
+                std::copy(state.diagonal.begin(), state.diagonal.end(), state.factor_diagonal.begin());
+                factor_current = true;
+                fresh = true;
+            }
             for (double& r_d : state.residual) r_d = -r_d;
             result.linear_iterations += state.solver->solve(state.system, state.residual.data(), state.delta.data());
+            result.solve_seconds += state.solver->solve_seconds;
         } catch (const Error& e) {
-            result.factorize_seconds += state.solver->factorize_seconds;
-            restore_start_state(body);
-            result.stable = false;
-            result.status = e.status();
-            result.reason = e.status() == SH_ERR_NOT_CONVERGED ? "the linear solver did not converge"
-                                                                 : "the sparse factorisation failed (matrix not positive definite)";
-            return result;
+            state.factor_valid = false;
+            return fail(e.status(), e.status() == SH_ERR_NOT_CONVERGED
+                                        ? "the linear solver did not converge"
+                                        : "the sparse factorisation failed (matrix not positive definite)");
         }
-        result.factorize_seconds += state.solver->factorize_seconds;
-        result.solve_seconds += state.solver->solve_seconds;
-        ++result.newton_iterations;
         double largest_change = 0.0, largest_speed = 0.0;
         for (int32_t d = 0; d < dofs; ++d) {
             double& v = body.v[static_cast<size_t>(global[static_cast<size_t>(d)])];
+            state.previous_v[static_cast<size_t>(d)] = v;
             v += state.delta[static_cast<size_t>(d)];
             largest_change = std::max(largest_change, std::fabs(state.delta[static_cast<size_t>(d)]));
             largest_speed = std::max(largest_speed, std::fabs(v));
         }
+        const double r_new = residual_norm();
+        if (!fresh && !(r_new <= s.factor_reuse * r)) {
+            // The kept factorisation is too far from the current tangent: take the update back
+            // and solve again with a new one here.
+            for (int32_t d = 0; d < dofs; ++d)
+                body.v[static_cast<size_t>(global[static_cast<size_t>(d)])] = state.previous_v[static_cast<size_t>(d)];
+            r = residual_norm();
+            factor_current = false;
+            continue;
+        }
+        r = r_new;
+        fresh = false;
+        factor_current = reuse;  // exact Newton (or CG) builds the tangent at every iterate
+        ++iteration;
+        ++result.newton_iterations;
+        result.newton_residual = residual0 > 0.0 ? r / residual0 : 0.0;
         // Near equilibrium of a stiff body the residual is cancellation noise of large element
         // forces, so a negligible velocity correction also ends the iteration.
         const double speed_scale = std::max({largest_speed, dt * gravity_norm, kSpeedFloor});
-        const bool negligible = iteration > 0 && largest_change <= s.newton_tolerance * speed_scale;
-        if (max_iterations == 1 || negligible) {
-            for (size_t j = 0; j < n3; ++j) body.x[j] = w.x0[j] + dt * body.v[j];
-            converged = true;
-            break;
-        }
+        const bool negligible = iteration > 1 && largest_change <= s.newton_tolerance * speed_scale;
+        if (max_iterations == 1 || negligible) converged = true;
     }
     end_kinematic_motion(body);
-    if (!converged) {
-        restore_start_state(body);
-        result.stable = false;
-        result.status = SH_ERR_NOT_CONVERGED;
-        result.reason = "Newton iterations did not reach newton_tolerance";
-    } else if (!body_state_is_sane(body)) {
-        restore_start_state(body);
-        result.stable = false;
-        result.status = SH_ERR_UNSTABLE;
-        result.reason = "the state became non-finite or exceeded the runaway speed; rolled back";
-    }
+    if (!converged) return fail(SH_ERR_NOT_CONVERGED, "Newton iterations did not reach newton_tolerance");
+    if (!body_state_is_sane(body))
+        return fail(SH_ERR_UNSTABLE, "the state became non-finite or exceeded the runaway speed; rolled back");
     return result;
 }
 

@@ -1,6 +1,8 @@
 // Backward (implicit) Euler for one body: Newton iterations on the end-of-step velocity,
 // starting from the current one (one iteration = the linearised Baraff-Witkin step), with the
 // sparse system and linear solver kept across steps while the set of free nodes is unchanged.
+// Direct solvers also keep their factorisation across iterations and steps (a chord/lagged
+// Newton method) while the updates it gives cut the residual fast enough.
 #pragma once
 
 #include "model/body.hpp"
@@ -18,10 +20,22 @@ struct ImplicitState {
     vec<double> residual;       ///< per free DOF
     vec<double> delta;          ///< per free DOF (CG warm start)
     vec<double> diagonal;       ///< per free DOF: m (1 + h (alpha + c_i))
+    vec<double> previous_v;     ///< per free DOF: velocities before a trial update
     int32_t free_count = -1;    ///< -1: pattern not built yet
+
+    // The kept factorisation of a direct solver: of M + h D + h^2 K(x_f) for this step size,
+    // mass-and-damping diagonal and the body's stiffness version, at some earlier state x_f.
+    bool factor_valid = false;
+    double factor_dt = 0.0;
+    uint64_t factor_stiffness_version = 0;
+    vec<double> factor_diagonal;  ///< per free DOF: the diagonal it was built with
+    double roundoff_floor = 0.0;  ///< residual round-off level at the factorised state
 };
 
-/// Advances body by dt with backward Euler. On a failed factorisation (SH_ERR_SOLVER), a
+/// Advances body by dt with backward Euler. With a direct solver and
+/// settings.implicit.factor_reuse > 0 an update solved with a kept factorisation is accepted if
+/// it cuts the residual by that factor, else discarded and solved again with a factorisation
+/// at the same iterate. On a failed factorisation (SH_ERR_SOLVER), a
 /// Newton loop that misses its tolerance (SH_ERR_NOT_CONVERGED) or a non-finite or runaway
 /// state (SH_ERR_UNSTABLE) the body is restored and result.status says why.
 BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double gravity[3]);

@@ -38,6 +38,9 @@ public:
 
     /// Static description of the backend as configured ("cholmod", "eigen-ldlt", "eigen-cg-jacobi").
     virtual const char* name() const = 0;
+    /// True for direct solvers: after factorize, solve is exact for the factorised values, and
+    /// keeps working after the system's values change (CG multiplies with the current system).
+    virtual bool is_direct() const { return false; }
     /// After factorize: a short description of the factorisation actually used, e.g.
     /// "cholmod supernodal LL^T" (CHOLMOD's automatic choice); name() before.
     virtual const char* method() const { return name(); }

@@ -5,6 +5,8 @@
 #include "solver/implicit_integrator.hpp"
 #include "solver/static_solver.hpp"
 #include "solver/step_support.hpp"
+#include "world/body_step.hpp"
+#include "world/step_doubling.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -29,15 +31,21 @@ uint32_t next_generation() {
 
 }  // namespace
 
-World::World(const sh_world_def& def) {
+World::World(const sh_world_def& def) : error_estimate_(def.error_estimate != 0) {
     for (int k = 0; k < 3; ++k) gravity[k] = def.gravity[k];
 }
 
 World::~World() {
-    for (Slot& slot : slots_) {
-        sh::destroy(slot.body);
-        sh::destroy(slot.implicit);
-    }
+    for (Slot& slot : slots_) destroy_slot(slot);
+}
+
+void World::destroy_slot(Slot& slot) {
+    sh::destroy(slot.body);
+    sh::destroy(slot.implicit);
+    sh::destroy(slot.doubling);
+    slot.body = nullptr;
+    slot.implicit = nullptr;
+    slot.doubling = nullptr;
 }
 
 sh_body_id World::add_body(Body* body) {
@@ -56,8 +64,19 @@ sh_body_id World::add_body(Body* body) {
         }
         index = static_cast<uint32_t>(slots_.size() - 1);
     }
+    StepDoubling* doubling = nullptr;
+    if (error_estimate_) {
+        try {
+            doubling = sh::create<StepDoubling>(body->x.size());
+        } catch (...) {
+            free_slots_.push_back(index);
+            sh::destroy(body);
+            throw;
+        }
+    }
     Slot& slot = slots_[index];
     slot.body = body;
+    slot.doubling = doubling;
     slot.generation = next_generation();
     return id_of(index);
 }
@@ -81,10 +100,7 @@ void World::remove_body(sh_body_id id) {
     body(id);  // validates
     const uint32_t index = slot_of(id);
     free_slots_.push_back(index);  // within the capacity reserved in add_body
-    sh::destroy(slots_[index].body);
-    sh::destroy(slots_[index].implicit);
-    slots_[index].body = nullptr;
-    slots_[index].implicit = nullptr;
+    destroy_slot(slots_[index]);
 }
 
 void World::step(double dt, sh_step_report* report) {
@@ -92,19 +108,26 @@ void World::step(double dt, sh_step_report* report) {
     const auto start = std::chrono::steady_clock::now();
     sh_step_report r{};
     r.substeps = 1;
+    r.error_estimate = error_estimate_ ? 0.0 : -1.0;
     r.dt_critical = INFINITY;
     sh_body_id first_failed = SH_NULL_BODY;
     BodyStepResult first_failure;
     for (size_t index = 0; index < slots_.size(); ++index) {
         Slot& slot = slots_[index];
         if (!slot.body) continue;
-        BodyStepResult result;
+        bool half_steps_stable = false;
+        if (slot.doubling) {
+            const auto t0 = std::chrono::steady_clock::now();
+            half_steps_stable = take_half_steps(*slot.body, *slot.doubling, dt, gravity);
+            r.error_estimate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        }
         slot.body->clear_inverted_elements();
-        if (slot.body->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER) {
-            if (!slot.implicit) slot.implicit = sh::create<ImplicitState>();
-            result = step_implicit(*slot.body, *slot.implicit, dt, gravity);
-        } else {
-            result = step_explicit(*slot.body, dt, gravity);
+        const BodyStepResult result = step_body(*slot.body, slot.implicit, dt, gravity);
+        if (slot.doubling) {
+            if (half_steps_stable && result.stable && r.error_estimate >= 0.0)
+                r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*slot.body, *slot.doubling));
+            else
+                r.error_estimate = -1.0;
         }
         r.dt_critical = std::min(r.dt_critical, result.dt_critical);
         r.substeps = std::max(r.substeps, result.substeps);
@@ -113,6 +136,7 @@ void World::step(double dt, sh_step_report* report) {
         r.newton_residual = std::max(r.newton_residual, result.newton_residual);
         r.factorize_seconds += result.factorize_seconds;
         r.solve_seconds += result.solve_seconds;
+        r.factorizations += result.factorizations;
         if (result.substeps > 1) r.warnings |= 1u << SH_WARN_SUBSTEPPED;
         if (slot.body->inverted_elements() > 0) r.warnings |= 1u << SH_WARN_INVERTED;
         if (!result.stable) {

@@ -11,6 +11,7 @@
 namespace sh {
 
 struct ImplicitState;
+struct StepDoubling;
 
 /// The simulation world of the C API's sh_world.
 class World {
@@ -47,8 +48,11 @@ private:
     struct Slot {
         Body* body = nullptr;
         ImplicitState* implicit = nullptr;  ///< built on the first implicit step
+        StepDoubling* doubling = nullptr;   ///< with error_estimate_ only
         uint32_t generation = 0;
     };
+    void destroy_slot(Slot& slot);
+    bool error_estimate_ = false;
     sh_body_id id_of(size_t index) const;
     vec<Slot> slots_;
     vec<uint32_t> free_slots_;

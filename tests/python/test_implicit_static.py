@@ -74,11 +74,12 @@ def test_implicit_oscillator_matches_the_backward_euler_recursion(damping):
         assert abs(state[0]) < amplitude  # dissipative
 
 
-def implicit_liver_positions(meshes, solver):
+def implicit_liver_positions(meshes, solver, factor_reuse=0.0):
     mesh = softhap.Mesh.load(meshes / "liver.msh")
     with softhap.World() as world:
         body = world.add_fem_body(
-            mesh, model="corotational", integrator="implicit_euler", linear_solver=solver
+            mesh, model="corotational", integrator="implicit_euler", linear_solver=solver,
+            factor_reuse=factor_reuse,
         )
         body.fix_nodes(range(10))
         for _ in range(3):
@@ -94,6 +95,27 @@ def test_linear_solvers_agree(meshes):
     for solver in solvers:
         scale = np.abs(reference).max()
         np.testing.assert_allclose(implicit_liver_positions(meshes, solver), reference, atol=1e-6 * scale)
+
+
+def test_factor_reuse_is_validated_and_reported(meshes):
+    with softhap.World() as world:
+        with pytest.raises(softhap.Error) as info:
+            world.add_spring_body([[0, 0, 0]], integrator="implicit_euler", factor_reuse=1.0)
+        assert info.value.status_name == "SH_ERR_INVALID_ARGUMENT"
+        assert "factor_reuse" in str(info.value)
+    # A linear material's tangent never changes: one factorisation serves every step, and the
+    # steps are exactly those of a factorisation per step.
+    mesh = softhap.Mesh.load(meshes / "liver.msh")
+    positions = []
+    for factor_reuse in (0.0, 0.25):
+        with softhap.World() as world:
+            body = world.add_fem_body(mesh, model="linear", integrator="implicit_euler",
+                                      factor_reuse=factor_reuse)
+            body.fix_nodes(range(10))
+            counts = [world.step(0.05).factorizations for _ in range(4)]
+            assert counts == ([1, 1, 1, 1] if factor_reuse == 0.0 else [1, 0, 0, 0])
+            positions.append(body.positions)
+    np.testing.assert_allclose(positions[1], positions[0], atol=1e-12 * np.abs(positions[0]).max())
 
 
 def test_unknown_linear_solver_lists_the_valid_ones():
@@ -216,3 +238,27 @@ def test_static_def_values_are_checked_by_the_library():
             assert info.value.report is None  # rejected before anything was tried
         with pytest.raises(ValueError):
             world.solve_static(linear_solver="qr")
+
+
+def test_step_doubling_error_estimate():
+    # A 1 kg mass on a 100 N/m spring, backward Euler by hand: (m + h^2 k) v1 = m v0 - h k d0,
+    # d1 = d0 + h v1 (d: stretch). The estimate is |one step - two half steps|.
+    def backward_euler(d, v, h):
+        v = (1.0 * v - h * 100.0 * d) / (1.0 + h * h * 100.0)
+        return d + h * v, v
+
+    for flag in (True, False):
+        with softhap.World(gravity=(0, 0, 0), error_estimate=flag) as world:
+            body = world.add_spring_body([[0, 0, 0], [1, 0, 0]], [[0, 1]], stiffness=100.0,
+                                         mass=1.0, integrator="implicit_euler")
+            body.fix_nodes([0])
+            body.positions = [[0, 0, 0], [1.01, 0, 0]]
+            report = world.step(0.02)
+            full = backward_euler(0.01, 0.0, 0.02)[0]
+            half = backward_euler(*backward_euler(0.01, 0.0, 0.01), 0.01)[0]
+            if flag:
+                assert report.error_estimate == pytest.approx(abs(full - half), rel=1e-9)
+                assert report.error_estimate_seconds > 0.0
+            else:
+                assert report.error_estimate == -1.0 and report.error_estimate_seconds == 0.0
+            assert body.positions[1, 0] == pytest.approx(1.0 + full, abs=1e-14)

@@ -70,15 +70,15 @@ def test_field_offsets_match_c(c_layout, name):
 
 def test_sizes_computed_by_hand():
     # Independent of any compiler: the x86-64/aarch64 SysV layout worked out from the header.
-    assert ctypes.sizeof(_lib.sh_world_def) == 32  # u32, pad 4, 3 doubles
-    assert ctypes.sizeof(_lib.sh_step_report) == 88
+    assert ctypes.sizeof(_lib.sh_world_def) == 40  # u32, pad 4, 3 doubles, i32, pad 4
+    assert ctypes.sizeof(_lib.sh_step_report) == 112  # ... 88, i32, pad 4, 2 doubles
     assert ctypes.sizeof(_lib.sh_mesh_info) == 88  # 7 int32, pad 4, 7 doubles
     assert ctypes.sizeof(_lib.sh_material) == 32
-    assert ctypes.sizeof(_lib.sh_fem_body_def) == 112  # 80 + sh_implicit_settings
+    assert ctypes.sizeof(_lib.sh_fem_body_def) == 120  # 80 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_spring_params) == 72
-    assert ctypes.sizeof(_lib.sh_spring_body_def) == 192  # 160 + sh_implicit_settings
+    assert ctypes.sizeof(_lib.sh_spring_body_def) == 200  # 160 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_body_info) == 32
-    assert ctypes.sizeof(_lib.sh_implicit_settings) == 32
+    assert ctypes.sizeof(_lib.sh_implicit_settings) == 40  # i32 x2, 2 doubles, i32, pad 4, double
     assert ctypes.sizeof(_lib.sh_static_def) == 32
     assert ctypes.sizeof(_lib.sh_static_report) == 16 + 8 + 64 * 8 + 8
     assert _lib.sh_spring_body_def.params.offset == 48

@@ -37,7 +37,7 @@ def test_empty_world_steps_and_reports():
             "wall_seconds", "substeps", "dt_critical", "kinetic_energy", "elastic_energy",
             "potential_energy", "warnings", "warning_bits", "unstable_body_count",
             "newton_iterations", "linear_iterations", "newton_residual", "factorize_seconds",
-            "solve_seconds",
+            "solve_seconds", "factorizations", "error_estimate", "error_estimate_seconds",
         }
         with pytest.raises(AttributeError):
             report.no_such_field

@@ -26,7 +26,7 @@ from ctypes import (
 # Version this package was written for (SH_VERSION of include/softhap/softhap.h).
 
 SH_VERSION_MAJOR = 0
-SH_VERSION_MINOR = 2
+SH_VERSION_MINOR = 3
 SH_VERSION_PATCH = 0
 SH_VERSION = SH_VERSION_MAJOR * 1000000 + SH_VERSION_MINOR * 1000 + SH_VERSION_PATCH
 
@@ -150,6 +150,7 @@ class sh_world_def(Structure):
     _fields_ = [
         ("internal_init", c_uint32),
         ("gravity", c_double * 3),
+        ("error_estimate", c_int32),
     ]
 
 
@@ -170,6 +171,9 @@ class sh_step_report(Structure):
         ("newton_residual", c_double),
         ("factorize_seconds", c_double),
         ("solve_seconds", c_double),
+        ("factorizations", c_int32),
+        ("error_estimate", c_double),
+        ("error_estimate_seconds", c_double),
     ]
 
 
@@ -182,6 +186,7 @@ class sh_implicit_settings(Structure):
         ("newton_tolerance", c_double),
         ("cg_tolerance", c_double),
         ("cg_max_iterations", c_int32),
+        ("factor_reuse", c_double),
     ]
 
 

@@ -39,7 +39,9 @@ class StepReport(Record):
     potential_energy (J), warnings (a frozenset of warning names raised in this step, e.g.
     {"SH_WARN_SUBSTEPPED"}), warning_bits (the raw bit mask, bit 1 << sh_warning),
     unstable_body_count, and for implicit bodies newton_iterations, linear_iterations,
-    newton_residual, factorize_seconds and solve_seconds (s).
+    newton_residual, factorize_seconds and solve_seconds (s) and factorizations (0 when every
+    solve reused a kept factorisation); error_estimate (m: step doubling, with
+    World(error_estimate=True), else -1) and error_estimate_seconds.
     """
 
 

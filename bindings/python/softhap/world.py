@@ -67,6 +67,9 @@ def _step_report(raw):
         newton_residual=raw.newton_residual,
         factorize_seconds=raw.factorize_seconds,
         solve_seconds=raw.solve_seconds,
+        factorizations=raw.factorizations,
+        error_estimate=raw.error_estimate,
+        error_estimate_seconds=raw.error_estimate_seconds,
     )
 
 
@@ -83,7 +86,7 @@ def _static_report(raw):
 
 
 def _set_implicit(settings, linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
-                  cg_max_iterations):
+                  cg_max_iterations, factor_reuse):
     """Fill an sh_implicit_settings from keyword arguments (None keeps the C default)."""
     if linear_solver is not None:
         settings.linear_solver = _choose(linear_solver, LINEAR_SOLVERS, "linear_solver")
@@ -95,11 +98,13 @@ def _set_implicit(settings, linear_solver, newton_max_iterations, newton_toleran
         settings.cg_tolerance = float(cg_tolerance)
     if cg_max_iterations is not None:
         settings.cg_max_iterations = _arrays.count(cg_max_iterations, "cg_max_iterations")
+    if factor_reuse is not None:
+        settings.factor_reuse = float(factor_reuse)
 
 
 def _set_body_options(definition, integrator, on_unstable, damping_mass, runaway_speed,
                       linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
-                      cg_max_iterations):
+                      cg_max_iterations, factor_reuse):
     """Fill the options sh_fem_body_def and sh_spring_body_def share from keyword arguments
     (None keeps the C default)."""
     if integrator is not None:
@@ -111,7 +116,7 @@ def _set_body_options(definition, integrator, on_unstable, damping_mass, runaway
     if runaway_speed is not None:
         definition.runaway_speed = float(runaway_speed)
     _set_implicit(definition.implicit, linear_solver, newton_max_iterations, newton_tolerance,
-                  cg_tolerance, cg_max_iterations)
+                  cg_tolerance, cg_max_iterations, factor_reuse)
 
 
 def _default_material():
@@ -132,14 +137,20 @@ class World(OwnedHandle):
     _kind = "world"
     _destroy = "sh_world_destroy"
 
-    def __init__(self, gravity=(0.0, 0.0, -9.81)):
-        """Create a world with the given gravitational acceleration (3 floats, m/s^2)."""
+    def __init__(self, gravity=(0.0, 0.0, -9.81), error_estimate=False):
+        """Create a world with the given gravitational acceleration (3 floats, m/s^2).
+
+        error_estimate=True makes every step also take each body over dt in two half steps
+        and report the largest node distance between the two results (StepReport
+        error_estimate, m; error_estimate_seconds its cost); the state kept is the full step's.
+        """
         self._handle = None
         gravity = _arrays.float_array(gravity, "gravity", (3,))
         definition = sh_world_def()
         lib.sh_world_def_default(ctypes.byref(definition))
         for k in range(3):
             definition.gravity[k] = gravity[k]
+        definition.error_estimate = 1 if error_estimate else 0
         handle = ctypes.c_void_p()
         check(lib.sh_world_create(ctypes.byref(definition), ctypes.byref(handle)), "sh_world_create")
         self._handle = handle.value
@@ -251,6 +262,7 @@ class World(OwnedHandle):
         newton_tolerance=None,
         cg_tolerance=None,
         cg_max_iterations=None,
+        factor_reuse=None,
     ):
         """Add a tetrahedral FEM body whose rest shape is mesh (copied) and return its Body.
 
@@ -267,7 +279,9 @@ class World(OwnedHandle):
           implicit_euler only (sh_implicit_settings): linear_solver "default" (CHOLMOD when
           built in, else "ldlt"), "cholmod", "ldlt" or "cg"; newton_max_iterations (default 1:
           one linearised solve per step); newton_tolerance (default 1e-6); cg_tolerance
-          (default 1e-8); cg_max_iterations (default 2000).
+          (default 1e-8); cg_max_iterations (default 2000); factor_reuse (default 0.25: keep a
+          direct solver's factorisation while its updates cut the residual at least 4x; 0 =
+          factorise at every Newton iteration).
         Unknown names raise ValueError; invalid values raise softhap.Error
         (SH_ERR_INVALID_ARGUMENT).
         """
@@ -289,7 +303,7 @@ class World(OwnedHandle):
             definition.damping_stiffness = float(damping_stiffness)
         _set_body_options(definition, integrator, on_unstable, damping_mass, runaway_speed,
                           linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
-                          cg_max_iterations)
+                          cg_max_iterations, factor_reuse)
         body = sh_body_id()
         check(
             lib.sh_world_add_fem_body(handle, ctypes.byref(definition), ctypes.byref(body)),
@@ -319,6 +333,7 @@ class World(OwnedHandle):
         newton_tolerance=None,
         cg_tolerance=None,
         cg_max_iterations=None,
+        factor_reuse=None,
     ):
         """Add a mass-spring body and return its Body. Rest lengths are the initial lengths.
 
@@ -393,7 +408,7 @@ class World(OwnedHandle):
                 definition.node_masses = _arrays.double_ptr(mass_array)
         _set_body_options(definition, integrator, on_unstable, damping_mass, runaway_speed,
                           linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
-                          cg_max_iterations)
+                          cg_max_iterations, factor_reuse)
 
         body = sh_body_id()
         status = lib.sh_world_add_spring_body(handle, ctypes.byref(definition), ctypes.byref(body))

@@ -1,0 +1,42 @@
+#include "world/step_doubling.hpp"
+
+#include "solver/implicit_integrator.hpp"
+#include "world/body_step.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sh {
+
+StepDoubling::StepDoubling(size_t values) : start_x(values), start_v(values), start_target(values), half_x(values) {}
+
+StepDoubling::~StepDoubling() { sh::destroy(implicit); }
+
+bool take_half_steps(Body& body, StepDoubling& scratch, double dt, const double gravity[3]) {
+    std::copy(body.x.begin(), body.x.end(), scratch.start_x.begin());
+    std::copy(body.v.begin(), body.v.end(), scratch.start_v.begin());
+    std::copy(body.target.begin(), body.target.end(), scratch.start_target.begin());
+    for (size_t i = 0; i < body.kinematic.size(); ++i)
+        if (body.kinematic[i])
+            for (size_t k = 3 * i; k < 3 * i + 3; ++k) body.target[k] = 0.5 * (body.x[k] + body.target[k]);
+    bool stable = step_body(body, scratch.implicit, 0.5 * dt, gravity).stable;
+    std::copy(scratch.start_target.begin(), scratch.start_target.end(), body.target.begin());
+    if (stable) stable = step_body(body, scratch.implicit, 0.5 * dt, gravity).stable;
+    std::copy(body.x.begin(), body.x.end(), scratch.half_x.begin());
+    std::copy(scratch.start_x.begin(), scratch.start_x.end(), body.x.begin());
+    std::copy(scratch.start_v.begin(), scratch.start_v.end(), body.v.begin());
+    body.clear_inverted_elements();
+    return stable;
+}
+
+double largest_half_step_difference(const Body& body, const StepDoubling& scratch) {
+    double largest = 0.0;
+    for (size_t i = 0; i < body.x.size(); i += 3) {
+        const double dx = body.x[i] - scratch.half_x[i], dy = body.x[i + 1] - scratch.half_x[i + 1],
+                     dz = body.x[i + 2] - scratch.half_x[i + 2];
+        largest = std::max(largest, dx * dx + dy * dy + dz * dz);
+    }
+    return std::sqrt(largest);
+}
+
+}  // namespace sh

@@ -366,11 +366,20 @@ static void run_integrators(const char* filter) {
 }
 
 /* The implicit Euler step on raptorTetra_19409 (gravity, highest 1% of the nodes fixed), dt =
- * kImplicitDt, one linearised solve per step (the default), per material and linear solver. The
- * body falls from rest and swings, so its stiffness changes from step to step. Per step: wall
- * time, and from the step report the factorisation and solve times (assembly and the rest = wall -
- * both). Steps whose report shows a factorisation are counted ("factorizations"). */
-static const double kImplicitDt = 0.01; /* s: a 100 Hz organ step */
+ * kImplicitDt, one linearised solve per step (the default), per scenario, material and linear
+ * solver. Scenarios: "swing": the body falls from rest and swings, so its stiffness changes a lot
+ * from step to step; "ramp": gravity rises smoothly from 0 over kRampTime, so the body sags
+ * slowly (a quasi-static load, as in palpation or positioning). Per step: wall time, and from the step report the
+ * factorisation and solve times (assembly and the rest = wall - both) and the factorisations. */
+static const double kImplicitDt = 0.01;  /* s: a 100 Hz organ step */
+static const double kRampTime = 1.0;     /* s */
+
+/* The ramp scenario's gravity at time t: 0 to -9.81 m/s^2 along z, smoothly over kRampTime. */
+static void set_ramp_gravity(sh_world* world, double t) {
+    const double fraction = t < kRampTime ? 0.5 * (1.0 - cos(M_PI * t / kRampTime)) : 1.0;
+    const double g[3] = {0.0, 0.0, -9.81 * fraction};
+    CHECK(sh_world_set_gravity(world, g));
+}
 
 static void run_implicit(const char* filter) {
     static const struct {
@@ -380,10 +389,12 @@ static void run_implicit(const char* filter) {
     const int steps = g_steps > 0 ? g_steps : 100;
     bench_mesh m;
     if (!load_mesh("raptorTetra_19409", &m)) exit(1);
+    static const char* const kScenarios[] = {"swing", "ramp"};
+    for (size_t c = 0; c < sizeof kScenarios / sizeof kScenarios[0]; ++c)
     for (size_t j = 0; j < sizeof kKinds / sizeof kKinds[0]; ++j) {
         for (size_t k = 0; k < sizeof kSolvers / sizeof kSolvers[0]; ++k) {
             char name[256];
-            snprintf(name, sizeof name, "implicit/%s/%s/%s", kKinds[j].name, kSolvers[k].name, m.name);
+            snprintf(name, sizeof name, "implicit/%s/%s/%s/%s", kScenarios[c], kKinds[j].name, kSolvers[k].name, m.name);
             if (!matches(name, filter)) continue;
             if (kSolvers[k].solver == SH_LINEAR_SOLVER_CHOLMOD && !(sh_build_features() & SH_FEATURE_CHOLMOD)) continue;
             sh_world_def wd;
@@ -399,12 +410,14 @@ static void run_implicit(const char* filter) {
             implicit.linear_solver = kSolvers[k].solver;
             if (g_factor_reuse >= 0.0) implicit.factor_reuse = g_factor_reuse;
             add_body(world, &m, kKinds[j].model, SH_INTEGRATOR_IMPLICIT_EULER, &implicit);
+            const int ramp = strcmp(kScenarios[c], "ramp") == 0;
             double* wall = (double*)xmalloc(sizeof(double) * (size_t)steps);
             double factorize = 0.0, solve = 0.0, first_step = 0.0;
             int factorizations = 0, failed = 0;
             long linear_iterations = 0;
             sh_step_report report;
             for (int s = -1; s < steps; ++s) { /* step -1: first step (analysis), reported apart */
+                if (ramp) set_ramp_gravity(world, (s + 1) * kImplicitDt);
                 const double t0 = now_ns();
                 const sh_status st = sh_world_step(world, kImplicitDt, &report);
                 const double ns = now_ns() - t0;

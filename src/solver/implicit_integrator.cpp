@@ -14,6 +14,12 @@ namespace {
 // Speeds below this (m/s) count as rest when judging a Newton correction negligible.
 constexpr double kSpeedFloor = 1e-9;
 
+// An update solved with a kept factorisation is kept only if it cuts the residual at least by
+// this factor (chord iterations slower than this cost more solves than a new factorisation is
+// worth), and a step makes at most kMaxStaleSolves such solves before it refactorises.
+constexpr double kStaleContraction = 0.5;
+constexpr int kMaxStaleSolves = 4;
+
 LinearSolverKind solver_kind(sh_linear_solver kind) {
     switch (kind) {
         case SH_LINEAR_SOLVER_CHOLMOD: return LinearSolverKind::Cholmod;
@@ -74,7 +80,12 @@ int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_
     return 3 * free_count;
 }
 
-BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double g[3]) {
+namespace {
+
+// One attempt at the step; allow_stale: updates may use a kept factorisation. used_stale
+// tells whether any did.
+BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const double g[3], bool allow_stale,
+                            bool& used_stale) {
     BodyStepResult result;
     result.dt_critical = INFINITY;
     const sh_implicit_settings& s = body.settings.implicit;
@@ -91,8 +102,8 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
         const double c = body.settings.damping_mass + (per_node ? body.node_damping[node] : 0.0);
         state.diagonal[static_cast<size_t>(d)] = body.mass[node] * (1.0 + dt * c);
     }
-    const bool reuse = s.factor_reuse > 0.0 && state.solver->is_direct();
-    bool factor_current = reuse && state.factor_valid && state.factor_dt == dt &&
+    const bool reuse = s.factor_reuse > 0.0 && state.solver->is_direct();  // keep factorisations
+    bool factor_current = reuse && allow_stale && state.factor_valid && state.factor_dt == dt &&
                           state.factor_stiffness_version == body.stiffness_version &&
                           std::equal(state.diagonal.begin(), state.diagonal.end(), state.factor_diagonal.begin());
 
@@ -107,12 +118,16 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
 
     // Newton on g(v) = M (v - v0) - dt F(x0 + dt v, v) over the free DOFs, from v = v0.
     double* a = w.a[0].data();
+    double largest_residual = 0.0;  // max norm of the last residual_norm()
     auto residual_norm = [&] {
         for (size_t j = 0; j < n3; ++j) body.x[j] = w.x0[j] + dt * body.v[j];
         compute_accelerations(body, body.x.data(), body.v.data(), g, a);
+        largest_residual = 0.0;
         for (int32_t d = 0; d < dofs; ++d) {
             const size_t j = static_cast<size_t>(global[static_cast<size_t>(d)]);
-            state.residual[static_cast<size_t>(d)] = body.mass[j / 3] * (body.v[j] - w.v0[j] - dt * a[j]);
+            const double r_d = body.mass[j / 3] * (body.v[j] - w.v0[j] - dt * a[j]);
+            state.residual[static_cast<size_t>(d)] = r_d;
+            largest_residual = std::max(largest_residual, std::fabs(r_d));
         }
         return norm(state.residual);
     };
@@ -125,11 +140,16 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
     };
 
     const int max_iterations = std::max(1, s.newton_max_iterations);
-    double r = residual_norm();
+    const bool linearised = max_iterations == 1;
+    double r = residual_norm(), r_max = largest_residual;
     const double residual0 = std::max(r, dt * applied_load);
+    // Updates with a kept factorisation must reach this in both norms: the max norm keeps a
+    // small badly-solved region from hiding in the sum.
+    const double target = s.factor_reuse * r, target_max = s.factor_reuse * r_max;
     result.newton_residual = -1.0;
     bool converged = residual0 == 0.0;
-    bool fresh = false;  // the factorisation is of the tangent at the current iterate
+    bool fresh = false;    // the factorisation is of the tangent at the current iterate
+    int stale_solves = 0;  // solves with a kept factorisation in this step
     for (int iteration = 0; !converged;) {
         // Converged: small against the first residual or the applied load's impulse, or down
         // to the round-off of the element forces themselves.
@@ -140,7 +160,7 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
         if (iteration == max_iterations) break;
 
         try {
-            if (!factor_current) {
+            if (!factor_current || stale_solves == kMaxStaleSolves) {
                 state.factor_valid = false;
                 state.system.clear_values();
                 body.add_tangent(body.x.data(), dt * dt, dt, state.system);
@@ -173,32 +193,62 @@ BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const 
             largest_change = std::max(largest_change, std::fabs(state.delta[static_cast<size_t>(d)]));
             largest_speed = std::max(largest_speed, std::fabs(v));
         }
-        const double r_new = residual_norm();
-        if (!fresh && !(r_new <= s.factor_reuse * r)) {
-            // The kept factorisation is too far from the current tangent: take the update back
-            // and solve again with a new one here.
-            for (int32_t d = 0; d < dofs; ++d)
-                body.v[static_cast<size_t>(global[static_cast<size_t>(d)])] = state.previous_v[static_cast<size_t>(d)];
-            r = residual_norm();
-            factor_current = false;
-            continue;
+        const double r_new = residual_norm(), r_new_max = largest_residual;
+        if (!fresh) {
+            ++stale_solves;
+            used_stale = true;
+            if (!(r_new <= kStaleContraction * r && r_new_max <= kStaleContraction * r_max)) {
+                // The kept factorisation is too far from the current tangent: take the update
+                // back and solve again with a new one here.
+                for (int32_t d = 0; d < dofs; ++d)
+                    body.v[static_cast<size_t>(global[static_cast<size_t>(d)])] = state.previous_v[static_cast<size_t>(d)];
+                r = residual_norm();
+                r_max = largest_residual;
+                factor_current = false;
+                continue;
+            }
         }
+        const bool was_fresh = fresh;
         r = r_new;
+        r_max = r_new_max;
         fresh = false;
-        factor_current = reuse;  // exact Newton (or CG) builds the tangent at every iterate
-        ++iteration;
+        factor_current = reuse && allow_stale;  // exact Newton (or CG): a tangent per iterate
         ++result.newton_iterations;
         result.newton_residual = residual0 > 0.0 ? r / residual0 : 0.0;
+        if (linearised) {
+            // One update with the tangent at its iterate is the linearised step; updates with a
+            // kept factorisation go on until they are at least as good as factor_reuse asks.
+            if (was_fresh || (r <= target && r_max <= target_max)) converged = true;
+            continue;
+        }
+        ++iteration;
         // Near equilibrium of a stiff body the residual is cancellation noise of large element
         // forces, so a negligible velocity correction also ends the iteration.
         const double speed_scale = std::max({largest_speed, dt * gravity_norm, kSpeedFloor});
-        const bool negligible = iteration > 1 && largest_change <= s.newton_tolerance * speed_scale;
-        if (max_iterations == 1 || negligible) converged = true;
+        if (iteration > 1 && largest_change <= s.newton_tolerance * speed_scale) converged = true;
     }
     end_kinematic_motion(body);
     if (!converged) return fail(SH_ERR_NOT_CONVERGED, "Newton iterations did not reach newton_tolerance");
     if (!body_state_is_sane(body))
         return fail(SH_ERR_UNSTABLE, "the state became non-finite or exceeded the runaway speed; rolled back");
+    return result;
+}
+
+}  // namespace
+
+BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double g[3]) {
+    bool used_stale = false;
+    BodyStepResult result = attempt_step(body, state, dt, g, true, used_stale);
+    if (result.stable || !used_stale) return result;
+    // A kept factorisation took this step somewhere bad: the step again, a factorisation at
+    // every iterate (the body is back at its start state).
+    const BodyStepResult first = result;
+    result = attempt_step(body, state, dt, g, false, used_stale);
+    result.newton_iterations += first.newton_iterations;
+    result.linear_iterations += first.linear_iterations;
+    result.factorize_seconds += first.factorize_seconds;
+    result.solve_seconds += first.solve_seconds;
+    result.factorizations += first.factorizations;
     return result;
 }
 

@@ -3,7 +3,10 @@
 # Safe to run repeatedly; does nothing when everything is present.
 set -euo pipefail
 
-debian_packages=(libeigen3-dev libccd-dev libsuitesparse-dev libcmocka-dev pkg-config)
+# libopenblas0-serial: an optimised single-threaded BLAS for CHOLMOD's supernodal factorisation
+# and solves (Debian's default reference BLAS makes them ~2.5x and ~1.9x slower). Installing it
+# makes it the system's libblas.so.3 through update-alternatives.
+debian_packages=(libeigen3-dev libccd-dev libsuitesparse-dev libopenblas0-serial libcmocka-dev pkg-config)
 missing=()
 for package in "${debian_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")

@@ -497,6 +497,61 @@ static void test_set_material_out_of_memory_changes_nothing(void** state) {
     assert_int_equal(failures, 0);
 }
 
+/* The first implicit step builds the body's solver state (and, with the error estimate, the
+ * half steps' own): running out of memory anywhere in it leaves positions, velocities and the
+ * prescribed motion as they were, so the step then succeeds and the prescribed node still
+ * ends exactly on its target. */
+static void test_implicit_step_out_of_memory_changes_nothing(void** state) {
+    (void)state;
+    reset_counts();
+    sh_world_def wd;
+    sh_world_def_default(&wd);
+    wd.error_estimate = 1;
+    sh_world* world = NULL;
+    assert_ok(sh_world_create(&wd, &world));
+    sh_mesh* mesh = sh_test_box(0.02, 0.01, 0.01, 2, 1, 1);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+    sh_body_id body;
+    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_mesh_destroy(mesh));
+    sh_body_info info;
+    assert_ok(sh_body_get_info(world, body, &info));
+    assert_true(info.node_count <= 64);
+    double x[3 * 64], v[3 * 64], x_now[3 * 64], v_now[3 * 64];
+    assert_ok(sh_body_get_positions(world, body, x, 3 * 64));
+    const int32_t pulled = 0;
+    const double target[3] = {x[0] - 1e-3, x[1], x[2]};
+    assert_ok(sh_body_prescribe_positions(world, body, &pulled, target, 1));
+    assert_ok(sh_body_get_velocities(world, body, v, 3 * 64));
+    const size_t bytes = sizeof(double) * 3 * (size_t)info.node_count;
+    int failures = 0;
+    for (long n = 0; n < 10000; ++n) {
+        reset_counts();
+        g.fail_after = n;
+        const sh_status status = sh_world_step(world, 1e-3, NULL);
+        const size_t failed = g.failed;
+        g.fail_after = -1;
+        if (failed == 0) {
+            assert_ok(status);
+            break;
+        }
+        assert_status(status, SH_ERR_OUT_OF_MEMORY);
+        assert_ok(sh_body_get_positions(world, body, x_now, 3 * 64));
+        assert_ok(sh_body_get_velocities(world, body, v_now, 3 * 64));
+        if (memcmp(x_now, x, bytes) != 0 || memcmp(v_now, v, bytes) != 0) {
+            print_error("sh_world_step failing after %ld allocations changed the body\n", n);
+            ++failures;
+        }
+    }
+    assert_ok(sh_body_get_positions(world, body, x_now, 3 * 64));
+    assert_memory_equal(x_now, target, sizeof target);
+    destroy_world_checking_leaks(world);
+    assert_int_equal(failures, 0);
+}
+
 /* sh_world_add_spring_body into a garbage id: on failure the id must be SH_NULL_BODY. */
 static sh_status add_spring_body_or_null(sh_world* world, const sh_spring_body_def* def, sh_body_id* body) {
     *body = 42;
@@ -653,6 +708,7 @@ int main(void) {
         cmocka_unit_test(test_rejected_step_allocates_nothing),
         cmocka_unit_test(test_remove_body_allocates_nothing),
         cmocka_unit_test(test_set_material_out_of_memory_changes_nothing),
+        cmocka_unit_test(test_implicit_step_out_of_memory_changes_nothing),
         cmocka_unit_test(test_failing_allocator), /* last: a leak would stay behind */
     };
     return cmocka_run_group_tests(tests, setup_install, NULL);

@@ -294,16 +294,18 @@ typedef struct sh_implicit_settings {
                                          1e-9 m/s); default 1e-6 */
     double cg_tolerance;            /**< CG relative residual; default 1e-8 */
     int32_t cg_max_iterations;      /**< CG iteration cap; default 2000 */
-    double factor_reuse;            /**< direct solvers (CHOLMOD, LDLT): the factorisation of
-                                         M + dt D + dt^2 K is kept across Newton iterations and
-                                         steps while an update solved with it cuts the residual
-                                         |g| by at least this factor (|g_new| <= factor_reuse
-                                         |g|); a slower update is discarded and solved again
-                                         with a fresh factorisation at the same state. Changing
-                                         dt, the fixed nodes, a material or node damping also
-                                         refactorises. 0 = a new factorisation at every Newton
-                                         iteration (exact Newton); must be in [0, 1); default
-                                         0.25 */
+    double factor_reuse;            /**< direct solvers (CHOLMOD, LDLT), > 0: the factorisation
+                                         of M + dt D + dt^2 K is kept across Newton iterations
+                                         and steps. An update solved with a kept factorisation
+                                         is accepted if it at least halves the residual |g|
+                                         (2-norm and max-norm), else discarded and solved again
+                                         with a fresh factorisation at the same state; a
+                                         linearised step (newton_max_iterations = 1) takes such
+                                         updates until |g| is down by factor_reuse from its
+                                         start. Changing dt, the fixed nodes, a material or node
+                                         damping refactorises. 0 = a new factorisation at every
+                                         Newton iteration (exact Newton); must be in [0, 1);
+                                         default 0.25 */
 } sh_implicit_settings;
 
 /** What a step larger than the body's critical step does. */

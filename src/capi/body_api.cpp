@@ -171,14 +171,12 @@ SH_API sh_status sh_body_set_external_forces(sh_world* world, sh_body_id body, c
 SH_API sh_status sh_body_set_node_damping(sh_world* world, sh_body_id body, const double* coefficients, int32_t node_count) {
     return capi::guard([&] {
         Body& b = body_of(world, body);
-        if (!coefficients) {
-            b.node_damping = vec<double>();
-            return;
+        if (coefficients) {
+            require_node_count(b, node_count);
+            for (int32_t i = 0; i < node_count; ++i)
+                SH_REQUIRE(std::isfinite(coefficients[i]) && coefficients[i] >= 0.0, SH_ERR_INVALID_ARGUMENT, "coefficients[%d] = %g 1/s, must be finite and >= 0", i, coefficients[i]);
         }
-        require_node_count(b, node_count);
-        for (int32_t i = 0; i < node_count; ++i)
-            SH_REQUIRE(std::isfinite(coefficients[i]) && coefficients[i] >= 0.0, SH_ERR_INVALID_ARGUMENT, "coefficients[%d] = %g 1/s, must be finite and >= 0", i, coefficients[i]);
-        b.node_damping.assign(coefficients, coefficients + node_count);
+        b.set_node_damping(coefficients);
     });
 }
 

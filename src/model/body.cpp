@@ -17,7 +17,6 @@ Body::Body(IntegrationSettings s, vec<double> rest_positions) : settings(s), x(s
     IntegratorWorkspace& w = workspace;
     w.x0.resize(3 * n);
     w.v0.resize(3 * n);
-    w.kinematic_velocity.assign(3 * n, 0.0);
     w.xs.resize(3 * n);
     w.vs.resize(3 * n);
     for (auto& a : w.a) a.resize(3 * n);
@@ -27,6 +26,14 @@ Body::Body(IntegrationSettings s, vec<double> rest_positions) : settings(s), x(s
 void Body::update_inverse_mass() {
     for (size_t i = 0; i < mass.size(); ++i)
         inverse_mass[i] = (mass[i] > 0.0 && !kinematic[i]) ? 1.0 / mass[i] : 0.0;
+}
+
+void Body::set_node_damping(const double* coefficients) {
+    if (coefficients)
+        node_damping.assign(coefficients, coefficients + mass.size());
+    else
+        node_damping = vec<double>();
+    ++matrix_version;
 }
 
 void Body::write_vtu(const std::string& path) const {

@@ -25,7 +25,6 @@ struct IntegrationSettings {
 /// Scratch arrays of the integrators, sized once when the body is built.
 struct IntegratorWorkspace {
     vec<double> x0, v0;                 ///< state at the start of the step (rollback)
-    vec<double> kinematic_velocity;     ///< 3 per node, prescribed-node velocity in this step
     vec<double> xs, vs;                 ///< stage state
     vec<double> a[4];                   ///< stage accelerations
     vec<double> dx;                     ///< RK4 accumulated velocity
@@ -86,6 +85,9 @@ public:
     /// Recomputes inverse_mass from mass and kinematic.
     void update_inverse_mass();
 
+    /// Replaces node_damping by coefficients[node_count()] (1/s), or clears it for null.
+    void set_node_damping(const double* coefficients);
+
     int32_t node_count() const { return static_cast<int32_t>(mass.size()); }
 
     IntegrationSettings settings;
@@ -96,9 +98,10 @@ public:
     vec<double> target;          ///< 3 per node, where kinematic nodes go in the next step
     vec<double> external_force;  ///< 3 per node (N), held
     vec<double> node_damping;    ///< per-node viscous coefficient (1/s); empty if unused
-    /// Bumped whenever K or D change other than through x (a material change): a factorisation
-    /// kept by the implicit integrator is valid only for the version it was built at.
-    uint64_t stiffness_version = 0;
+    /// Bumped whenever M, D or K change other than through x (a material or node-damping
+    /// change): a factorisation kept by the implicit integrator is valid only for the version it
+    /// was built at.
+    uint64_t matrix_version = 0;
     IntegratorWorkspace workspace;
 };
 

@@ -135,7 +135,7 @@ void FemBody::rebuild(vec<sh_material> materials) {
     materials_.swap(materials);
     mass.swap(new_mass);
     for (int model = 0; model < 4; ++model) blocks_[model].swap(new_blocks[model]);
-    ++stiffness_version;
+    ++matrix_version;
     update_inverse_mass();
 }
 

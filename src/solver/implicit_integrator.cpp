@@ -16,7 +16,7 @@ constexpr double kSpeedFloor = 1e-9;
 
 // An update solved with a kept factorisation is kept only if it cuts the residual at least by
 // this factor (chord iterations slower than this cost more solves than a new factorisation is
-// worth), and a step makes at most kMaxStaleSolves such solves before it refactorises.
+// worth), and one factorisation serves at most kMaxStaleSolves such solves in a step.
 constexpr double kStaleContraction = 0.5;
 constexpr int kMaxStaleSolves = 4;
 
@@ -65,7 +65,7 @@ int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_
     LinearSolverPtr solver = make_linear_solver(solver_kind(s.linear_solver), s.cg_tolerance, s.cg_max_iterations);
     if (free_count > 0) solver->analyze(system);
     const size_t dofs = 3 * static_cast<size_t>(free_count);
-    vec<double> residual(dofs), delta(dofs, 0.0), diagonal(dofs), previous_v(dofs), factor_diagonal(dofs);
+    vec<double> residual(dofs), delta(dofs, 0.0), diagonal(dofs), previous_v(dofs);
     // Commit only once everything is built.
     state.system = std::move(system);
     state.solver = std::move(solver);
@@ -74,7 +74,6 @@ int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_
     state.delta.swap(delta);
     state.diagonal.swap(diagonal);
     state.previous_v.swap(previous_v);
-    state.factor_diagonal.swap(factor_diagonal);
     state.factor_valid = false;
     state.free_count = free_count;
     return 3 * free_count;
@@ -96,16 +95,9 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
 
     save_start_state(body);
     begin_kinematic_motion(body, dt);
-    const bool per_node = !body.node_damping.empty();
-    for (int32_t d = 0; d < dofs; ++d) {
-        const size_t node = static_cast<size_t>(global[static_cast<size_t>(d)]) / 3;
-        const double c = body.settings.damping_mass + (per_node ? body.node_damping[node] : 0.0);
-        state.diagonal[static_cast<size_t>(d)] = body.mass[node] * (1.0 + dt * c);
-    }
     const bool reuse = s.factor_reuse > 0.0 && state.solver->is_direct();  // keep factorisations
     bool factor_current = reuse && allow_stale && state.factor_valid && state.factor_dt == dt &&
-                          state.factor_stiffness_version == body.stiffness_version &&
-                          std::equal(state.diagonal.begin(), state.diagonal.end(), state.factor_diagonal.begin());
+                          state.factor_matrix_version == body.matrix_version;
 
     double applied_load = 0.0;  // |f_ext + m g| over the free DOFs (N)
     for (int32_t d = 0; d < dofs; ++d) {
@@ -133,6 +125,7 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
     };
     auto fail = [&](sh_status status, const char* reason) {
         restore_start_state(body);
+        state.factor_valid = false;  // built at an iterate that went wrong
         result.stable = false;
         result.status = status;
         result.reason = reason;
@@ -149,7 +142,7 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
     result.newton_residual = -1.0;
     bool converged = residual0 == 0.0;
     bool fresh = false;    // the factorisation is of the tangent at the current iterate
-    int stale_solves = 0;  // solves with a kept factorisation in this step
+    int stale_solves = 0;  // solves with a kept factorisation since the last factorisation
     for (int iteration = 0; !converged;) {
         // Converged: small against the first residual or the applied load's impulse, or down
         // to the round-off of the element forces themselves.
@@ -161,6 +154,12 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
 
         try {
             if (!factor_current || stale_solves == kMaxStaleSolves) {
+                const bool per_node = !body.node_damping.empty();
+                for (int32_t d = 0; d < dofs; ++d) {
+                    const size_t node = static_cast<size_t>(global[static_cast<size_t>(d)]) / 3;
+                    const double c = body.settings.damping_mass + (per_node ? body.node_damping[node] : 0.0);
+                    state.diagonal[static_cast<size_t>(d)] = body.mass[node] * (1.0 + dt * c);
+                }
                 state.factor_valid = false;
                 state.system.clear_values();
                 body.add_tangent(body.x.data(), dt * dt, dt, state.system);
@@ -171,19 +170,26 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
                 ++result.factorizations;
                 state.factor_valid = reuse;
                 state.factor_dt = dt;
-                state.factor_stiffness_version = body.stiffness_version;
-                std::copy(state.diagonal.begin(), state.diagonal.end(), state.factor_diagonal.begin());
+                state.factor_matrix_version = body.matrix_version;
                 factor_current = true;
                 fresh = true;
+                stale_solves = 0;
             }
             for (double& r_d : state.residual) r_d = -r_d;
             result.linear_iterations += state.solver->solve(state.system, state.residual.data(), state.delta.data());
             result.solve_seconds += state.solver->solve_seconds;
         } catch (const Error& e) {
+            if (e.status() == SH_ERR_NOT_CONVERGED) return fail(e.status(), "the linear solver did not converge");
+            if (e.status() == SH_ERR_SOLVER)
+                return fail(e.status(), "the sparse factorisation or solve failed (matrix not positive definite, "
+                                        "or a non-finite value)");
+            restore_start_state(body);  // anything else (capacity, internal) goes up unchanged
             state.factor_valid = false;
-            return fail(e.status(), e.status() == SH_ERR_NOT_CONVERGED
-                                        ? "the linear solver did not converge"
-                                        : "the sparse factorisation failed (matrix not positive definite)");
+            throw;
+        } catch (...) {  // out of memory: nothing half done stays behind
+            restore_start_state(body);
+            state.factor_valid = false;
+            throw;
         }
         double largest_change = 0.0, largest_speed = 0.0;
         for (int32_t d = 0; d < dofs; ++d) {

@@ -19,23 +19,25 @@ struct ImplicitState {
     vec<int32_t> free_index;    ///< per node: index among free nodes, or -1
     vec<double> residual;       ///< per free DOF
     vec<double> delta;          ///< per free DOF (CG warm start)
-    vec<double> diagonal;       ///< per free DOF: m (1 + h (alpha + c_i))
+    vec<double> diagonal;       ///< per free DOF: m (1 + h (alpha + c_i)), filled to factorise
     vec<double> previous_v;     ///< per free DOF: velocities before a trial update
     int32_t free_count = -1;    ///< -1: pattern not built yet
 
-    // The kept factorisation of a direct solver: of M + h D + h^2 K(x_f) for this step size,
-    // mass-and-damping diagonal and the body's stiffness version, at some earlier state x_f.
+    // The kept factorisation of a direct solver: of M + h D + h^2 K(x_f) for this step size and
+    // the body's matrix version, at some earlier state x_f.
     bool factor_valid = false;
     double factor_dt = 0.0;
-    uint64_t factor_stiffness_version = 0;
-    vec<double> factor_diagonal;  ///< per free DOF: the diagonal it was built with
+    uint64_t factor_matrix_version = 0;
     double roundoff_floor = 0.0;  ///< residual round-off level at the factorised state
 };
 
 /// Advances body by dt with backward Euler. With a direct solver and
-/// settings.implicit.factor_reuse > 0 an update solved with a kept factorisation is accepted if
-/// it cuts the residual by that factor, else discarded and solved again with a factorisation
-/// at the same iterate. On a failed factorisation (SH_ERR_SOLVER), a
+/// settings.implicit.factor_reuse > 0 a factorisation is kept across iterations and steps: an
+/// update solved with a kept one is accepted if it at least halves the residual (2-norm and
+/// max-norm), else discarded and solved again with a factorisation at the same iterate; a
+/// linearised step goes on with kept-factorisation updates until the residual is down by
+/// factor_reuse. A step that fails after using a kept factorisation is retried with fresh ones.
+/// On a failed factorisation (SH_ERR_SOLVER), a
 /// Newton loop that misses its tolerance (SH_ERR_NOT_CONVERGED) or a non-finite or runaway
 /// state (SH_ERR_UNSTABLE) the body is restored and result.status says why.
 BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double gravity[3]);

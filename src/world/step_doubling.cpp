@@ -19,13 +19,22 @@ bool take_half_steps(Body& body, StepDoubling& scratch, double dt, const double 
     for (size_t i = 0; i < body.kinematic.size(); ++i)
         if (body.kinematic[i])
             for (size_t k = 3 * i; k < 3 * i + 3; ++k) body.target[k] = 0.5 * (body.x[k] + body.target[k]);
-    bool stable = step_body(body, scratch.implicit, 0.5 * dt, gravity).stable;
-    std::copy(scratch.start_target.begin(), scratch.start_target.end(), body.target.begin());
-    if (stable) stable = step_body(body, scratch.implicit, 0.5 * dt, gravity).stable;
+    auto put_back = [&] {
+        std::copy(scratch.start_target.begin(), scratch.start_target.end(), body.target.begin());
+        std::copy(scratch.start_x.begin(), scratch.start_x.end(), body.x.begin());
+        std::copy(scratch.start_v.begin(), scratch.start_v.end(), body.v.begin());
+    };
+    bool stable;
+    try {
+        stable = step_body(body, scratch.implicit, 0.5 * dt, gravity).stable;
+        std::copy(scratch.start_target.begin(), scratch.start_target.end(), body.target.begin());
+        if (stable) stable = step_body(body, scratch.implicit, 0.5 * dt, gravity).stable;
+    } catch (...) {  // e.g. out of memory building the half steps' solver: the body as it was
+        put_back();
+        throw;
+    }
     std::copy(body.x.begin(), body.x.end(), scratch.half_x.begin());
-    std::copy(scratch.start_x.begin(), scratch.start_x.end(), body.x.begin());
-    std::copy(scratch.start_v.begin(), scratch.start_v.end(), body.v.begin());
-    body.clear_inverted_elements();
+    put_back();
     return stable;
 }
 

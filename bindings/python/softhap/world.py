@@ -280,8 +280,9 @@ class World(OwnedHandle):
           built in, else "ldlt"), "cholmod", "ldlt" or "cg"; newton_max_iterations (default 1:
           one linearised solve per step); newton_tolerance (default 1e-6); cg_tolerance
           (default 1e-8); cg_max_iterations (default 2000); factor_reuse (default 0.25: keep a
-          direct solver's factorisation while its updates cut the residual at least 4x; 0 =
-          factorise at every Newton iteration).
+          direct solver's factorisation while its updates at least halve the residual, a
+          linearised step taking them until the residual is down 4x; 0 = factorise at every
+          Newton iteration).
         Unknown names raise ValueError; invalid values raise softhap.Error
         (SH_ERR_INVALID_ARGUMENT).
         """

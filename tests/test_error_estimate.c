@@ -6,8 +6,6 @@
 #include <math.h>
 #include <string.h>
 
-static const double kMass = 1.0, kStiffness = 100.0, kRest = 1.0, kAmplitude = 0.01;
-
 static sh_world* oscillator_world(int error_estimate, sh_integrator integrator, sh_body_id* body) {
     sh_world_def wd;
     sh_world_def_default(&wd);
@@ -15,20 +13,8 @@ static sh_world* oscillator_world(int error_estimate, sh_integrator integrator, 
     wd.error_estimate = error_estimate;
     sh_world* world = NULL;
     assert_ok(sh_world_create(&wd, &world));
-    sh_spring_params params = {SH_SPRING_LINEAR};
-    params.stiffness = kStiffness;
-    *body = sh_test_spring_pair(world, kRest, &params, kMass, integrator, SH_UNSTABLE_REJECT);
-    const int32_t anchor = 0;
-    assert_ok(sh_body_fix_nodes(world, *body, &anchor, 1));
-    const double start[6] = {0, 0, 0, kRest + kAmplitude, 0, 0};
-    assert_ok(sh_body_set_positions(world, *body, start, 2));
+    *body = sh_test_oscillator(world, integrator, SH_LINEAR_SOLVER_DEFAULT);
     return world;
-}
-
-/* Backward Euler from (x, v) over h: (m + h^2 k) v1 = m v - h k (x - L), x1 = x + h v1. */
-static void backward_euler(double* x, double* v, double h) {
-    *v = (kMass * *v - h * kStiffness * (*x - kRest)) / (kMass + h * h * kStiffness);
-    *x += h * *v;
 }
 
 /* The estimate is exactly |x(one step) - x(two half steps)| of the hand-computed recursion,
@@ -39,17 +25,18 @@ static void test_estimate_is_the_half_step_difference(void** state) {
     sh_body_id with, without;
     sh_world* w1 = oscillator_world(1, SH_INTEGRATOR_IMPLICIT_EULER, &with);
     sh_world* w0 = oscillator_world(0, SH_INTEGRATOR_IMPLICIT_EULER, &without);
-    double x = kRest + kAmplitude, v = 0.0;
+    double x = SH_TEST_OSC_AMPLITUDE, v = 0.0; /* stretch */
     const double h = 0.02;
     for (int n = 0; n < 10; ++n) {
         double xf = x, vf = v, xh = x, vh = v;
-        backward_euler(&xf, &vf, h);
-        backward_euler(&xh, &vh, 0.5 * h);
-        backward_euler(&xh, &vh, 0.5 * h);
+        sh_test_oscillator_backward_euler(&xf, &vf, h, 0.0);
+        sh_test_oscillator_backward_euler(&xh, &vh, 0.5 * h, 0.0);
+        sh_test_oscillator_backward_euler(&xh, &vh, 0.5 * h, 0.0);
         sh_step_report r1, r0;
         assert_ok(sh_world_step(w1, h, &r1));
         assert_ok(sh_world_step(w0, h, &r0));
         assert_close(r1.error_estimate, fabs(xf - xh), 1e-9);
+        assert_true(fabs(r1.error_estimate / fabs(xf - xh) - 1.0) <= 1e-9);
         assert_true(r1.error_estimate_seconds > 0.0);
         assert_true(r0.error_estimate == -1.0 && r0.error_estimate_seconds == 0.0);
         double p1[6], p0[6], v1[6], v0[6];
@@ -59,7 +46,7 @@ static void test_estimate_is_the_half_step_difference(void** state) {
         assert_ok(sh_body_get_velocities(w0, without, v0, 6));
         assert_memory_equal(p1, p0, sizeof p1);
         assert_memory_equal(v1, v0, sizeof v1);
-        assert_true(fabs(p1[3] - xf) <= 1e-14);
+        assert_true(fabs(p1[3] - SH_TEST_OSC_REST - xf) <= 1e-14);
         x = xf;
         v = vf;
     }
@@ -72,7 +59,8 @@ static void test_estimate_is_the_half_step_difference(void** state) {
  * the limit of small h (here within 10 %): p = 1 for backward Euler, 4 for RK4. */
 static void test_estimate_predicts_the_true_local_error(void** state) {
     (void)state;
-    const double w = sqrt(kStiffness / kMass), t = 0.3;
+    const double w = sqrt(SH_TEST_OSC_STIFFNESS / SH_TEST_OSC_MASS), t = 0.3, L = SH_TEST_OSC_REST,
+                 A = SH_TEST_OSC_AMPLITUDE;
     const struct {
         sh_integrator integrator;
         int order;
@@ -82,15 +70,15 @@ static void test_estimate_predicts_the_true_local_error(void** state) {
         sh_body_id body;
         sh_world* world = oscillator_world(1, cases[c].integrator, &body);
         const double h = cases[c].h;
-        const double start[6] = {0, 0, 0, kRest + kAmplitude * cos(w * t), 0, 0};
-        const double speed[6] = {0, 0, 0, -kAmplitude * w * sin(w * t), 0, 0};
+        const double start[6] = {0, 0, 0, L + A * cos(w * t), 0, 0};
+        const double speed[6] = {0, 0, 0, -A * w * sin(w * t), 0, 0};
         assert_ok(sh_body_set_positions(world, body, start, 2));
         assert_ok(sh_body_set_velocities(world, body, speed, 2));
         sh_step_report report;
         assert_ok(sh_world_step(world, h, &report));
         double x[6];
         assert_ok(sh_body_get_positions(world, body, x, 6));
-        const double true_error = fabs(x[3] - (kRest + kAmplitude * cos(w * (t + h))));
+        const double true_error = fabs(x[3] - (L + A * cos(w * (t + h))));
         const double factor = pow(2.0, cases[c].order) / (pow(2.0, cases[c].order) - 1.0);
         print_message("order %d: true local error %.4g, estimate %.4g x %.4f = %.4g\n", cases[c].order, true_error,
                       report.error_estimate, factor, factor * report.error_estimate);

@@ -4,7 +4,8 @@
 
 #include <math.h>
 
-static const double kMass = 1.0, kStiffness = 100.0, kRest = 1.0, kAmplitude = 0.01;
+static const double kMass = SH_TEST_OSC_MASS, kStiffness = SH_TEST_OSC_STIFFNESS, kRest = SH_TEST_OSC_REST,
+                    kAmplitude = SH_TEST_OSC_AMPLITUDE;
 
 typedef struct {
     sh_world* world;
@@ -14,14 +15,7 @@ typedef struct {
 static oscillator make_oscillator(sh_integrator integrator) {
     oscillator o;
     o.world = sh_test_world(0.0);
-    sh_spring_params params = {SH_SPRING_LINEAR};
-    params.stiffness = kStiffness;
-    /* reject: a test must never sub-step silently */
-    o.body = sh_test_spring_pair(o.world, kRest, &params, kMass, integrator, SH_UNSTABLE_REJECT);
-    const int32_t fixed = 0;
-    assert_ok(sh_body_fix_nodes(o.world, o.body, &fixed, 1));
-    const double start[6] = {0, 0, 0, kRest + kAmplitude, 0, 0};
-    assert_ok(sh_body_set_positions(o.world, o.body, start, 2));
+    o.body = sh_test_oscillator(o.world, integrator, SH_LINEAR_SOLVER_DEFAULT);
     return o;
 }
 
@@ -58,13 +52,7 @@ static void test_order_symplectic_euler(void** s) { (void)s; check_order(SH_INTE
 static void test_order_rk2(void** s) { (void)s; check_order(SH_INTEGRATOR_RK2, 2e-3, 2.0); }
 static void test_order_rk4(void** s) { (void)s; check_order(SH_INTEGRATOR_RK4, 2e-2, 4.0); }
 
-static double oscillator_energy(const oscillator* o) {
-    double x[6], v[6];
-    assert_ok(sh_body_get_positions(o->world, o->body, x, 6));
-    assert_ok(sh_body_get_velocities(o->world, o->body, v, 6));
-    const double d = x[3] - kRest;
-    return 0.5 * kMass * v[3] * v[3] + 0.5 * kStiffness * d * d;
-}
+static double oscillator_energy(const oscillator* o) { return sh_test_oscillator_energy(o->world, o->body); }
 
 /* Symplectic Euler conserves a modified energy: the true energy oscillates within
  * O(w dt) of E0 and does not drift, over 1e5 steps. */

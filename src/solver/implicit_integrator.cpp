@@ -203,7 +203,9 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
         if (!fresh) {
             ++stale_solves;
             used_stale = true;
-            if (!(r_new <= kStaleContraction * r && r_new_max <= kStaleContraction * r_max)) {
+            const double floor = state.roundoff_floor;  // nothing to gain below it
+            if (!(r_new <= std::max(kStaleContraction * r, floor) &&
+                  r_new_max <= std::max(kStaleContraction * r_max, floor))) {
                 // The kept factorisation is too far from the current tangent: take the update
                 // back and solve again with a new one here.
                 for (int32_t d = 0; d < dofs; ++d)
@@ -224,7 +226,8 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
         if (linearised) {
             // One update with the tangent at its iterate is the linearised step; updates with a
             // kept factorisation go on until they are at least as good as factor_reuse asks.
-            if (was_fresh || (r <= target && r_max <= target_max)) converged = true;
+            const double floor = state.roundoff_floor;
+            if (was_fresh || (r <= std::max(target, floor) && r_max <= std::max(target_max, floor))) converged = true;
             continue;
         }
         ++iteration;

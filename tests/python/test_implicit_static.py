@@ -67,11 +67,11 @@ def test_implicit_oscillator_matches_the_backward_euler_recursion(damping):
             state = step @ state
             assert body.positions[1, 0] - length == pytest.approx(state[0], rel=1e-9, abs=1e-15)
             assert body.velocities[1, 0] == pytest.approx(state[1], rel=1e-9, abs=1e-15)
+        # A linear spring along its axis: one exact update per step, one solve, and the
+        # factorisation of the first step serves every later one.
         assert report.substeps == 1
-        assert report.newton_iterations >= 1
-        assert report.linear_iterations >= 1
-        assert report.factorize_seconds >= 0.0 and report.solve_seconds >= 0.0
-        assert abs(state[0]) < amplitude  # dissipative
+        assert report.newton_iterations == 1 and report.linear_iterations == 1
+        assert report.factorizations == 0
 
 
 def implicit_liver_positions(meshes, solver, factor_reuse=0.0):

@@ -29,8 +29,8 @@ sh_world* sh_test_world(double gravity_z) {
     return world;
 }
 
-sh_body_id sh_test_spring_pair(sh_world* world, double rest_length, const sh_spring_params* params, double mass,
-                               sh_integrator integrator, sh_unstable_policy policy) {
+static sh_body_id spring_pair(sh_world* world, double rest_length, const sh_spring_params* params, double mass,
+                              sh_integrator integrator, sh_unstable_policy policy, sh_linear_solver solver) {
     const double nodes[6] = {0, 0, 0, rest_length, 0, 0};
     const int32_t springs[2] = {0, 1};
     sh_spring_body_def def;
@@ -43,9 +43,43 @@ sh_body_id sh_test_spring_pair(sh_world* world, double rest_length, const sh_spr
     def.node_mass = mass;
     def.integrator = integrator;
     def.on_unstable = policy;
+    def.implicit.linear_solver = solver;
     sh_body_id body = SH_NULL_BODY;
     sh_test_assert_status(sh_world_add_spring_body(world, &def, &body), SH_OK, "sh_world_add_spring_body", __FILE__, __LINE__);
     return body;
+}
+
+sh_body_id sh_test_spring_pair(sh_world* world, double rest_length, const sh_spring_params* params, double mass,
+                               sh_integrator integrator, sh_unstable_policy policy) {
+    return spring_pair(world, rest_length, params, mass, integrator, policy, SH_LINEAR_SOLVER_DEFAULT);
+}
+
+sh_body_id sh_test_oscillator(sh_world* world, sh_integrator integrator, sh_linear_solver solver) {
+    sh_spring_params params = {SH_SPRING_LINEAR};
+    params.stiffness = SH_TEST_OSC_STIFFNESS;
+    const sh_body_id body =
+        spring_pair(world, SH_TEST_OSC_REST, &params, SH_TEST_OSC_MASS, integrator, SH_UNSTABLE_REJECT, solver);
+    const int32_t anchor = 0;
+    sh_test_assert_status(sh_body_fix_nodes(world, body, &anchor, 1), SH_OK, "sh_body_fix_nodes", __FILE__, __LINE__);
+    const double start[6] = {0, 0, 0, SH_TEST_OSC_REST + SH_TEST_OSC_AMPLITUDE, 0, 0};
+    sh_test_assert_status(sh_body_set_positions(world, body, start, 2), SH_OK, "sh_body_set_positions", __FILE__,
+                          __LINE__);
+    return body;
+}
+
+double sh_test_oscillator_energy(const sh_world* world, sh_body_id body) {
+    double x[6], v[6];
+    sh_test_assert_status(sh_body_get_positions(world, body, x, 6), SH_OK, "sh_body_get_positions", __FILE__, __LINE__);
+    sh_test_assert_status(sh_body_get_velocities(world, body, v, 6), SH_OK, "sh_body_get_velocities", __FILE__,
+                          __LINE__);
+    const double d = x[3] - SH_TEST_OSC_REST;
+    return 0.5 * SH_TEST_OSC_MASS * v[3] * v[3] + 0.5 * SH_TEST_OSC_STIFFNESS * d * d;
+}
+
+void sh_test_oscillator_backward_euler(double* stretch, double* velocity, double h, double c) {
+    const double m = SH_TEST_OSC_MASS, k = SH_TEST_OSC_STIFFNESS;
+    *velocity = (m * *velocity - h * k * *stretch) / (m * (1.0 + h * c) + h * h * k);
+    *stretch += h * *velocity;
 }
 
 sh_mesh* sh_test_unit_tet(double s) {

@@ -36,6 +36,24 @@ sh_world* sh_test_world(double gravity_z);
 sh_body_id sh_test_spring_pair(sh_world* world, double rest_length, const sh_spring_params* params, double mass,
                                sh_integrator integrator, sh_unstable_policy policy);
 
+/** The test oscillator: a spring pair along x (sh_test_spring_pair) with node 0 fixed, node 1
+ *  of mass SH_TEST_OSC_MASS on a linear spring of stiffness SH_TEST_OSC_STIFFNESS and rest
+ *  length SH_TEST_OSC_REST, started at rest stretched by SH_TEST_OSC_AMPLITUDE. Steps above the
+ *  critical one are rejected (a test never sub-steps silently); solver is the implicit
+ *  integrator's linear solver. Its motion is x(t) = L + A cos(w t), w = sqrt(k / m). */
+#define SH_TEST_OSC_MASS 1.0
+#define SH_TEST_OSC_STIFFNESS 100.0
+#define SH_TEST_OSC_REST 1.0
+#define SH_TEST_OSC_AMPLITUDE 0.01
+sh_body_id sh_test_oscillator(sh_world* world, sh_integrator integrator, sh_linear_solver solver);
+
+/** Kinetic plus spring energy of the test oscillator's moving node (J), read from the body. */
+double sh_test_oscillator_energy(const sh_world* world, sh_body_id body);
+
+/** One exact backward Euler step of the test oscillator with node damping c (force -c m v):
+ *  (m (1 + h c) + h^2 k) v1 = m v - h k s, s1 = s + h v1, for its stretch s and velocity v. */
+void sh_test_oscillator_backward_euler(double* stretch, double* velocity, double h, double c);
+
 /** A unit right-handed tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) scaled by s, as a mesh. */
 sh_mesh* sh_test_unit_tet(double s);
 

@@ -227,6 +227,39 @@ def test_static_not_converged_error_carries_the_report(meshes):
         assert report.iterations >= 1 and report.residual > 1e-14
 
 
+def test_implicit_failure_carries_the_step_report():
+    # CG capped at one iteration cannot solve the stiff implicit body (SH_ERR_NOT_CONVERGED):
+    # that body keeps its state while a free particle in the same world still falls one step.
+    with softhap.World(gravity=(0, 0, -9.81)) as world:
+        particle = world.add_spring_body([[0.0, 0.0, 0.0]], integrator="symplectic_euler")
+        body = world.add_spring_body([[0.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, -1.0]],
+                                     springs=[[0, 1], [1, 2], [0, 2]], stiffness=1e6,
+                                     integrator="implicit_euler", linear_solver="cg",
+                                     cg_max_iterations=1, cg_tolerance=1e-14)
+        body.fix_nodes([0])
+        before = body.positions
+        with pytest.raises(softhap.Error) as info:
+            world.step(0.01)
+        assert info.value.status_name == "SH_ERR_NOT_CONVERGED"
+        assert isinstance(info.value.report, softhap.StepReport)
+        assert info.value.report.unstable_body_count == 1
+        np.testing.assert_array_equal(body.positions, before)
+        assert particle.positions[0, 2] == pytest.approx(-9.81 * 0.01 * 0.01, rel=1e-12)
+        with pytest.raises(softhap.Error) as info:
+            world.step(-1.0)
+        assert info.value.report is None
+
+
+@pytest.mark.parametrize("bad", [2.5, -(2**32) + 1, 2**31, float("nan")])
+def test_integer_arguments_must_be_whole_int32(bad):
+    with softhap.World() as world:
+        body = world.add_spring_body([[0.0, 0.0, 0.0], [0.0, 0.0, -1.0]], springs=[[0, 1]])
+        body.fix_nodes([0])
+        with pytest.raises(ValueError) as info:
+            world.solve_static(max_iterations=bad)
+        assert "max_iterations" in str(info.value)
+
+
 def test_static_def_values_are_checked_by_the_library():
     with softhap.World() as world:
         body = world.add_spring_body([[0.0, 0.0, 0.0], [0.0, 0.0, -1.0]], springs=[[0, 1]])

@@ -5,6 +5,7 @@ are left to the C library, which reports them as softhap.Error with its status.
 """
 
 import ctypes
+import operator
 import os
 
 import numpy as np
@@ -58,12 +59,24 @@ def index_array(value, name, shape):
     return array
 
 
+def index_list(value, name):
+    """index_array of a scalar index or a sequence of indices, as a 1-D array."""
+    return index_array(np.atleast_1d(np.asarray(value)), name, (None,))
+
+
 def count(n, name):
-    """Return n as an int after checking it fits in the C API's int32 counts."""
-    n = int(n)
-    if n > INT32_MAX:
-        raise ValueError("%s is %d, more than the C API's int32 limit" % (name, n))
-    return n
+    """Return n as an int after checking it is a whole number that fits in the C API's int32
+    (ctypes would silently wrap a larger one); the C call judges the range itself."""
+    try:
+        value = operator.index(n)
+    except TypeError:
+        as_float = float(n)
+        if not as_float.is_integer():
+            raise ValueError("%s must be a whole number, got %r" % (name, n)) from None
+        value = int(as_float)
+    if not INT32_MIN <= value <= INT32_MAX:
+        raise ValueError("%s is %d, outside the C API's int32 range" % (name, value))
+    return value
 
 
 def double_ptr(array):

@@ -20,8 +20,9 @@ class Error(Exception):
         message: sh_last_error_message() of the failed call (which file and line, element,
             node or parameter), or a description written by the bindings.
         function: the C function that failed (e.g. "sh_mesh_load"), or None.
-        report: for sh_world_step failing with SH_ERR_UNSTABLE, the StepReport of that step
-            (the other bodies still advanced); None otherwise.
+        report: for a failed sh_world_step that stepped the bodies, the StepReport of that
+            step (the other bodies still advanced); for sh_world_solve_static, the StaticReport
+            of what was tried when the library filled it; None otherwise.
     """
 
     def __init__(self, status, message, function=None, report=None):

@@ -18,11 +18,13 @@ def status_string(status):
     return raw.decode("utf-8", errors="replace") if raw else ""
 
 
-def check(status, function):
-    """Raise softhap.Error if status (returned by the C function named function) is not SH_OK."""
+def check(status, function, report=None):
+    """Raise softhap.Error if status (returned by the C function named function) is not SH_OK.
+    report: None, or a callable giving what the error carries as .report (called only on
+    failure)."""
     if status != Status.SH_OK:
         message = last_error_message() or status_string(status)
-        raise Error(status, message, function)
+        raise Error(status, message, function, report=report() if report else None)
 
 
 def closed_error(what, function=None):

@@ -1,6 +1,8 @@
 """Record: a dict whose keys can also be read as attributes (report["substeps"] or
 report.substeps). Used for mesh info, body info and step reports."""
 
+import ctypes
+
 
 class Record(dict):
     """A dict of named values, also readable as attributes."""
@@ -19,6 +21,17 @@ class Record(dict):
     def __repr__(self):
         items = ", ".join("%s=%r" % item for item in self.items())
         return "%s(%s)" % (type(self).__name__, items)
+
+
+def record_of(cls, raw, **overrides):
+    """A cls holding every field of the ctypes struct raw under its C name (arrays as tuples),
+    with the values in overrides replacing or adding fields."""
+    values = {}
+    for name, _ in raw._fields_:
+        value = getattr(raw, name)
+        values[name] = tuple(value) if isinstance(value, ctypes.Array) else value
+    values.update(overrides)
+    return cls(values)
 
 
 class MeshInfo(Record):

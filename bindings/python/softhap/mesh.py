@@ -8,7 +8,7 @@ from . import _arrays
 from ._lib import sh_mesh_info
 from ._handle import OwnedHandle
 from ._loaded import check, lib
-from ._record import MeshInfo
+from ._record import MeshInfo, record_of
 
 
 class Mesh(OwnedHandle):
@@ -99,18 +99,7 @@ class Mesh(OwnedHandle):
         handle = self._require_handle("sh_mesh_get_info")
         raw = sh_mesh_info()
         check(lib.sh_mesh_get_info(handle, ctypes.byref(raw)), "sh_mesh_get_info")
-        return MeshInfo(
-            node_count=raw.node_count,
-            tet_count=raw.tet_count,
-            surface_triangle_count=raw.surface_triangle_count,
-            edge_count=raw.edge_count,
-            orphan_node_count=raw.orphan_node_count,
-            reoriented_tet_count=raw.reoriented_tet_count,
-            skipped_element_count=raw.skipped_element_count,
-            bounds_min=tuple(raw.bounds_min),
-            bounds_max=tuple(raw.bounds_max),
-            volume=raw.volume,
-        )
+        return record_of(MeshInfo, raw)
 
     @property
     def node_count(self):

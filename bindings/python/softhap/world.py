@@ -5,7 +5,6 @@ import ctypes
 import numpy as np
 
 from . import _arrays
-from ._errors import Error
 from ._lib import (
     INTEGRATORS,
     LINEAR_SOLVERS,
@@ -13,7 +12,6 @@ from ._lib import (
     SH_WARN_COUNT,
     SPRING_LAWS,
     UNSTABLE_POLICIES,
-    Status,
     WarningKind,
     sh_body_id,
     sh_body_info,
@@ -25,8 +23,8 @@ from ._lib import (
     sh_world_def,
 )
 from ._handle import OwnedHandle
-from ._loaded import check, closed_error, last_error_message, lib, status_string
-from ._record import BodyInfo, StaticReport, StepReport
+from ._loaded import check, closed_error, lib
+from ._record import BodyInfo, StaticReport, StepReport, record_of
 from .mesh import Mesh
 
 # Which sh_spring_params fields each law reads (damping is read by every law).
@@ -52,25 +50,7 @@ def _warning_names(bits):
 
 
 def _step_report(raw):
-    return StepReport(
-        wall_seconds=raw.wall_seconds,
-        substeps=raw.substeps,
-        dt_critical=raw.dt_critical,
-        kinetic_energy=raw.kinetic_energy,
-        elastic_energy=raw.elastic_energy,
-        potential_energy=raw.potential_energy,
-        warnings=_warning_names(raw.warnings),
-        warning_bits=int(raw.warnings),
-        unstable_body_count=raw.unstable_body_count,
-        newton_iterations=raw.newton_iterations,
-        linear_iterations=raw.linear_iterations,
-        newton_residual=raw.newton_residual,
-        factorize_seconds=raw.factorize_seconds,
-        solve_seconds=raw.solve_seconds,
-        factorizations=raw.factorizations,
-        error_estimate=raw.error_estimate,
-        error_estimate_seconds=raw.error_estimate_seconds,
-    )
+    return record_of(StepReport, raw, warnings=_warning_names(raw.warnings), warning_bits=int(raw.warnings))
 
 
 def _static_report(raw):
@@ -85,38 +65,59 @@ def _static_report(raw):
     )
 
 
-def _set_implicit(settings, linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
-                  cg_max_iterations, factor_reuse):
-    """Fill an sh_implicit_settings from keyword arguments (None keeps the C default)."""
-    if linear_solver is not None:
-        settings.linear_solver = _choose(linear_solver, LINEAR_SOLVERS, "linear_solver")
-    if newton_max_iterations is not None:
-        settings.newton_max_iterations = _arrays.count(newton_max_iterations, "newton_max_iterations")
-    if newton_tolerance is not None:
-        settings.newton_tolerance = float(newton_tolerance)
-    if cg_tolerance is not None:
-        settings.cg_tolerance = float(cg_tolerance)
-    if cg_max_iterations is not None:
-        settings.cg_max_iterations = _arrays.count(cg_max_iterations, "cg_max_iterations")
-    if factor_reuse is not None:
-        settings.factor_reuse = float(factor_reuse)
+def _choice(choices, parameter):
+    """Converter of a name (e.g. "rk4") to its C enum value, for _fill."""
+    return lambda value: _choose(value, choices, parameter)
 
 
-def _set_body_options(definition, integrator, on_unstable, damping_mass, runaway_speed,
-                      linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
-                      cg_max_iterations, factor_reuse):
-    """Fill the options sh_fem_body_def and sh_spring_body_def share from keyword arguments
-    (None keeps the C default)."""
-    if integrator is not None:
-        definition.integrator = _choose(integrator, INTEGRATORS, "integrator")
-    if on_unstable is not None:
-        definition.on_unstable = _choose(on_unstable, UNSTABLE_POLICIES, "on_unstable")
-    if damping_mass is not None:
-        definition.damping_mass = float(damping_mass)
-    if runaway_speed is not None:
-        definition.runaway_speed = float(runaway_speed)
-    _set_implicit(definition.implicit, linear_solver, newton_max_iterations, newton_tolerance,
-                  cg_tolerance, cg_max_iterations, factor_reuse)
+def _int32(parameter):
+    """Converter of an integer count, for _fill."""
+    return lambda value: _arrays.count(value, parameter)
+
+
+# For each C struct filled from keyword arguments: field name -> converter.
+_MATERIAL_FIELDS = {
+    "model": _choice(MATERIAL_MODELS, "model"),
+    "young": float,
+    "poisson": float,
+    "density": float,
+}
+_BODY_FIELDS = {  # shared by sh_fem_body_def and sh_spring_body_def
+    "integrator": _choice(INTEGRATORS, "integrator"),
+    "on_unstable": _choice(UNSTABLE_POLICIES, "on_unstable"),
+    "damping_mass": float,
+    "runaway_speed": float,
+}
+_IMPLICIT_FIELDS = {
+    "linear_solver": _choice(LINEAR_SOLVERS, "linear_solver"),
+    "newton_max_iterations": _int32("newton_max_iterations"),
+    "newton_tolerance": float,
+    "cg_tolerance": float,
+    "cg_max_iterations": _int32("cg_max_iterations"),
+    "factor_reuse": float,
+}
+_STATIC_FIELDS = {
+    "tolerance": float,
+    "max_iterations": _int32("max_iterations"),
+    "load_steps": _int32("load_steps"),
+    "linear_solver": _choice(LINEAR_SOLVERS, "linear_solver"),
+}
+
+
+def _fill(struct, fields, arguments):
+    """Set each field of struct named in fields from arguments[name] through its converter,
+    skipping arguments that are None (they keep the C default)."""
+    for name, convert in fields.items():
+        value = arguments.get(name)
+        if value is not None:
+            setattr(struct, name, convert(value))
+
+
+def _set_body_options(definition, arguments):
+    """Fill the options sh_fem_body_def and sh_spring_body_def share (integration and implicit
+    settings) from a method's keyword arguments."""
+    _fill(definition, _BODY_FIELDS, arguments)
+    _fill(definition.implicit, _IMPLICIT_FIELDS, arguments)
 
 
 def _default_material():
@@ -198,17 +199,18 @@ class World(OwnedHandle):
         access: wall_seconds, substeps, dt_critical, kinetic_energy, elastic_energy,
         potential_energy, warnings (set of names), warning_bits, unstable_body_count).
 
-        If a body's step was rejected or rolled back (SH_ERR_UNSTABLE) the other bodies still
-        advanced; the raised softhap.Error then carries the step's report as ``err.report``.
+        If a body's step failed (rejected or rolled back: SH_ERR_UNSTABLE; an implicit body's
+        SH_ERR_SOLVER or SH_ERR_NOT_CONVERGED) that body is as before and the other bodies still
+        advanced; the raised softhap.Error then carries the step's report as ``err.report``
+        (None when nothing was stepped, e.g. for an invalid dt).
         """
         handle = self._require_handle("sh_world_step")
         raw = sh_step_report()
+        raw.substeps = 0  # sentinel: the library writes >= 1 when it stepped the bodies
         status = lib.sh_world_step(handle, float(dt), ctypes.byref(raw))
-        if status == Status.SH_OK:
-            return _step_report(raw)
-        message = last_error_message() or status_string(status)
-        report = _step_report(raw) if status == Status.SH_ERR_UNSTABLE else None
-        raise Error(status, message, "sh_world_step", report=report)
+        check(status, "sh_world_step",
+              report=lambda: _step_report(raw) if raw.substeps > 0 else None)
+        return _step_report(raw)
 
     def solve_static(self, tolerance=None, max_iterations=None, load_steps=None, linear_solver=None):
         """Move every body to static equilibrium under gravity and its external forces, fixed
@@ -223,25 +225,17 @@ class World(OwnedHandle):
         state, and ``err.report`` is the report of what was tried (converged False) when the
         library filled it (it does not for rejected arguments), else None.
         """
+        arguments = dict(locals())
         handle = self._require_handle("sh_world_solve_static")
         definition = sh_static_def()
         lib.sh_static_def_default(ctypes.byref(definition))
-        if tolerance is not None:
-            definition.tolerance = float(tolerance)
-        if max_iterations is not None:
-            definition.max_iterations = _arrays.count(max_iterations, "max_iterations")
-        if load_steps is not None:
-            definition.load_steps = _arrays.count(load_steps, "load_steps")
-        if linear_solver is not None:
-            definition.linear_solver = _choose(linear_solver, LINEAR_SOLVERS, "linear_solver")
+        _fill(definition, _STATIC_FIELDS, arguments)
         raw = sh_static_report()
         raw.iterations = -1  # sentinel: tells whether the library wrote the report
         status = lib.sh_world_solve_static(handle, ctypes.byref(definition), ctypes.byref(raw))
-        if status == Status.SH_OK:
-            return _static_report(raw)
-        message = last_error_message() or status_string(status)
-        report = _static_report(raw) if raw.iterations >= 0 else None
-        raise Error(status, message, "sh_world_solve_static", report=report)
+        check(status, "sh_world_solve_static",
+              report=lambda: _static_report(raw) if raw.iterations >= 0 else None)
+        return _static_report(raw)
 
     # -- bodies ----------------------------------------------------------------------------
 
@@ -286,25 +280,17 @@ class World(OwnedHandle):
         Unknown names raise ValueError; invalid values raise softhap.Error
         (SH_ERR_INVALID_ARGUMENT).
         """
+        arguments = dict(locals())
         handle = self._require_handle("sh_world_add_fem_body")
         if not isinstance(mesh, Mesh):
             raise TypeError("mesh must be a softhap.Mesh, got %s" % type(mesh).__name__)
         definition = sh_fem_body_def()
         lib.sh_fem_body_def_default(ctypes.byref(definition))
         definition.mesh = mesh._require_handle("sh_world_add_fem_body")
-        if model is not None:
-            definition.material.model = _choose(model, MATERIAL_MODELS, "model")
-        if young is not None:
-            definition.material.young = float(young)
-        if poisson is not None:
-            definition.material.poisson = float(poisson)
-        if density is not None:
-            definition.material.density = float(density)
+        _fill(definition.material, _MATERIAL_FIELDS, arguments)
         if damping_stiffness is not None:
             definition.damping_stiffness = float(damping_stiffness)
-        _set_body_options(definition, integrator, on_unstable, damping_mass, runaway_speed,
-                          linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
-                          cg_max_iterations, factor_reuse)
+        _set_body_options(definition, arguments)
         body = sh_body_id()
         check(
             lib.sh_world_add_fem_body(handle, ctypes.byref(definition), ctypes.byref(body)),
@@ -353,24 +339,22 @@ class World(OwnedHandle):
             settings (linear_solver, newton_max_iterations, ...): as add_fem_body.
         Unknown names raise ValueError; invalid values raise softhap.Error.
         """
+        arguments = dict(locals())
         handle = self._require_handle("sh_world_add_spring_body")
         definition = sh_spring_body_def()
         lib.sh_spring_body_def_default(ctypes.byref(definition))
 
-        # Arrays referenced by the def must stay alive until the create call returns.
-        keep_alive = []
+        # The arrays the def points into are locals: alive until the create call returns.
         if isinstance(nodes, Mesh):
             definition.mesh = nodes._require_handle("sh_world_add_spring_body")
             node_count = nodes.node_count
         else:
             node_array = _arrays.float_array(nodes, "nodes", (None, 3))
-            keep_alive.append(node_array)
             definition.nodes = _arrays.double_ptr(node_array)
             definition.node_count = _arrays.count(node_array.shape[0], "node count")
             node_count = node_array.shape[0]
         if springs is not None:
             spring_array = _arrays.index_array(springs, "springs", (None, 2))
-            keep_alive.append(spring_array)
             definition.springs = _arrays.int32_ptr(spring_array)
             definition.spring_count = _arrays.count(spring_array.shape[0], "spring count")
 
@@ -396,7 +380,6 @@ class World(OwnedHandle):
                 setattr(definition.params, name, float(given[name]))
         if table is not None:
             table_array = _arrays.float_array(table, "table", (None, 2))
-            keep_alive.append(table_array)
             definition.params.table = _arrays.double_ptr(table_array)
             definition.params.table_rows = _arrays.count(table_array.shape[0], "table rows")
 
@@ -405,15 +388,11 @@ class World(OwnedHandle):
                 definition.node_mass = float(mass)
             else:
                 mass_array = _arrays.float_array(mass, "mass", (node_count,))
-                keep_alive.append(mass_array)
                 definition.node_masses = _arrays.double_ptr(mass_array)
-        _set_body_options(definition, integrator, on_unstable, damping_mass, runaway_speed,
-                          linear_solver, newton_max_iterations, newton_tolerance, cg_tolerance,
-                          cg_max_iterations, factor_reuse)
+        _set_body_options(definition, arguments)
 
         body = sh_body_id()
         status = lib.sh_world_add_spring_body(handle, ctypes.byref(definition), ctypes.byref(body))
-        del keep_alive
         check(status, "sh_world_add_spring_body")
         return Body(self, body.value)
 
@@ -476,14 +455,7 @@ class Body:
         handle = self._world_handle("sh_body_get_info")
         raw = sh_body_info()
         check(lib.sh_body_get_info(handle, self._id, ctypes.byref(raw)), "sh_body_get_info")
-        return BodyInfo(
-            node_count=raw.node_count,
-            element_count=raw.element_count,
-            is_fem=bool(raw.is_fem),
-            fixed_node_count=raw.fixed_node_count,
-            total_mass=raw.total_mass,
-            dt_critical=raw.dt_critical,
-        )
+        return record_of(BodyInfo, raw, is_fem=bool(raw.is_fem))
 
     @property
     def node_count(self):
@@ -561,7 +533,7 @@ class Body:
 
     def _node_list(self, function_name, indices):
         handle = self._world_handle(function_name)
-        nodes = _arrays.index_array(np.atleast_1d(np.asarray(indices)), "indices", (None,))
+        nodes = _arrays.index_list(indices, "indices")
         check(
             getattr(lib, function_name)(handle, self._id, _arrays.int32_ptr(nodes), nodes.size),
             function_name,
@@ -579,7 +551,7 @@ class Body:
         """Prescribe target positions ((k, 3), m) of k nodes: each moves linearly to its target
         over the next step and is then held there."""
         handle = self._world_handle("sh_body_prescribe_positions")
-        nodes = _arrays.index_array(np.atleast_1d(np.asarray(indices)), "indices", (None,))
+        nodes = _arrays.index_list(indices, "indices")
         targets = _arrays.float_array(positions, "positions", (nodes.size, 3))
         check(
             lib.sh_body_prescribe_positions(
@@ -627,19 +599,11 @@ class Body:
         sh_fem_body_def_default value (StVK, 3000 Pa, 0.45, 1000 kg/m^3), not the element's
         current value. Invalid values raise softhap.Error (SH_ERR_INVALID_ARGUMENT).
         """
+        arguments = dict(locals())
         handle = self._world_handle("sh_body_set_material")
-        elements = _arrays.index_array(
-            np.atleast_1d(np.asarray(element_indices)), "element_indices", (None,)
-        )
+        elements = _arrays.index_list(element_indices, "element_indices")
         material = _default_material()
-        if model is not None:
-            material.model = _choose(model, MATERIAL_MODELS, "model")
-        if young is not None:
-            material.young = float(young)
-        if poisson is not None:
-            material.poisson = float(poisson)
-        if density is not None:
-            material.density = float(density)
+        _fill(material, _MATERIAL_FIELDS, arguments)
         check(
             lib.sh_body_set_material(
                 handle, self._id, _arrays.int32_ptr(elements), elements.size, ctypes.byref(material)

@@ -85,6 +85,10 @@ public:
     /// Recomputes inverse_mass from mass and kinematic.
     void update_inverse_mass();
 
+    /// The applied load on global DOF j = 3 node + c: external force plus the node's weight
+    /// under gravity g (N).
+    double applied_load(size_t j, const double g[3]) const { return external_force[j] + mass[j / 3] * g[j % 3]; }
+
     /// Replaces node_damping by coefficients[node_count()] (1/s), or clears it for null.
     void set_node_damping(const double* coefficients);
 

@@ -2,6 +2,10 @@
 // of the system per step). One cholmod_common per solver; the symbolic analysis (ordering,
 // elimination tree, supernodes) is kept in the cholmod_factor and reused by every factorize until
 // the pattern changes; solves reuse CHOLMOD's solution and workspace (cholmod_solve2).
+// CHOLMOD picks supernodal LL^T for 3D tet meshes of a few thousand nodes and up. Note for
+// real-time hosts: Debian's CHOLMOD 3 runs OpenMP parallel regions in the supernodal
+// factorisation (OMP_THREAD_LIMIT=1 keeps it on the calling thread) and uses the system BLAS
+// (OpenBLAS is about 2.5x faster there than the reference BLAS).
 #if SOFTHAP_WITH_CHOLMOD
 
 #include "solver/linear_solver.hpp"
@@ -31,21 +35,10 @@ const char* cholmod_status_text(int status) {
 
 class CholmodSolver final : public LinearSolver {
 public:
-    CholmodSolver(CholmodMode mode, CholmodOrdering ordering) {
+    CholmodSolver() {
         cholmod_start(&common_);
         common_.print = 0;  // never print (errors come back as sh::Error)
         common_.error_handler = nullptr;
-        switch (mode) {
-            case CholmodMode::Automatic: common_.supernodal = CHOLMOD_AUTO; break;
-            case CholmodMode::Supernodal: common_.supernodal = CHOLMOD_SUPERNODAL; break;
-            case CholmodMode::Simplicial: common_.supernodal = CHOLMOD_SIMPLICIAL; break;
-        }
-        switch (ordering) {
-            case CholmodOrdering::Default: break;
-            case CholmodOrdering::Amd: set_single_ordering(CHOLMOD_AMD); break;
-            case CholmodOrdering::Metis: set_single_ordering(CHOLMOD_METIS); break;
-            case CholmodOrdering::NestedDissection: set_single_ordering(CHOLMOD_NESDIS); break;
-        }
         // Keep the factor as computed (supernodal LL^T or simplicial LDL^T): no conversion pass.
         common_.final_asis = 1;
     }
@@ -60,110 +53,72 @@ public:
 
     const char* name() const override { return "cholmod"; }
     bool is_direct() const override { return true; }
-    const char* method() const override {
-        if (!factor_ || factor_->xtype == CHOLMOD_PATTERN) return "cholmod (not factorised)";
-        if (factor_->is_super) return "cholmod supernodal LL^T";
-        return factor_->is_ll ? "cholmod simplicial LL^T" : "cholmod simplicial LDL^T";
-    }
-    int64_t factor_nonzeros() const override {
-        if (!factor_) return 0;
-        if (factor_->is_super) return static_cast<int64_t>(factor_->xsize);  // incl. supernode padding
-        const int* nz = static_cast<const int*>(factor_->nz);
-        int64_t total = 0;
-        for (size_t j = 0; nz && j < factor_->n; ++j) total += nz[j];
-        return total;
-    }
 
-    void analyze(const SparseSystem& a) override {
-        const double t0 = solver_detail::now_seconds();
+protected:
+    void do_analyze(const SparseSystem& a) override {
         free_all();
-        if (a.dof_count() > 0) {
-            cholmod_sparse matrix = wrap(a);
-            factor_ = cholmod_analyze(&matrix, &common_);
-            check(factor_ != nullptr, "symbolic analysis");
-        }
-        analysed_id_ = a.pattern_id();
-        analyze_seconds = solver_detail::now_seconds() - t0;
+        cholmod_sparse matrix = wrap(a);
+        factor_ = cholmod_analyze(&matrix, &common_);
+        check(factor_ != nullptr, "symbolic analysis");
     }
 
-    void factorize(const SparseSystem& a) override {
-        const double t0 = solver_detail::now_seconds();
-        solver_detail::require_analysed(a, analysed_id_, name());
-        factorized_ = false;
-        if (a.dof_count() > 0) {
-            solver_detail::require_finite_values(a, name());
-            cholmod_sparse matrix = wrap(a);
-            const int ok = cholmod_factorize(&matrix, factor_, &common_);
-            size_t minor = factor_->minor;
-            if (ok && minor >= factor_->n && !factor_->is_super && !factor_->is_ll) {
-                // Simplicial LDL^T only stops at a zero pivot (an indefinite matrix factorises);
-                // we need positive definite, so check D: the first entry of each column of L.
-                const int* lp = static_cast<const int*>(factor_->p);
-                const double* lx = static_cast<const double*>(factor_->x);
-                for (size_t k = 0; k < factor_->n; ++k)
-                    if (!(lx[lp[k]] > 0.0)) {
-                        minor = k;
-                        break;
-                    }
-            }
-            if (common_.status == CHOLMOD_NOT_POSDEF || minor < factor_->n) {
-                // minor is the failing column of the permuted matrix P A P^T; Perm maps it back.
-                const int* perm = static_cast<const int*>(factor_->Perm);
-                const int32_t column = perm && minor < factor_->n ? perm[minor] : static_cast<int32_t>(minor);
-                solver_detail::throw_not_positive_definite(
-                    a, column, name(),
-                    format("%s factorisation stopped at elimination step %zu", factor_->is_super ? "supernodal" : "simplicial",
-                           minor)
-                        .c_str());
-            }
-            check(ok != 0, "numeric factorisation");
+    void do_factorize(const SparseSystem& a) override {
+        cholmod_sparse matrix = wrap(a);
+        const int ok = cholmod_factorize(&matrix, factor_, &common_);
+        size_t minor = factor_->minor;
+        if (ok && minor >= factor_->n && !factor_->is_super && !factor_->is_ll) {
+            // Simplicial LDL^T only stops at a zero pivot (an indefinite matrix factorises);
+            // we need positive definite, so check D: the first entry of each column of L.
+            const int* lp = static_cast<const int*>(factor_->p);
+            const double* lx = static_cast<const double*>(factor_->x);
+            for (size_t k = 0; k < factor_->n; ++k)
+                if (!(lx[lp[k]] > 0.0)) {
+                    minor = k;
+                    break;
+                }
         }
-        factorized_ = true;
-        factorize_seconds = solver_detail::now_seconds() - t0;
+        if (common_.status == CHOLMOD_NOT_POSDEF || minor < factor_->n) {
+            // minor is the failing column of the permuted matrix P A P^T; Perm maps it back.
+            const int* perm = static_cast<const int*>(factor_->Perm);
+            const int32_t column = perm && minor < factor_->n ? perm[minor] : static_cast<int32_t>(minor);
+            solver_detail::throw_not_positive_definite(
+                a, column, name(),
+                format("%s factorisation stopped at elimination step %zu", factor_->is_super ? "supernodal" : "simplicial",
+                       minor)
+                    .c_str());
+        }
+        check(ok != 0, "numeric factorisation");
     }
 
-    int solve(const SparseSystem& a, const double* b, double* x) override {
-        const double t0 = solver_detail::now_seconds();
-        solver_detail::require_analysed(a, analysed_id_, name());
-        SH_REQUIRE(factorized_, SH_ERR_INTERNAL, "cholmod: solve before a successful factorize");
+    int do_solve(const SparseSystem& a, const double* b, double* x) override {
         const size_t n = static_cast<size_t>(a.dof_count());
-        if (n > 0) {
-            // b wrapped in place; X, Y and E are kept between calls, so after the first solve
-            // cholmod_solve2 allocates nothing.
-            cholmod_dense rhs;
-            std::memset(&rhs, 0, sizeof rhs);
-            rhs.nrow = n;
-            rhs.ncol = 1;
-            rhs.nzmax = n;
-            rhs.d = n;
-            rhs.x = const_cast<double*>(b);
-            rhs.xtype = CHOLMOD_REAL;
-            rhs.dtype = CHOLMOD_DOUBLE;
-            if (work_y_ && !factor_->is_super && work_y_->nzmax >= 4 * n) {
-                // The simplicial solve asks for a 4 x n Y, then relabels it 1 x n for one right-hand
-                // side, so the next call would free and reallocate it; restore the shape it asks
-                // for (same memory, nzmax >= 4n) so Y really is reused.
-                work_y_->nrow = 4;
-                work_y_->ncol = n;
-                work_y_->d = 4;
-            }
-            const int ok = cholmod_solve2(CHOLMOD_A, factor_, &rhs, nullptr, &solution_, nullptr, &work_y_, &work_e_,
-                                          &common_);
-            check(ok != 0 && solution_ != nullptr, "solve");
-            std::memcpy(x, solution_->x, n * sizeof(double));
-            solver_detail::require_finite_solution(a, x, name());
+        // b wrapped in place; X, Y and E are kept between calls, so after the first solve
+        // cholmod_solve2 allocates nothing.
+        cholmod_dense rhs;
+        std::memset(&rhs, 0, sizeof rhs);
+        rhs.nrow = n;
+        rhs.ncol = 1;
+        rhs.nzmax = n;
+        rhs.d = n;
+        rhs.x = const_cast<double*>(b);
+        rhs.xtype = CHOLMOD_REAL;
+        rhs.dtype = CHOLMOD_DOUBLE;
+        if (work_y_ && !factor_->is_super && work_y_->nzmax >= 4 * n) {
+            // The simplicial solve asks for a 4 x n Y, then relabels it 1 x n for one right-hand
+            // side, so the next call would free and reallocate it; restore the shape it asks
+            // for (same memory, nzmax >= 4n) so Y really is reused.
+            work_y_->nrow = 4;
+            work_y_->ncol = n;
+            work_y_->d = 4;
         }
-        solve_seconds = solver_detail::now_seconds() - t0;
+        const int ok =
+            cholmod_solve2(CHOLMOD_A, factor_, &rhs, nullptr, &solution_, nullptr, &work_y_, &work_e_, &common_);
+        check(ok != 0 && solution_ != nullptr, "solve");
+        std::memcpy(x, solution_->x, n * sizeof(double));
         return 1;
     }
 
 private:
-    void set_single_ordering(int method) {
-        common_.nmethods = 1;
-        common_.method[0].ordering = method;
-        common_.postorder = 1;
-    }
-
     // The system's upper triangle as a packed, sorted, stype = 1 CHOLMOD matrix over its arrays.
     // CHOLMOD only reads an input matrix, so the const_casts are safe.
     static cholmod_sparse wrap(const SparseSystem& a) {
@@ -199,8 +154,6 @@ private:
         if (solution_) cholmod_free_dense(&solution_, &common_);
         if (work_y_) cholmod_free_dense(&work_y_, &common_);
         if (work_e_) cholmod_free_dense(&work_e_, &common_);
-        analysed_id_ = 0;
-        factorized_ = false;
     }
 
     cholmod_common common_;
@@ -208,15 +161,11 @@ private:
     cholmod_dense* solution_ = nullptr;
     cholmod_dense* work_y_ = nullptr;
     cholmod_dense* work_e_ = nullptr;
-    uint64_t analysed_id_ = 0;
-    bool factorized_ = false;
 };
 
 }  // namespace
 
-LinearSolverPtr make_cholmod_solver(CholmodMode mode, CholmodOrdering ordering) {
-    return LinearSolverPtr(create<CholmodSolver>(mode, ordering));
-}
+LinearSolverPtr make_cholmod_solver() { return LinearSolverPtr(create<CholmodSolver>()); }
 
 }  // namespace sh
 

@@ -4,10 +4,7 @@
 #include "solver/step_support.hpp"
 
 #include <algorithm>
-#include <cfloat>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 
 #if defined(__AVX512F__)
 #include <immintrin.h>
@@ -238,6 +235,17 @@ struct EulerPass {
 
 }  // namespace
 
+namespace {
+
+void roll_back(Body& body, BodyStepResult& result) {
+    restore_start_state(body);
+    result.stable = false;
+    result.status = SH_ERR_UNSTABLE;
+    result.reason = kRolledBackReason;
+}
+
+}  // namespace
+
 BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
     BodyStepResult result;
     result.dt_critical = body.critical_dt();
@@ -247,6 +255,7 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
         if (body.settings.on_unstable == SH_UNSTABLE_REJECT || !(substeps <= kMaxSubsteps)) {
             result.stable = false;
             result.rejected = true;
+            result.status = SH_ERR_UNSTABLE;
             return result;
         }
     }
@@ -280,10 +289,7 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
                 body.x[j] = body.target[j];
             }
         });
-        if (!sane) {
-            restore_start_state(body);
-            result.stable = false;
-        }
+        if (!sane) roll_back(body, result);
         return result;
     }
 
@@ -295,10 +301,7 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
 
     end_kinematic_motion(body);
 
-    if (!body_state_is_sane(body)) {
-        restore_start_state(body);
-        result.stable = false;
-    }
+    if (!body_state_is_sane(body)) roll_back(body, result);
     return result;
 }
 

@@ -4,7 +4,6 @@
 #include "solver/step_support.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -102,7 +101,7 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
     double applied_load = 0.0;  // |f_ext + m g| over the free DOFs (N)
     for (int32_t d = 0; d < dofs; ++d) {
         const size_t j = static_cast<size_t>(global[static_cast<size_t>(d)]);
-        const double load = body.external_force[j] + body.mass[j / 3] * g[j % 3];
+        const double load = body.applied_load(j, g);
         applied_load += load * load;
     }
     applied_load = std::sqrt(applied_load);
@@ -239,7 +238,7 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
     end_kinematic_motion(body);
     if (!converged) return fail(SH_ERR_NOT_CONVERGED, "Newton iterations did not reach newton_tolerance");
     if (!body_state_is_sane(body))
-        return fail(SH_ERR_UNSTABLE, "the state became non-finite or exceeded the runaway speed; rolled back");
+        return fail(SH_ERR_UNSTABLE, kRolledBackReason);
     return result;
 }
 

@@ -16,36 +16,7 @@ void LinearSolverDelete::operator()(LinearSolver* solver) const noexcept {
     deallocate(memory);
 }
 
-LinearSolverPtr make_linear_solver(LinearSolverKind kind, double cg_tolerance, int cg_max_iterations) {
-    switch (kind) {
-        case LinearSolverKind::Cholmod:
-            return make_cholmod_solver();
-        case LinearSolverKind::Ldlt:
-            return make_ldlt_solver();
-        case LinearSolverKind::ConjugateGradient:
-            // Jacobi, by measurement on raptorTetra_19409 (17340 DOF, M + h^2 K, warm start, 1e-6):
-            // IncompleteCholesky needs ~3x fewer iterations (h = 1e-3: 33 vs 114) but its set-up
-            // costs 50-130 ms and ~350k heap allocations per factorize and each iteration about
-            // twice as much, so per step Jacobi is faster where CG is usable at all (h = 1e-3:
-            // ~40 ms vs ~100 ms) and on par at h = 1e-2; Jacobi's set-up is 0.3 ms, allocation-free.
-            // Use make_cg_solver(..., IncompleteCholesky) when one preconditioner serves many solves.
-            return make_cg_solver(cg_tolerance, cg_max_iterations, CgPreconditioner::Jacobi);
-    }
-    throw Error(SH_ERR_INVALID_ARGUMENT, format("linear solver: unknown kind %d", static_cast<int>(kind)));
-}
-
-#if !SOFTHAP_WITH_CHOLMOD
-LinearSolverPtr make_cholmod_solver(CholmodMode, CholmodOrdering) {
-    throw Error(SH_ERR_UNSUPPORTED, "linear solver: CHOLMOD is not built in (SOFTHAP_WITH_CHOLMOD=OFF); "
-                                    "use the LDL^T or conjugate-gradient solver");
-}
-#endif
-
-namespace solver_detail {
-
-double now_seconds() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+namespace {
 
 void require_analysed(const SparseSystem& a, uint64_t analysed_id, const char* backend) {
     SH_REQUIRE(analysed_id != 0 && a.pattern_id() == analysed_id, SH_ERR_INTERNAL,
@@ -77,6 +48,75 @@ void require_finite_solution(const SparseSystem& a, const double* x, const char*
             throw Error(SH_ERR_SOLVER, format("%s: non-finite solution at free DOF %zu (%s): non-finite "
                                               "right-hand side or singular matrix", backend, i, dof));
         }
+}
+
+}  // namespace
+
+void LinearSolver::analyze(const SparseSystem& a) {
+    analysed_id_ = 0;
+    factorized_ = false;
+    if (a.dof_count() > 0) do_analyze(a);
+    analysed_id_ = a.pattern_id();
+}
+
+void LinearSolver::factorize(const SparseSystem& a) {
+    const double t0 = solver_detail::now_seconds();
+    require_analysed(a, analysed_id_, name());
+    factorized_ = false;
+    if (a.dof_count() > 0) {
+        require_finite_values(a, name());
+        do_factorize(a);
+    }
+    factorized_ = true;
+    factorize_seconds = solver_detail::now_seconds() - t0;
+}
+
+int LinearSolver::solve(const SparseSystem& a, const double* b, double* x) {
+    const double t0 = solver_detail::now_seconds();
+    require_analysed(a, analysed_id_, name());
+    SH_REQUIRE(factorized_, SH_ERR_INTERNAL, "%s: solve before a successful factorize", name());
+    int iterations = 0;
+    if (a.dof_count() > 0) {
+        try {
+            iterations = do_solve(a, b, x);
+        } catch (...) {  // CG out of iterations: its time still counts
+            solve_seconds = solver_detail::now_seconds() - t0;
+            throw;
+        }
+        require_finite_solution(a, x, name());
+    }
+    solve_seconds = solver_detail::now_seconds() - t0;
+    return iterations;
+}
+
+LinearSolverPtr make_linear_solver(LinearSolverKind kind, double cg_tolerance, int cg_max_iterations) {
+    switch (kind) {
+        case LinearSolverKind::Cholmod:
+            return make_cholmod_solver();
+        case LinearSolverKind::Ldlt:
+            return make_ldlt_solver();
+        case LinearSolverKind::ConjugateGradient:
+            // Jacobi, by measurement on raptorTetra_19409 (17340 DOF, M + h^2 K, warm start, 1e-6):
+            // Eigen's IncompleteCholesky needed ~3x fewer iterations (h = 1e-3: 33 vs 114) but its
+            // set-up cost 50-130 ms and ~350k heap allocations per factorize and each iteration about
+            // twice as much, so per step Jacobi was faster where CG is usable at all (h = 1e-3:
+            // ~40 ms vs ~100 ms) and on par at h = 1e-2; Jacobi's set-up is 0.3 ms, allocation-free.
+            return make_cg_solver(cg_tolerance, cg_max_iterations);
+    }
+    throw Error(SH_ERR_INVALID_ARGUMENT, format("linear solver: unknown kind %d", static_cast<int>(kind)));
+}
+
+#if !SOFTHAP_WITH_CHOLMOD
+LinearSolverPtr make_cholmod_solver() {
+    throw Error(SH_ERR_UNSUPPORTED, "linear solver: CHOLMOD is not built in (SOFTHAP_WITH_CHOLMOD=OFF); "
+                                    "use the LDL^T or conjugate-gradient solver");
+}
+#endif
+
+namespace solver_detail {
+
+double now_seconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 void throw_not_positive_definite(const SparseSystem& a, int32_t column, const char* backend, const char* detail) {

@@ -161,7 +161,6 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
 
     dof_count_ = dofs;
     element_count_ = element_count;
-    nodes_per_element_ = nodes_per_element;
     column_starts_.swap(column_starts);
     row_indices_.swap(row_indices);
     values_.swap(values);
@@ -205,37 +204,6 @@ void SparseSystem::add_diagonal(const double* diag, double scale) {
     double* v = values_.data();
     const int32_t* cs = column_starts_.data();
     for (int32_t d = 0; d < dof_count_; ++d) v[cs[d + 1] - 1] += scale * diag[d];
-}
-
-void SparseSystem::add_node_block(int32_t free_node, const double* K3, double scale) {
-    SH_REQUIRE(free_node >= 0 && free_node < free_node_count(), SH_ERR_INTERNAL,
-               "sparse system: free node %d of %d", free_node, free_node_count());
-    double* v = values_.data();
-    for (int s = 0; s < 3; ++s) {
-        const int32_t col = 3 * free_node + s;
-        // The diagonal block's rows 3J..3J+s are the last s+1 entries of column 3J+s.
-        const int32_t first = column_starts_[static_cast<size_t>(col) + 1] - (s + 1);
-        for (int r = 0; r <= s; ++r) v[first + r] += scale * K3[3 * r + s];
-    }
-}
-
-void SparseSystem::multiply(const double* x, double* y) const {
-    const int32_t* cs = column_starts_.data();
-    const int32_t* ri = row_indices_.data();
-    const double* v = values_.data();
-    // Column j touches y[i] for rows i < j (already assigned) and assigns y[j]; later columns
-    // only add to it. The diagonal is the last entry of each column.
-    for (int32_t j = 0; j < dof_count_; ++j) {
-        const int32_t diag = cs[j + 1] - 1;
-        const double xj = x[j];
-        double dot = 0.0;
-        for (int32_t p = cs[j]; p < diag; ++p) {
-            const int32_t i = ri[p];
-            dot += v[p] * x[i];
-            y[i] += v[p] * xj;
-        }
-        y[j] = dot + v[diag] * xj;
-    }
 }
 
 int32_t SparseSystem::first_nonfinite_column() const {

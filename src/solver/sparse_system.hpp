@@ -40,8 +40,6 @@ public:
     void add_element(size_t element, const double* Ke, double scale);
     /// Adds diag[d] to diagonal entry d, for d < dof_count() (lumped mass, per-DOF terms).
     void add_diagonal(const double* diag, double scale);
-    /// y = A x (full symmetric product from the upper triangle); x, y of dof_count().
-    void multiply(const double* x, double* y) const;
     const vec<int32_t>& column_starts() const { return column_starts_; }  ///< dof_count()+1
     const vec<int32_t>& row_indices() const { return row_indices_; }
     const vec<double>& values() const { return values_; }
@@ -49,21 +47,11 @@ public:
     /// Per free DOF d: the global DOF 3*node+c it stands for; and the inverse via free_index.
     const vec<int32_t>& dof_to_global() const { return dof_to_global_; }
 
-    // ---- additions -------------------------------------------------------------------------
-
-    int32_t free_node_count() const { return dof_count_ / 3; }  ///< free_count of build_pattern
-    size_t element_count() const { return element_count_; }     ///< as given to build_pattern
-    int nodes_per_element() const { return nodes_per_element_; } ///< as given to build_pattern
     /// Changes on every build_pattern (unique across systems): solvers check that the system they
     /// factorize is the one they analysed.
     uint64_t pattern_id() const { return pattern_id_; }
     /// Value slot of diagonal entry d (the last entry of column d).
     int32_t diagonal_slot(int32_t d) const { return column_starts_[static_cast<size_t>(d) + 1] - 1; }
-    /// Adds scale * K3 (3x3 row-major, symmetric; its upper part is read) to the diagonal block of
-    /// free node free_node (e.g. a contact or tool-coupling stiffness on one node).
-    void add_node_block(int32_t free_node, const double* K3, double scale);
-    /// 3x3 block records in the element scatter map (10 per tet with all nodes free).
-    size_t scatter_block_count() const { return block_records_.size(); }
     /// -1 if every value is finite, else the column of the first non-finite value.
     int32_t first_nonfinite_column() const;
     /// The node and component free DOF d stands for, for messages: "node n, component x".
@@ -72,7 +60,6 @@ public:
 private:
     int32_t dof_count_ = 0;
     size_t element_count_ = 0;
-    int nodes_per_element_ = 0;
     uint64_t pattern_id_ = 0;
     vec<int32_t> column_starts_;
     vec<int32_t> row_indices_;

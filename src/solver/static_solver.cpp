@@ -19,8 +19,7 @@ double out_of_balance(const Body& body, const ImplicitState& state, const double
     double s = 0.0;
     for (size_t d = 0; d < out.size(); ++d) {
         const size_t j = static_cast<size_t>(global[d]);
-        const double load = body.external_force[j] + body.mass[j / 3] * g[j % 3];
-        out[d] = force_scratch[j] + load_factor * load;
+        out[d] = force_scratch[j] + load_factor * body.applied_load(j, g);
         s += out[d] * out[d];
     }
     return std::sqrt(s);
@@ -31,7 +30,7 @@ double potential(const Body& body, const ImplicitState& state, const double g[3]
     double work = 0.0;
     for (const int32_t j : state.system.dof_to_global()) {
         const size_t k = static_cast<size_t>(j);
-        work += (body.external_force[k] + body.mass[k / 3] * g[k % 3]) * body.x[k];
+        work += body.applied_load(k, g) * body.x[k];
     }
     return body.elastic_energy(body.x.data()) - load_factor * work;
 }
@@ -50,9 +49,7 @@ void solve_static_body(Body& body, const double g[3], const sh_static_def& def, 
     solver.cg_tolerance = std::max(1e-3 * def.tolerance, 1e-15);  // well below the Newton tolerance
     solver.cg_max_iterations = 20000;
     const int32_t dofs = prepare_implicit_state(body, state, solver);
-    for (size_t i = 0; i < body.kinematic.size(); ++i)
-        if (body.kinematic[i])
-            for (int k = 0; k < 3; ++k) body.x[3 * i + k] = body.target[3 * i + k];
+    end_kinematic_motion(body);  // fixed and prescribed nodes on their targets
     std::fill(body.v.begin(), body.v.end(), 0.0);
     if (dofs == 0) return;
 
@@ -63,7 +60,7 @@ void solve_static_body(Body& body, const double g[3], const sh_static_def& def, 
     double load_norm = 0.0;
     for (const int32_t j : global) {
         const size_t k = static_cast<size_t>(j);
-        const double load = body.external_force[k] + body.mass[k / 3] * g[k % 3];
+        const double load = body.applied_load(k, g);
         load_norm += load * load;
     }
     load_norm = load_norm > 0.0 ? std::sqrt(load_norm) : 1.0;

@@ -22,4 +22,7 @@ void end_kinematic_motion(Body& body);
 /// True if every position is finite and no node is faster than the body's runaway speed.
 bool body_state_is_sane(const Body& body);
 
+/// Why a step that failed body_state_is_sane was undone (a BodyStepResult reason).
+constexpr const char* kRolledBackReason = "the state became non-finite or exceeded the runaway speed; rolled back";
+
 }  // namespace sh

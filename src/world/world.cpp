@@ -174,10 +174,8 @@ void World::step(double dt, sh_step_report* report) {
         throw Error(SH_ERR_UNSTABLE, format("body 0x%llx: dt = %g s exceeds its critical step %g s (policy: reject); "
                                             "%d body(ies) left unchanged",
                                             id, dt, first_failure.dt_critical, r.unstable_body_count));
-    const sh_status status = first_failure.status == SH_OK ? SH_ERR_UNSTABLE : first_failure.status;
-    const char* reason = first_failure.reason[0] ? first_failure.reason
-                                                 : "the state became non-finite or exceeded the runaway speed; rolled back";
-    throw Error(status, format("body 0x%llx: %s (%d body(ies) left as before the step)", id, reason, r.unstable_body_count));
+    throw Error(first_failure.status, format("body 0x%llx: %s (%d body(ies) left as before the step)", id,
+                                             first_failure.reason, r.unstable_body_count));
 }
 
 void World::solve_static(const sh_static_def& def, sh_static_report* report) {

@@ -44,6 +44,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "accuracy.h"
+#include "box_mesh.h"
 
 #include <softhap/softhap.h>
 
@@ -183,7 +184,8 @@ static const char* status_name(sh_status s) {
 /* The bar                                                                                      */
 
 typedef struct {
-    int nx, ny, nz, node_count, tet_count;
+    int nx, ny, nz;
+    int32_t node_count, tet_count;
     sh_mesh* mesh;
     double* rest;         /* node_count x 3 */
     int32_t* fixed;       /* nodes at x = 0 */
@@ -191,36 +193,17 @@ typedef struct {
     double* tip_weight;   /* node_count: share of a uniform tip traction (sums to 1) */
 } bar_t;
 
-/* [0,L] x [0,a] x [0,a] in nx*ny*ny cubes of 6 tets (Kuhn split along the 0-6 diagonal). */
+/* [0,L] x [0,a] x [0,a] in nx*ny*ny cubes of 6 tets (box_mesh.h). */
 static void bar_build(bar_t* b, int ny) {
     memset(b, 0, sizeof *b);
     b->ny = b->nz = ny;
     b->nx = (int)lround(kLength / kSide) * ny;
-    const int px = b->nx + 1, py = ny + 1, pz = ny + 1;
-    b->node_count = px * py * pz;
-    b->tet_count = 6 * b->nx * ny * ny;
-    b->rest = (double*)xcalloc(3 * (size_t)b->node_count, sizeof(double));
-    int32_t* tets = (int32_t*)xcalloc(4 * (size_t)b->tet_count, sizeof(int32_t));
-    for (int k = 0; k < pz; ++k)
-        for (int j = 0; j < py; ++j)
-            for (int i = 0; i < px; ++i) {
-                double* p = &b->rest[3 * (size_t)((k * py + j) * px + i)];
-                p[0] = kLength * i / b->nx;
-                p[1] = kSide * j / ny;
-                p[2] = kSide * k / ny;
-            }
-    static const int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-    int t = 0;
-    for (int k = 0; k < ny; ++k)
-        for (int j = 0; j < ny; ++j)
-            for (int i = 0; i < b->nx; ++i) {
-                const int c[8] = {(k * py + j) * px + i,           (k * py + j) * px + i + 1,
-                                  (k * py + j + 1) * px + i + 1,   (k * py + j + 1) * px + i,
-                                  ((k + 1) * py + j) * px + i,     ((k + 1) * py + j) * px + i + 1,
-                                  ((k + 1) * py + j + 1) * px + i + 1, ((k + 1) * py + j + 1) * px + i};
-                for (int s = 0; s < 6; ++s, ++t)
-                    for (int a = 0; a < 4; ++a) tets[4 * t + a] = c[kuhn[s][a]];
-            }
+    int32_t* tets = NULL;
+    sh_test_box_arrays(kLength, kSide, kSide, b->nx, ny, ny, &b->rest, &b->node_count, &tets, &b->tet_count);
+    if (!b->rest || !tets) {
+        fprintf(stderr, "softhap_bench: out of memory\n");
+        exit(1);
+    }
     CHECK(sh_mesh_create(b->rest, b->node_count, tets, b->tet_count, &b->mesh));
     free(tets);
 

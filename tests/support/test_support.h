@@ -10,6 +10,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "box_mesh.h"
+
 /** Path of a file in ../shared/meshes (tests run from the repository root). */
 #define SH_TEST_MESH(name) ("../shared/meshes/" name)
 
@@ -57,13 +59,8 @@ void sh_test_oscillator_backward_euler(double* stretch, double* velocity, double
 /** A unit right-handed tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) scaled by s, as a mesh. */
 sh_mesh* sh_test_unit_tet(double s);
 
-/** An axis-aligned box [0,lx]x[0,ly]x[0,lz] split into nx*ny*nz cubes of 6 tets each. */
+/** The box of sh_test_box_arrays (box_mesh.h) as a mesh. */
 sh_mesh* sh_test_box(double lx, double ly, double lz, int nx, int ny, int nz);
-
-/** The node and tet arrays of sh_test_box, without creating the mesh. The caller frees both
- *  (either may be NULL if allocation failed; the counts are set regardless). */
-void sh_test_box_arrays(double lx, double ly, double lz, int nx, int ny, int nz, double** out_nodes,
-                        int32_t* out_node_count, int32_t** out_tets, int32_t* out_tet_count);
 
 /** Fills def with the defaults and a stiff (E = 1 GPa, nu = 0.3) FEM body on mesh with the given
  *  material model, integrated by implicit Euler with at most 10 Newton iterations to 1e-10. */

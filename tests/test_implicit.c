@@ -145,16 +145,11 @@ static void test_factor_reuse_nonlinear(void** state) {
     (void)state;
     const double length = 0.1;
     sh_mesh* bar = sh_test_box(length, 0.01, 0.01, 10, 1, 1);
-    sh_mesh_info info;
-    assert_ok(sh_mesh_get_info(bar, &info));
-    const int n = info.node_count;
-    double* rest = malloc(sizeof(double) * 3 * n);
+    sh_test_mesh_arrays m = sh_test_mesh_arrays_of(bar);
+    const int n = m.node_count;
     double* x[2] = {malloc(sizeof(double) * 3 * n), malloc(sizeof(double) * 3 * n)};
-    assert_ok(sh_mesh_get_nodes(bar, rest, 3 * n));
     int32_t fixed[8];
-    int fixed_count = 0;
-    for (int i = 0; i < n; ++i)
-        if (rest[3 * i] < 1e-12) fixed[fixed_count++] = i;
+    const int fixed_count = sh_test_nodes_at(m.nodes, n, 0, 0.0, fixed);
     uint8_t* is_fixed = calloc((size_t)n, 1);
     for (int k = 0; k < fixed_count; ++k) is_fixed[fixed[k]] = 1;
     double* mass = malloc(sizeof(double) * n);
@@ -208,7 +203,7 @@ static void test_factor_reuse_nonlinear(void** state) {
     assert_int_equal(factorizations[0], iterations[0]);
     assert_true(factorizations[1] < iterations[1]);
     assert_true(factorizations[2] > 1 && factorizations[2] < 60);
-    free(rest);
+    sh_test_mesh_arrays_free(&m);
     free(x[0]);
     free(x[1]);
     free(is_fixed);

@@ -107,12 +107,6 @@ static sh_mesh* load_ok(const char* path) {
     return mesh;
 }
 
-static sh_mesh_info info_of(const sh_mesh* mesh) {
-    sh_mesh_info info;
-    assert_ok(sh_mesh_get_info(mesh, &info));
-    return info;
-}
-
 /* ------------------------------------------------------------------------------------------ */
 /* The shared meshes                                                                            */
 
@@ -126,7 +120,7 @@ typedef struct shared_mesh {
 static void check_shared_mesh(const shared_mesh* expected) {
     print_message("%s\n", expected->path);
     sh_mesh* mesh = load_ok(expected->path);
-    const sh_mesh_info info = info_of(mesh);
+    const sh_mesh_info info = sh_test_mesh_info(mesh);
     assert_int_equal(info.node_count, expected->nodes);
     assert_int_equal(info.tet_count, expected->tets);
     assert_int_equal(info.orphan_node_count, expected->orphans);
@@ -181,7 +175,7 @@ static const int32_t kTwoTetsTets[8] = {0, 1, 2, 3, 1, 2, 3, 4};
 static void check_two_tets(const char* path, int32_t skipped) {
     print_message("%s\n", path);
     sh_mesh* mesh = load_ok(path);
-    const sh_mesh_info info = info_of(mesh);
+    const sh_mesh_info info = sh_test_mesh_info(mesh);
     assert_int_equal(info.node_count, 6);
     assert_int_equal(info.tet_count, 2);
     assert_int_equal(info.orphan_node_count, 1);
@@ -538,7 +532,7 @@ static void test_missing_unknown_and_bad_arguments(void** state) {
 
 /* Asserts that b has a's nodes (bitwise) and tets. */
 static void assert_same_mesh(const sh_mesh* a, const sh_mesh* b) {
-    const sh_mesh_info ia = info_of(a), ib = info_of(b);
+    const sh_mesh_info ia = sh_test_mesh_info(a), ib = sh_test_mesh_info(b);
     assert_int_equal(ib.node_count, ia.node_count);
     assert_int_equal(ib.tet_count, ia.tet_count);
     assert_int_equal(ib.orphan_node_count, ia.orphan_node_count);
@@ -565,7 +559,7 @@ static void check_round_trip(const sh_mesh* mesh, const char* name) {
     assert_ok(sh_mesh_write_vtu(mesh, path));
     sh_mesh* back = load_ok(path);
     assert_same_mesh(mesh, back);
-    assert_int_equal(info_of(back).reoriented_tet_count, 0); /* written already positively oriented */
+    assert_int_equal(sh_test_mesh_info(back).reoriented_tet_count, 0); /* written already positively oriented */
     assert_ok(sh_mesh_destroy(back));
 }
 

@@ -25,24 +25,6 @@ static void expect_create(const double* nodes, int32_t node_count, const int32_t
         }
 }
 
-static sh_mesh_info info_of(const sh_mesh* mesh) {
-    sh_mesh_info info;
-    assert_ok(sh_mesh_get_info(mesh, &info));
-    return info;
-}
-
-static double signed_volume(const double* p, const int32_t* t) {
-    const double* a = &p[3 * t[0]];
-    double u[3], v[3], w[3];
-    for (int k = 0; k < 3; ++k) {
-        u[k] = p[3 * t[1] + k] - a[k];
-        v[k] = p[3 * t[2] + k] - a[k];
-        w[k] = p[3 * t[3] + k] - a[k];
-    }
-    return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-            u[2] * (v[0] * w[1] - v[1] * w[0])) / 6.0;
-}
-
 /* ------------------------------------------------------------------------------------------ */
 /* Validation                                                                                   */
 
@@ -133,10 +115,10 @@ static int is_odd_permutation(const int32_t from[4], const int32_t to[4]) {
 static void test_inverted_tet_is_reoriented(void** state) {
     (void)state;
     const int32_t tets[8] = {1, 2, 3, 4, 0, 2, 1, 3}; /* tet 1 is the unit tet, inverted */
-    assert_true(signed_volume(kNodes, &tets[4]) < 0);
+    assert_true(sh_test_tet_volume(kNodes, &tets[4]) < 0);
     sh_mesh* mesh = NULL;
     assert_ok(sh_mesh_create(kNodes, 5, tets, 2, &mesh));
-    const sh_mesh_info info = info_of(mesh);
+    const sh_mesh_info info = sh_test_mesh_info(mesh);
     assert_int_equal(info.reoriented_tet_count, 1);
     assert_close(info.volume, 1.0 / 6.0 + 1.0 / 3.0, 1e-15); /* tet 0 = (1,2,3,4) has volume 1/3 */
 
@@ -154,7 +136,7 @@ static void test_inverted_tet_is_reoriented(void** state) {
             }
     assert_memory_equal(sorted_out, sorted_in, sizeof sorted_in); /* same nodes */
     assert_true(is_odd_permutation(&tets[4], &out[4]));           /* an odd swap of them */
-    assert_close(signed_volume(kNodes, &out[4]), 1.0 / 6.0, 1e-15);
+    assert_close(sh_test_tet_volume(kNodes, &out[4]), 1.0 / 6.0, 1e-15);
     assert_ok(sh_mesh_destroy(mesh));
 }
 
@@ -172,28 +154,7 @@ static void test_destroyed_mesh_is_an_invalid_handle(void** state) {
 /* ------------------------------------------------------------------------------------------ */
 /* Surface and edges                                                                            */
 
-typedef struct surface {
-    double* nodes;
-    int32_t* triangles;
-    int32_t triangle_count, node_count;
-} surface;
-
-static surface surface_of(const sh_mesh* mesh) {
-    const sh_mesh_info info = info_of(mesh);
-    surface s;
-    s.node_count = info.node_count;
-    s.triangle_count = info.surface_triangle_count;
-    s.nodes = malloc(sizeof(double) * 3 * (size_t)info.node_count);
-    s.triangles = malloc(sizeof(int32_t) * 3 * (size_t)info.surface_triangle_count);
-    assert_ok(sh_mesh_get_nodes(mesh, s.nodes, 3 * (int64_t)info.node_count));
-    assert_ok(sh_mesh_get_surface_triangles(mesh, s.triangles, 3 * (int64_t)info.surface_triangle_count));
-    return s;
-}
-
-static void free_surface(surface* s) {
-    free(s->nodes);
-    free(s->triangles);
-}
+typedef sh_test_mesh_arrays surface;
 
 /* Divergence theorem with F = x/3: volume = sum over outward triangles of p0 . (p1-p0)x(p2-p0) / 6. */
 static double enclosed_volume(const surface* s) {
@@ -237,13 +198,13 @@ static void assert_closed_oriented_manifold(const surface* s) {
 static void test_surface_of_unit_tet(void** state) {
     (void)state;
     sh_mesh* mesh = sh_test_unit_tet(2.0);
-    const sh_mesh_info info = info_of(mesh);
+    const sh_mesh_info info = sh_test_mesh_info(mesh);
     assert_int_equal(info.surface_triangle_count, 4);
     assert_int_equal(info.edge_count, 6);
-    surface s = surface_of(mesh);
+    surface s = sh_test_mesh_arrays_of(mesh);
     assert_closed_oriented_manifold(&s);
     assert_close(enclosed_volume(&s), 8.0 / 6.0, 1e-14);
-    free_surface(&s);
+    sh_test_mesh_arrays_free(&s);
     assert_ok(sh_mesh_destroy(mesh));
 }
 
@@ -258,7 +219,7 @@ static int32_t box_edges(int nx, int ny, int nz) {
 static void test_kuhn_cube_counts(void** state) {
     (void)state;
     sh_mesh* mesh = sh_test_box(1, 1, 1, 1, 1, 1);
-    const sh_mesh_info info = info_of(mesh);
+    const sh_mesh_info info = sh_test_mesh_info(mesh);
     assert_int_equal(info.node_count, 8);
     assert_int_equal(info.tet_count, 6);
     assert_int_equal(info.surface_triangle_count, 12);
@@ -273,7 +234,7 @@ static void test_surface_and_edges_of_box(void** state) {
     const int nx = 2, ny = 3, nz = 4;
     const double lx = 1.5, ly = 2.0, lz = 0.5;
     sh_mesh* mesh = sh_test_box(lx, ly, lz, nx, ny, nz);
-    const sh_mesh_info info = info_of(mesh);
+    const sh_mesh_info info = sh_test_mesh_info(mesh);
     assert_int_equal(info.node_count, (nx + 1) * (ny + 1) * (nz + 1));
     assert_int_equal(info.tet_count, 6 * nx * ny * nz);
     assert_int_equal(info.surface_triangle_count, 2 * 2 * (nx * ny + ny * nz + nx * nz));
@@ -287,10 +248,10 @@ static void test_surface_and_edges_of_box(void** state) {
     assert_close(info.bounds_max[1], ly, 1e-15);
     assert_close(info.bounds_max[2], lz, 1e-15);
 
-    surface s = surface_of(mesh);
+    surface s = sh_test_mesh_arrays_of(mesh);
     assert_closed_oriented_manifold(&s);
     assert_close(enclosed_volume(&s), lx * ly * lz, 1e-13);
-    free_surface(&s);
+    sh_test_mesh_arrays_free(&s);
 
     /* Edges: (smaller, larger), strictly increasing, and every tet edge among them. */
     int32_t* edges = malloc(sizeof(int32_t) * 2 * (size_t)info.edge_count);
@@ -322,11 +283,11 @@ static void check_organ_surface(const char* path, double expected_volume) {
     print_message("%s\n", path);
     sh_mesh* mesh = NULL;
     assert_ok(sh_mesh_load(path, &mesh));
-    surface s = surface_of(mesh);
+    surface s = sh_test_mesh_arrays_of(mesh);
     assert_closed_oriented_manifold(&s);
-    assert_close(enclosed_volume(&s), info_of(mesh).volume, 1e-10);
-    assert_close(info_of(mesh).volume, expected_volume, 1e-10);
-    free_surface(&s);
+    assert_close(enclosed_volume(&s), sh_test_mesh_info(mesh).volume, 1e-10);
+    assert_close(sh_test_mesh_info(mesh).volume, expected_volume, 1e-10);
+    sh_test_mesh_arrays_free(&s);
     assert_ok(sh_mesh_destroy(mesh));
 }
 
@@ -341,7 +302,7 @@ static void check_orphans(const char* path, int32_t expected) {
     print_message("%s\n", path);
     sh_mesh* mesh = NULL;
     assert_ok(sh_mesh_load(path, &mesh));
-    const sh_mesh_info info = info_of(mesh);
+    const sh_mesh_info info = sh_test_mesh_info(mesh);
     assert_int_equal(info.orphan_node_count, expected);
     int32_t* tets = malloc(sizeof(int32_t) * 4 * (size_t)info.tet_count);
     char* used = calloc((size_t)info.node_count, 1);
@@ -350,10 +311,10 @@ static void check_orphans(const char* path, int32_t expected) {
     int32_t unused = 0;
     for (int32_t n = 0; n < info.node_count; ++n) unused += !used[n];
     assert_int_equal(unused, expected);
-    surface s = surface_of(mesh);
+    surface s = sh_test_mesh_arrays_of(mesh);
     for (int32_t i = 0; i < 3 * s.triangle_count; ++i) assert_true(used[s.triangles[i]]);
     assert_close(enclosed_volume(&s), info.volume, 1e-10);
-    free_surface(&s);
+    sh_test_mesh_arrays_free(&s);
     free(used);
     free(tets);
     assert_ok(sh_mesh_destroy(mesh));

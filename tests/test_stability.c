@@ -34,47 +34,13 @@
 static double seconds_since(clock_t start) { return (double)(clock() - start) / CLOCKS_PER_SEC; }
 
 /* Rest nodes and tets of a mesh. */
-typedef struct {
-    int n, tet_count;
-    double* rest;
-    int32_t* tets;
-} mesh_data;
-
-static mesh_data mesh_data_of(const sh_mesh* mesh) {
-    sh_mesh_info info;
-    assert_ok(sh_mesh_get_info(mesh, &info));
-    mesh_data m;
-    m.n = info.node_count;
-    m.tet_count = info.tet_count;
-    m.rest = malloc(sizeof(double) * 3 * (size_t)m.n);
-    m.tets = malloc(sizeof(int32_t) * 4 * (size_t)m.tet_count);
-    assert_ok(sh_mesh_get_nodes(mesh, m.rest, 3 * (int64_t)m.n));
-    assert_ok(sh_mesh_get_tets(mesh, m.tets, 4 * (int64_t)m.tet_count));
-    return m;
-}
-
-static void mesh_data_free(mesh_data* m) {
-    free(m->rest);
-    free(m->tets);
-}
-
-/* Signed volume of a tet: det[x1 - x0, x2 - x0, x3 - x0] / 6. */
-static double tet_volume(const double* x, const int32_t* t) {
-    const double* p0 = &x[3 * t[0]];
-    double a[3], b[3], c[3];
-    for (int k = 0; k < 3; ++k) {
-        a[k] = x[3 * t[1] + k] - p0[k];
-        b[k] = x[3 * t[2] + k] - p0[k];
-        c[k] = x[3 * t[3] + k] - p0[k];
-    }
-    return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
-}
+typedef sh_test_mesh_arrays mesh_data;
 
 /* Smallest det F = V / V0 over the tets (V0 from the rest positions). */
 static double min_det_f(const mesh_data* m, const double* x) {
     double lowest = INFINITY;
     for (int t = 0; t < m->tet_count; ++t) {
-        const double j = tet_volume(x, &m->tets[4 * t]) / tet_volume(m->rest, &m->tets[4 * t]);
+        const double j = sh_test_tet_volume(x, &m->tets[4 * t]) / sh_test_tet_volume(m->nodes, &m->tets[4 * t]);
         lowest = j < lowest ? j : lowest;
     }
     return lowest;
@@ -95,10 +61,7 @@ static double max_displacement(const double* x, const double* rest, int n) {
 
 /* Nodes whose coordinate `axis` equals value (to 1e-12 m); returns their count. */
 static int nodes_at(const mesh_data* m, int axis, double value, int32_t* out) {
-    int count = 0;
-    for (int i = 0; i < m->n; ++i)
-        if (fabs(m->rest[3 * i + axis] - value) < 1e-12) out[count++] = i;
-    return count;
+    return sh_test_nodes_at(m->nodes, m->node_count, axis, value, out);
 }
 
 static double total_energy(const sh_step_report* r) { return r->kinetic_energy + r->elastic_energy + r->potential_energy; }
@@ -188,13 +151,13 @@ static void test_stiff_cube_energy_never_grows(void** state) {
     const clock_t start = clock();
     const double side = 0.05;
     sh_mesh* cube = sh_test_box(side, side, side, 3, 3, 3);
-    mesh_data m = mesh_data_of(cube);
+    mesh_data m = sh_test_mesh_arrays_of(cube);
     int32_t bottom[16], top[16];
     const int nb = nodes_at(&m, 2, 0.0, bottom), nt = nodes_at(&m, 2, side, top);
     assert_int_equal(nb, 16);
     assert_int_equal(nt, 16);
     double targets[48];
-    double* x = malloc(sizeof(double) * 3 * (size_t)m.n);
+    double* x = malloc(sizeof(double) * 3 * (size_t)m.node_count);
     for (int model = 0; model < 4; ++model) {
         sh_world* world = sh_test_world(-9.81);
         sh_fem_body_def def;
@@ -217,7 +180,7 @@ static void test_stiff_cube_energy_never_grows(void** state) {
         for (int s = 1; s <= 30; ++s) {
             const double press = 0.01 * side * (s < 10 ? s : 10) / 10.0;
             for (int k = 0; k < nt; ++k) {
-                for (int c = 0; c < 3; ++c) targets[3 * k + c] = m.rest[3 * top[k] + c];
+                for (int c = 0; c < 3; ++c) targets[3 * k + c] = m.nodes[3 * top[k] + c];
                 targets[3 * k + 2] -= press;
             }
             assert_ok(sh_body_prescribe_positions(world, body, top, targets, nt));
@@ -238,9 +201,9 @@ static void test_stiff_cube_energy_never_grows(void** state) {
                 print_message("%s step %d after release: energy %.17g -> %.17g\n", model_name((sh_material_model)model), s, previous, total);
             assert_true(total <= previous + 1e-10 * fabs(previous));
             previous = total;
-            assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.n));
-            assert_true(all_finite(x, 3 * m.n));
-            for (int i = 0; i < 3 * m.n; ++i) assert_true(x[i] >= -0.02 * side && x[i] <= 1.02 * side);
+            assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.node_count));
+            assert_true(all_finite(x, 3 * m.node_count));
+            for (int i = 0; i < 3 * m.node_count; ++i) assert_true(x[i] >= -0.02 * side && x[i] <= 1.02 * side);
         }
         assert_true(previous < released);
         print_message("stiff cube, %-12s: elastic energy at release %.4g J, total %.6g -> %.6g J, largest step change %+.2e "
@@ -249,7 +212,7 @@ static void test_stiff_cube_energy_never_grows(void** state) {
         assert_ok(sh_world_destroy(world));
     }
     free(x);
-    mesh_data_free(&m);
+    sh_test_mesh_arrays_free(&m);
     assert_ok(sh_mesh_destroy(cube));
     print_message("stiff cube: %.2f s\n", seconds_since(start));
 }
@@ -269,10 +232,10 @@ static void test_near_incompressible(void** state) {
     const clock_t start = clock();
     const double length = 0.1, side = 0.02;
     sh_mesh* bar = sh_test_box(length, side, side, 5, 1, 1);
-    mesh_data m = mesh_data_of(bar);
+    mesh_data m = sh_test_mesh_arrays_of(bar);
     int32_t root[4], tip[4];
     const int nr = nodes_at(&m, 0, 0.0, root), ntip = nodes_at(&m, 0, length, tip);
-    double* x = malloc(sizeof(double) * 3 * (size_t)m.n);
+    double* x = malloc(sizeof(double) * 3 * (size_t)m.node_count);
     const double poissons[3] = {0.3, 0.49, 0.499};
     const sh_material_model models[2] = {SH_MATERIAL_LINEAR, SH_MATERIAL_NEOHOOKEAN};
     const sh_integrator integrators[2] = {SH_INTEGRATOR_SYMPLECTIC_EULER, SH_INTEGRATOR_IMPLICIT_EULER};
@@ -301,13 +264,13 @@ static void test_near_incompressible(void** state) {
                     assert_ok(sh_world_step(world, 1e-3, &report));
                     assert_true(isfinite(total_energy(&report)));
                     most_substeps = report.substeps > most_substeps ? report.substeps : most_substeps;
-                    assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.n));
-                    assert_true(all_finite(x, 3 * m.n));
-                    assert_true(max_displacement(x, m.rest, m.n) <= 0.5 * length);
+                    assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.node_count));
+                    assert_true(all_finite(x, 3 * m.node_count));
+                    assert_true(max_displacement(x, m.nodes, m.node_count) <= 0.5 * length);
                 }
                 if (integrators[ii] == SH_INTEGRATOR_SYMPLECTIC_EULER) assert_true(most_substeps > 1);
                 double sag = 0.0;
-                for (int k = 0; k < ntip; ++k) sag += (m.rest[3 * tip[k] + 2] - x[3 * tip[k] + 2]) / ntip;
+                for (int k = 0; k < ntip; ++k) sag += (m.nodes[3 * tip[k] + 2] - x[3 * tip[k] + 2]) / ntip;
                 assert_true(sag > 0.0);
                 assert_ok(sh_world_get_warnings(world, warnings));
                 assert_int_equal(warnings[SH_WARN_LOCKING], poissons[pi] > 0.45 ? 1 : 0);
@@ -340,7 +303,7 @@ static void test_near_incompressible(void** state) {
     assert_ok(sh_world_destroy(world));
 
     free(x);
-    mesh_data_free(&m);
+    sh_test_mesh_arrays_free(&m);
     assert_ok(sh_mesh_destroy(bar));
     print_message("near-incompressible: %.2f s\n", seconds_since(start));
 }
@@ -377,7 +340,7 @@ static double max_speed(sh_world* world, sh_body_id body, int n) {
 static deformation_result deform_block(sh_material_model model, double ratio) {
     const double side = 0.02, dt = 2e-3;
     sh_mesh* block = sh_test_box(side, side, side, 3, 3, 3);
-    mesh_data m = mesh_data_of(block);
+    mesh_data m = sh_test_mesh_arrays_of(block);
     int32_t bottom[16], top[16];
     const int nb = nodes_at(&m, 2, 0.0, bottom), nt = nodes_at(&m, 2, side, top);
     sh_world* world = sh_test_world(0.0);
@@ -394,7 +357,7 @@ static deformation_result deform_block(sh_material_model model, double ratio) {
     sh_body_id body;
     assert_ok(sh_world_add_fem_body(world, &def, &body));
     assert_ok(sh_body_fix_nodes(world, body, bottom, nb));
-    double* x = malloc(sizeof(double) * 3 * (size_t)m.n);
+    double* x = malloc(sizeof(double) * 3 * (size_t)m.node_count);
     double targets[48];
     deformation_result r = {0, 0, 0, INFINITY, INFINITY, 0.0, 0.0};
     const int ramp = 40, hold = 20, free_steps = 400;
@@ -402,33 +365,33 @@ static deformation_result deform_block(sh_material_model model, double ratio) {
         if (s <= ramp) {
             const double h = side * (1.0 + (ratio - 1.0) * s / ramp);
             for (int k = 0; k < nt; ++k) {
-                for (int c = 0; c < 2; ++c) targets[3 * k + c] = m.rest[3 * top[k] + c];
+                for (int c = 0; c < 2; ++c) targets[3 * k + c] = m.nodes[3 * top[k] + c];
                 targets[3 * k + 2] = h;
             }
             assert_ok(sh_body_prescribe_positions(world, body, top, targets, nt));
         }
         if (s == ramp + hold + 1) assert_ok(sh_body_release_nodes(world, body, top, nt));
         sh_step_report report;
-        if (step_guarded(world, body, m.n, dt, &report) != SH_OK) {
+        if (step_guarded(world, body, m.node_count, dt, &report) != SH_OK) {
             ++r.failed_steps;
             /* After the release nothing changes between steps: a rolled-back step would fail
              * again at every later step. */
             if (s > ramp + hold) break;
         }
-        assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.n));
+        assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.node_count));
         if (s <= ramp + hold) r.min_det_loaded = fmin(r.min_det_loaded, min_det_f(&m, x));
         if (s == ramp + hold) r.height_loaded = x[3 * top[0] + 2] / side;
         if (s > ramp + hold) {
             r.released_steps = s - ramp - hold;
-            r.at_rest = max_speed(world, body, m.n) < kRestSpeed;
+            r.at_rest = max_speed(world, body, m.node_count) < kRestSpeed;
             if (r.at_rest) break;
         }
     }
     r.min_det_final = min_det_f(&m, x);
-    r.final_error = max_displacement(x, m.rest, m.n) / side;
+    r.final_error = max_displacement(x, m.nodes, m.node_count) / side;
     free(x);
     assert_ok(sh_world_destroy(world));
-    mesh_data_free(&m);
+    sh_test_mesh_arrays_free(&m);
     assert_ok(sh_mesh_destroy(block));
     return r;
 }
@@ -479,10 +442,10 @@ static void test_large_deformation_static(void** state) {
     const int increments[2] = {40, 20};
     const sh_material_model models[2] = {SH_MATERIAL_NEOHOOKEAN, SH_MATERIAL_COROTATIONAL};
     sh_mesh* block = sh_test_box(side, side, side, 3, 3, 3);
-    mesh_data m = mesh_data_of(block);
+    mesh_data m = sh_test_mesh_arrays_of(block);
     int32_t bottom[16], top[16];
     const int nb = nodes_at(&m, 2, 0.0, bottom), nt = nodes_at(&m, 2, side, top);
-    double* x = malloc(sizeof(double) * 3 * (size_t)m.n);
+    double* x = malloc(sizeof(double) * 3 * (size_t)m.node_count);
     double targets[48];
     for (int mi = 0; mi < 2; ++mi)
         for (int ri = 0; ri < 2; ++ri) {
@@ -506,22 +469,22 @@ static void test_large_deformation_static(void** state) {
             for (int k = 1; k <= increments[ri]; ++k) {
                 const double h = side * (1.0 + (ratios[ri] - 1.0) * k / increments[ri]);
                 for (int a = 0; a < nt; ++a) {
-                    for (int c = 0; c < 2; ++c) targets[3 * a + c] = m.rest[3 * top[a] + c];
+                    for (int c = 0; c < 2; ++c) targets[3 * a + c] = m.nodes[3 * top[a] + c];
                     targets[3 * a + 2] = h;
                 }
                 assert_ok(sh_body_prescribe_positions(world, body, top, targets, nt));
                 assert_ok(sh_world_solve_static(world, &sdef, &report));
                 assert_true(report.converged);
                 most_iterations = report.iterations > most_iterations ? report.iterations : most_iterations;
-                assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.n));
-                assert_true(all_finite(x, 3 * m.n));
+                assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.node_count));
+                assert_true(all_finite(x, 3 * m.node_count));
                 min_det_loaded = fmin(min_det_loaded, min_det_f(&m, x));
             }
             assert_close(x[3 * top[0] + 2] / side, ratios[ri], 1e-12);
             assert_ok(sh_body_release_nodes(world, body, top, nt));
             assert_ok(sh_world_solve_static(world, &sdef, &report));
-            assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.n));
-            const double error = max_displacement(x, m.rest, m.n) / side, det = min_det_f(&m, x);
+            assert_ok(sh_body_get_positions(world, body, x, 3 * (int64_t)m.node_count));
+            const double error = max_displacement(x, m.nodes, m.node_count) / side, det = min_det_f(&m, x);
             print_message("static block %-12s to %3.0f %%: at most %d iterations per increment, min det F loaded %+.4f; "
                           "released in %d iterations: min det F %.6f, max |x - X| / H %.2e\n",
                           model_name(models[mi]), 100 * ratios[ri], most_iterations, min_det_loaded, report.iterations,
@@ -531,7 +494,7 @@ static void test_large_deformation_static(void** state) {
             assert_ok(sh_world_destroy(world));
         }
     free(x);
-    mesh_data_free(&m);
+    sh_test_mesh_arrays_free(&m);
     assert_ok(sh_mesh_destroy(block));
     print_message("large deformation, static: %.2f s\n", seconds_since(start));
 }
@@ -574,7 +537,7 @@ static const int32_t kUnitTet[4] = {0, 1, 2, 3};
 static double unit_tet_det(sh_world* world, sh_body_id body) {
     double x[12];
     assert_ok(sh_body_get_positions(world, body, x, 12));
-    return tet_volume(x, kUnitTet) / (kTetSize * kTetSize * kTetSize / 6.0);
+    return sh_test_tet_volume(x, kUnitTet) / (kTetSize * kTetSize * kTetSize / 6.0);
 }
 
 /* Released from det F = -0.5 and stepped 1 ms at a time, with symplectic Euler and RK4
@@ -1005,8 +968,8 @@ static void test_critical_step(void** state) {
     const int cells[2][3] = {{5, 1, 1}, {8, 2, 2}};
     for (int b = 0; b < 2; ++b) {
         sh_mesh* bar = sh_test_box(0.1, 0.02, 0.02, cells[b][0], cells[b][1], cells[b][2]);
-        mesh_data m = mesh_data_of(bar);
-        const int n = m.n, dofs = 3 * n;
+        mesh_data m = sh_test_mesh_arrays_of(bar);
+        const int n = m.node_count, dofs = 3 * n;
         sh_world* world = sh_test_world(0.0);
         const sh_body_id probe = add_bar_body(world, bar, SH_INTEGRATOR_SYMPLECTIC_EULER, SH_MATERIAL_LINEAR);
         double* mass = malloc(sizeof(double) * (size_t)n);
@@ -1019,7 +982,7 @@ static void test_critical_step(void** state) {
         double* fm = malloc(sizeof(double) * (size_t)dofs);
         const double eps = 1e-6;
         for (int j = 0; j < dofs; ++j) {
-            memcpy(x, m.rest, sizeof(double) * (size_t)dofs);
+            memcpy(x, m.nodes, sizeof(double) * (size_t)dofs);
             x[j] += eps;
             assert_ok(sh_body_set_positions(world, probe, x, n));
             assert_ok(sh_body_get_elastic_forces(world, probe, fp, dofs));
@@ -1079,7 +1042,7 @@ static void test_critical_step(void** state) {
                 assert_ok(sh_world_remove_body(one, other));
             }
             /* One step on the highest mode. */
-            for (int i = 0; i < dofs; ++i) x[i] = m.rest[i] + u[i];
+            for (int i = 0; i < dofs; ++i) x[i] = m.nodes[i] + u[i];
             assert_ok(sh_body_set_positions(one, body, x, n));
             double e0;
             assert_ok(sh_body_get_elastic_energy(one, body, &e0));
@@ -1121,7 +1084,7 @@ static void test_critical_step(void** state) {
             double* v = malloc(sizeof(double) * (size_t)dofs);
             unsigned seed = 12345u;
             for (int i = 0; i < dofs; ++i) {
-                x[i] = m.rest[i] + u[i];
+                x[i] = m.nodes[i] + u[i];
                 seed = seed * 1103515245u + 12345u;
                 v[i] = 0.1 * 1e-5 * w_max * (((seed >> 8) & 0xffff) / 32768.0 - 1.0);
             }
@@ -1168,7 +1131,7 @@ static void test_critical_step(void** state) {
         free(fm);
         free(mass);
         assert_ok(sh_world_destroy(world));
-        mesh_data_free(&m);
+        sh_test_mesh_arrays_free(&m);
         assert_ok(sh_mesh_destroy(bar));
     }
     print_message("critical step: %.2f s\n", seconds_since(start));

@@ -37,9 +37,7 @@ static bar make_bar(sh_material_model model, double traction) {
     b.rest = malloc(sizeof(double) * 3 * b.n);
     assert_ok(sh_mesh_get_nodes(b.mesh, b.rest, 3 * b.n));
     int32_t* fixed = malloc(sizeof(int32_t) * b.n);
-    int fixed_count = 0;
-    for (int i = 0; i < b.n; ++i)
-        if (b.rest[3 * i] < 1e-12) fixed[fixed_count++] = i;
+    const int fixed_count = sh_test_nodes_at(b.rest, b.n, 0, 0.0, fixed);
     assert_ok(sh_body_fix_nodes(b.world, b.body, fixed, fixed_count));
     free(fixed);
 

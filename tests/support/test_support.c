@@ -90,6 +90,55 @@ sh_mesh* sh_test_unit_tet(double s) {
     return mesh;
 }
 
+sh_mesh_info sh_test_mesh_info(const sh_mesh* mesh) {
+    sh_mesh_info info;
+    sh_test_assert_status(sh_mesh_get_info(mesh, &info), SH_OK, "sh_mesh_get_info", __FILE__, __LINE__);
+    return info;
+}
+
+sh_test_mesh_arrays sh_test_mesh_arrays_of(const sh_mesh* mesh) {
+    sh_test_mesh_arrays m;
+    m.info = sh_test_mesh_info(mesh);
+    m.node_count = m.info.node_count;
+    m.tet_count = m.info.tet_count;
+    m.triangle_count = m.info.surface_triangle_count;
+    m.nodes = malloc(sizeof(double) * 3 * (size_t)m.node_count);
+    m.tets = malloc(sizeof(int32_t) * 4 * (size_t)m.tet_count);
+    m.triangles = malloc(sizeof(int32_t) * 3 * (size_t)m.triangle_count + 1);
+    sh_test_assert_status(sh_mesh_get_nodes(mesh, m.nodes, 3 * (int64_t)m.node_count), SH_OK, "sh_mesh_get_nodes",
+                          __FILE__, __LINE__);
+    sh_test_assert_status(sh_mesh_get_tets(mesh, m.tets, 4 * (int64_t)m.tet_count), SH_OK, "sh_mesh_get_tets",
+                          __FILE__, __LINE__);
+    sh_test_assert_status(sh_mesh_get_surface_triangles(mesh, m.triangles, 3 * (int64_t)m.triangle_count), SH_OK,
+                          "sh_mesh_get_surface_triangles", __FILE__, __LINE__);
+    return m;
+}
+
+void sh_test_mesh_arrays_free(sh_test_mesh_arrays* m) {
+    free(m->nodes);
+    free(m->tets);
+    free(m->triangles);
+}
+
+double sh_test_tet_volume(const double* nodes, const int32_t* tet) {
+    const double* p0 = &nodes[3 * tet[0]];
+    double a[3], b[3], c[3];
+    for (int k = 0; k < 3; ++k) {
+        a[k] = nodes[3 * tet[1] + k] - p0[k];
+        b[k] = nodes[3 * tet[2] + k] - p0[k];
+        c[k] = nodes[3 * tet[3] + k] - p0[k];
+    }
+    return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])) /
+           6.0;
+}
+
+int sh_test_nodes_at(const double* nodes, int node_count, int axis, double value, int32_t* out) {
+    int count = 0;
+    for (int i = 0; i < node_count; ++i)
+        if (fabs(nodes[3 * i + axis] - value) < 1e-12) out[count++] = i;
+    return count;
+}
+
 sh_mesh* sh_test_box(double lx, double ly, double lz, int nx, int ny, int nz) {
     double* nodes;
     int32_t* tets;

@@ -59,6 +59,28 @@ void sh_test_oscillator_backward_euler(double* stretch, double* velocity, double
 /** A unit right-handed tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) scaled by s, as a mesh. */
 sh_mesh* sh_test_unit_tet(double s);
 
+/** A mesh's info and arrays, read through the public getters; free with
+ *  sh_test_mesh_arrays_free. */
+typedef struct sh_test_mesh_arrays {
+    sh_mesh_info info;
+    int32_t node_count, tet_count, triangle_count; /**< copies of the info's counts */
+    double* nodes;                                 /**< node_count x 3 */
+    int32_t* tets;                                 /**< tet_count x 4 */
+    int32_t* triangles;                            /**< triangle_count x 3, outward surface */
+} sh_test_mesh_arrays;
+sh_test_mesh_arrays sh_test_mesh_arrays_of(const sh_mesh* mesh);
+void sh_test_mesh_arrays_free(sh_test_mesh_arrays* m);
+
+/** sh_mesh_get_info, asserted to succeed. */
+sh_mesh_info sh_test_mesh_info(const sh_mesh* mesh);
+
+/** Signed volume of tet (4 node indices) over nodes (x3): positive when right-handed. */
+double sh_test_tet_volume(const double* nodes, const int32_t* tet);
+
+/** Nodes among nodes[node_count x 3] whose coordinate axis equals value (to 1e-12 m), written
+ *  to out; returns their count. */
+int sh_test_nodes_at(const double* nodes, int node_count, int axis, double value, int32_t* out);
+
 /** The box of sh_test_box_arrays (box_mesh.h) as a mesh. */
 sh_mesh* sh_test_box(double lx, double ly, double lz, int nx, int ny, int nz);
 

@@ -8,15 +8,9 @@ import pytest
 
 import softhap
 
-G = 9.81
-UNIT_TET = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+from textbook import G, UNIT_TET, lame, linear_tet_stiffness
+
 MODELS = ["linear", "stvk", "corotational", "neohookean"]
-
-
-def lame(young, poisson):
-    lam = young * poisson / ((1 + poisson) * (1 - 2 * poisson))
-    mu = young / (2 * (1 + poisson))
-    return lam, mu
 
 
 def unit_tet_mesh(scale=1.0):
@@ -360,24 +354,11 @@ def test_critical_dt_scales_with_size_and_wave_speed():
 
 
 def linear_tet_frequency_max(nodes, young, poisson, density):
-    """Largest natural frequency (rad/s) of one linear tetrahedron with lumped mass, from the
-    textbook stiffness K = V B^T D B (B: 6 x 12 strain-displacement matrix with engineering
-    shear strains, D: isotropic Voigt elasticity) and M = rho V / 4 per node."""
-    lam, mu = lame(young, poisson)
-    dm = (nodes[1:] - nodes[0]).T
-    volume = abs(np.linalg.det(dm)) / 6.0
-    grads = np.linalg.inv(dm)  # row a-1 is the gradient of the shape function of node a
-    grads = np.vstack([-grads.sum(axis=0), grads])
-    b = np.zeros((6, 12))
-    for a, (gx, gy, gz) in enumerate(grads):
-        b[:, 3 * a:3 * a + 3] = [[gx, 0, 0], [0, gy, 0], [0, 0, gz], [gy, gx, 0], [0, gz, gy], [gz, 0, gx]]
-    d = np.zeros((6, 6))
-    d[:3, :3] = lam
-    d[:3, :3] += 2 * mu * np.eye(3)
-    d[3:, 3:] = mu * np.eye(3)
-    k = volume * b.T @ d @ b
-    m = density * volume / 4.0
-    return math.sqrt(np.linalg.eigvalsh(k / m).max())
+    """Largest natural frequency (rad/s) of one linear tetrahedron with the textbook stiffness
+    and lumped mass rho V / 4 per node."""
+    volume = abs(np.linalg.det((nodes[1:] - nodes[0]).T)) / 6.0
+    k = linear_tet_stiffness(nodes, young, poisson)
+    return math.sqrt(np.linalg.eigvalsh(k / (density * volume / 4.0)).max())
 
 
 @pytest.mark.parametrize("scale", [1.0, 0.05])

@@ -8,26 +8,7 @@ import pytest
 
 import softhap
 
-G = 9.81
-UNIT_TET = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
-
-
-def linear_tet_stiffness(nodes, young, poisson):
-    """Textbook K = V B^T D B (12 x 12) of one linear tetrahedron."""
-    lam = young * poisson / ((1 + poisson) * (1 - 2 * poisson))
-    mu = young / (2 * (1 + poisson))
-    dm = (nodes[1:] - nodes[0]).T
-    volume = abs(np.linalg.det(dm)) / 6.0
-    grads = np.linalg.inv(dm)
-    grads = np.vstack([-grads.sum(axis=0), grads])
-    b = np.zeros((6, 12))
-    for a, (gx, gy, gz) in enumerate(grads):
-        b[:, 3 * a:3 * a + 3] = [[gx, 0, 0], [0, gy, 0], [0, 0, gz], [gy, gx, 0], [0, gz, gy], [gz, 0, gx]]
-    d = np.zeros((6, 6))
-    d[:3, :3] = lam
-    d[:3, :3] += 2 * mu * np.eye(3)
-    d[3:, 3:] = mu * np.eye(3)
-    return volume * b.T @ d @ b
+from textbook import G, UNIT_TET, linear_tet_stiffness
 
 
 # ------------------------------------------------------------------------------------------

@@ -9,7 +9,7 @@ import pytest
 
 import softhap
 
-G = 9.81
+from textbook import G
 
 
 def particle(world, z0=2.0, mass=1e-3, **kwargs):

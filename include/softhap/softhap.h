@@ -252,7 +252,9 @@ typedef struct sh_step_report {
  *  (dt above its critical step under SH_UNSTABLE_REJECT) or whose state became non-finite or
  *  runaway is restored to its state before the call; the call then returns SH_ERR_UNSTABLE,
  *  the other bodies still advance, and SH_WARN_UNSTABLE is counted. report may be NULL.
- *  Thread: sim. Alloc: none once the scene is built. */
+ *  Thread: sim. Alloc: none once the scene is built, for explicit bodies. An implicit body
+ *  builds its solver state on its first step (and after fixed nodes change), and sparse
+ *  factorisations and CG solves allocate inside CHOLMOD and Eigen, outside sh_set_allocator. */
 SH_API sh_status sh_world_step(sh_world* world, double dt, sh_step_report* report);
 
 /* ------------------------------------------------------------------------------------------ */

@@ -246,6 +246,11 @@ typedef struct sh_step_report {
                                       is about 2^p / (2^p - 1) times it. -1 when off or when a
                                       half step failed */
     double error_estimate_seconds; /**< time spent on the half steps (s), 0 when off */
+    int32_t contact_count;       /**< contact points found in this step (tools, obstacles and
+                                      body pairs), at the step's end state */
+    double collision_seconds;    /**< time in collision detection and contact forces (s) */
+    int32_t contact_substeps;    /**< sub-steps taken so that no tool moves more than half
+                                      its inner radius per sub-step (1 = none) */
 } sh_step_report;
 
 /** Advance every body by dt seconds with its own integrator. A body whose step is rejected
@@ -497,6 +502,135 @@ SH_API sh_status sh_body_get_elastic_energy(const sh_world* world, sh_body_id bo
 /** Write the body's current shape as ASCII .vtu (FEM: tets; springs: lines) with point data
  *  "velocity". Thread: sim. Alloc: may. */
 SH_API sh_status sh_body_write_vtu(const sh_world* world, sh_body_id body, const char* path);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Tools, obstacles and contact                                                                 */
+
+/** Generation-checked id of a tool or an obstacle. 0 is the null id. */
+typedef uint64_t sh_tool_id;
+
+/** Generation-checked id of a static obstacle. 0 is the null id. */
+typedef uint64_t sh_obstacle_id;
+
+/** Kinds of rigid collision shape. */
+typedef enum sh_shape_kind {
+    SH_SHAPE_SPHERE = 0,  /**< radius, centred on the pose */
+    SH_SHAPE_CAPSULE = 1, /**< radius around the segment from -half_length to +half_length on
+                               the local z axis */
+    SH_SHAPE_BOX = 2,     /**< half_extents along the local axes, centred on the pose */
+    SH_SHAPE_CONVEX = 3,  /**< the convex hull of points (local frame); needs SH_FEATURE_CCD */
+    SH_SHAPE_PLANE = 4    /**< obstacles only: the half-space behind the plane through the
+                               pose's position with outward normal `normal` (world frame) */
+} sh_shape_kind;
+
+/** A rigid shape. Only the kind's fields are read. */
+typedef struct sh_shape {
+    sh_shape_kind kind;      /**< the kind; default SH_SHAPE_SPHERE */
+    double radius;           /**< sphere, capsule: radius (m), > 0; default 5 mm */
+    double half_length;      /**< capsule: half the segment's length (m), >= 0 */
+    double half_extents[3];  /**< box: half widths along local x, y, z (m), each > 0 */
+    const double* points;    /**< convex: point_count x 3 points (m, local frame), not all in
+                                  one plane; copied at creation */
+    int32_t point_count;     /**< convex: number of points, >= 4 */
+    double normal[3];        /**< plane: outward normal (world frame, normalised at creation);
+                                  default (0, 0, 1) */
+} sh_shape;
+
+/** The nonlinear Hunt-Crossley penalty law and Coulomb friction of a contact. With
+ *  penetration depth x >= 0 (m) and its rate x' (m/s), the normal force on the body is
+ *  F = max(0, lambda x^n + mu x' x^n) with mu = 3/2 alpha lambda: never attractive and exactly 0
+ *  at x = 0; for small alpha v the restitution of an impact at speed v is about 1 - alpha v.
+ *  Friction opposes tangential sliding with at most mu_s F while sticking and mu_d F while
+ *  sliding, regularised below slip_velocity. */
+typedef struct sh_contact_params {
+    double stiffness;        /**< lambda (N/m^n) per contact point, > 0; default 1e4 */
+    double exponent;         /**< n, >= 1; default 1.5 (Hertz-like) */
+    double damping;          /**< alpha (s/m), >= 0; default 0.2 */
+    double static_friction;  /**< mu_s, >= dynamic_friction; default 0 */
+    double dynamic_friction; /**< mu_d, >= 0; default 0 */
+    double slip_velocity;    /**< tangential speed (m/s) below which friction is viscous
+                                  (sticking), > 0; default 1e-3 */
+    int32_t capacity;        /**< most contact points kept per step; beyond it the deepest are
+                                  kept and SH_WARN_CAPACITY is counted; default 4096 */
+} sh_contact_params;
+
+/** Fill contact params with defaults. Thread: any. Alloc: none. */
+SH_API void sh_contact_params_default(sh_contact_params* params);
+
+/** Definition of a tool or an obstacle. Initialise with sh_collider_def_default. */
+typedef struct sh_collider_def {
+    uint32_t internal_init;    /**< set by sh_collider_def_default; do not touch */
+    sh_shape shape;            /**< the shape; default a sphere of radius 5 mm */
+    double position[3];        /**< initial position (m, world); a plane passes through it */
+    double orientation[4];     /**< initial orientation, unit quaternion (w, x, y, z);
+                                  default (1, 0, 0, 0) */
+    sh_contact_params contact; /**< the contact law against every body */
+} sh_collider_def;
+
+/** Fill a collider def with defaults. Thread: any. Alloc: none. */
+SH_API void sh_collider_def_default(sh_collider_def* def);
+
+/** Add a rigid tool posed by the host. A world builds collision structures (surface bounding
+ *  volume hierarchies) only once it has a tool or an obstacle. A plane is not a tool
+ *  (SH_ERR_INVALID_ARGUMENT); zero-size, non-finite or flat shapes are SH_ERR_INVALID_ARGUMENT
+ *  naming the field; a convex shape without libccd is SH_ERR_UNSUPPORTED.
+ *  Thread: sim. Alloc: may. */
+SH_API sh_status sh_tool_create(sh_world* world, const sh_collider_def* def, sh_tool_id* out_tool);
+
+/** Remove a tool; its id becomes stale. Thread: sim. Alloc: none. */
+SH_API sh_status sh_tool_destroy(sh_world* world, sh_tool_id tool);
+
+/** 1 if tool is a live tool of world, else 0. Thread: sim. Alloc: none. */
+SH_API int32_t sh_tool_is_valid(const sh_world* world, sh_tool_id tool);
+
+/** Pose the tool for the next sh_world_step: the step moves it from its last pose to this
+ *  one (its velocity is the difference over dt unless set with sh_tool_set_velocity). A
+ *  non-finite position or a quaternion that is not finite or is zero is
+ *  SH_ERR_INVALID_ARGUMENT and the tool keeps its pose; the quaternion is normalised.
+ *  Thread: sim. Alloc: none. */
+SH_API sh_status sh_tool_set_pose(sh_world* world, sh_tool_id tool, const double position[3],
+                                  const double orientation[4]);
+
+/** Give the tool's velocity for the next step instead of deriving it from successive poses:
+ *  linear (m/s) of its position and angular (rad/s), world frame. Only the contact's damping
+ *  and friction see it. Thread: sim. Alloc: none. */
+SH_API sh_status sh_tool_set_velocity(sh_world* world, sh_tool_id tool, const double linear[3],
+                                      const double angular[3]);
+
+/** Contact state of a tool or obstacle after the last step. */
+typedef struct sh_contact_state {
+    double force[3];            /**< reaction force on the tool/obstacle (N, world frame) */
+    double torque[3];           /**< reaction torque about its position (N m, world frame) */
+    int32_t contact_count;      /**< contact points in the last step */
+    double max_depth;           /**< deepest penetration (m) */
+    double penetration_volume;  /**< volume of body material inside the shape (m^3),
+                                     approximated as the sum over touching surface nodes of
+                                     depth times the node's share of surface area */
+} sh_contact_state;
+
+/** Read a tool's reaction wrench (force and torque on the tool, world frame) and contact
+ *  measures after the last step, at the step's end state. Thread: sim. Alloc: none. */
+SH_API sh_status sh_tool_get_contact(const sh_world* world, sh_tool_id tool, sh_contact_state* out);
+
+/** Add a static rigid obstacle (any shape kind; a plane takes position and shape.normal).
+ *  Same validation as sh_tool_create. Thread: sim. Alloc: may. */
+SH_API sh_status sh_obstacle_create(sh_world* world, const sh_collider_def* def,
+                                    sh_obstacle_id* out_obstacle);
+
+/** Remove an obstacle; its id becomes stale. Thread: sim. Alloc: none. */
+SH_API sh_status sh_obstacle_destroy(sh_world* world, sh_obstacle_id obstacle);
+
+/** Read an obstacle's reaction wrench and contact measures after the last step.
+ *  Thread: sim. Alloc: none. */
+SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id obstacle,
+                                         sh_contact_state* out);
+
+/** Enable contact between two deformable bodies with params (NULL disables it): each step,
+ *  the surface nodes of each body that lie inside the other's tets are pushed out through the
+ *  other's nearest surface triangle, the reaction spread over that triangle's nodes. Both
+ *  bodies must be FEM bodies of world, and different. Thread: sim. Alloc: may. */
+SH_API sh_status sh_world_set_body_contact(sh_world* world, sh_body_id a, sh_body_id b,
+                                           const sh_contact_params* params);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Static equilibrium                                                                           */

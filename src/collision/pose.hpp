@@ -1,0 +1,62 @@
+// Pose: a rigid placement (position and unit quaternion) and the maps it makes.
+#pragma once
+
+#include <cmath>
+
+namespace sh {
+
+/// A rigid placement: world = q * local + p, q = (w, x, y, z) a unit quaternion.
+struct Pose {
+    double p[3] = {0.0, 0.0, 0.0};
+    double q[4] = {1.0, 0.0, 0.0, 0.0};
+
+    /// out = R in (rotation only).
+    void rotate(const double in[3], double out[3]) const {
+        const double w = q[0], x = q[1], y = q[2], z = q[3];
+        // t = 2 (q_v x in); out = in + w t + q_v x t
+        const double t0 = 2.0 * (y * in[2] - z * in[1]);
+        const double t1 = 2.0 * (z * in[0] - x * in[2]);
+        const double t2 = 2.0 * (x * in[1] - y * in[0]);
+        out[0] = in[0] + w * t0 + (y * t2 - z * t1);
+        out[1] = in[1] + w * t1 + (z * t0 - x * t2);
+        out[2] = in[2] + w * t2 + (x * t1 - y * t0);
+    }
+
+    /// out = R^T in.
+    void unrotate(const double in[3], double out[3]) const {
+        const Pose inverse{{0.0, 0.0, 0.0}, {q[0], -q[1], -q[2], -q[3]}};
+        inverse.rotate(in, out);
+    }
+
+    /// World point of a local point.
+    void to_world(const double local[3], double out[3]) const {
+        rotate(local, out);
+        for (int k = 0; k < 3; ++k) out[k] += p[k];
+    }
+
+    /// Local point of a world point.
+    void to_local(const double world[3], double out[3]) const {
+        const double d[3] = {world[0] - p[0], world[1] - p[1], world[2] - p[2]};
+        unrotate(d, out);
+    }
+};
+
+/// The pose a fraction s in [0, 1] of the way from a to b: positions linearly, orientations
+/// by normalised linear interpolation along the shorter arc (exact at s = 0 and 1).
+inline Pose interpolate(const Pose& a, const Pose& b, double s) {
+    Pose out;
+    for (int k = 0; k < 3; ++k) out.p[k] = a.p[k] + s * (b.p[k] - a.p[k]);
+    double dot = 0.0;
+    for (int k = 0; k < 4; ++k) dot += a.q[k] * b.q[k];
+    const double sign = dot < 0.0 ? -1.0 : 1.0;
+    double norm = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        out.q[k] = (1.0 - s) * a.q[k] + s * sign * b.q[k];
+        norm += out.q[k] * out.q[k];
+    }
+    norm = std::sqrt(norm);
+    for (int k = 0; k < 4; ++k) out.q[k] /= norm;
+    return out;
+}
+
+}  // namespace sh

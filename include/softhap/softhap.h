@@ -33,7 +33,7 @@ extern "C" {
 /** Major version: incremented on ABI-incompatible changes. */
 #define SH_VERSION_MAJOR 0
 /** Minor version: incremented when features are added compatibly. */
-#define SH_VERSION_MINOR 3
+#define SH_VERSION_MINOR 4
 /** Patch version: incremented for fixes. */
 #define SH_VERSION_PATCH 0
 /** Version this header declares: MAJOR*1000000 + MINOR*1000 + PATCH. */
@@ -611,6 +611,11 @@ typedef struct sh_contact_state {
 /** Read a tool's reaction wrench (force and torque on the tool, world frame) and contact
  *  measures after the last step, at the step's end state. Thread: sim. Alloc: none. */
 SH_API sh_status sh_tool_get_contact(const sh_world* world, sh_tool_id tool, sh_contact_state* out);
+
+/** Read only the reaction wrench of sh_tool_get_contact: force (N) and torque about the tool's
+ *  position (N m) on the tool, world frame. Thread: sim. Alloc: none. */
+SH_API sh_status sh_tool_get_wrench(const sh_world* world, sh_tool_id tool, double force[3],
+                                    double torque[3]);
 
 /** Add a static rigid obstacle (any shape kind; a plane takes position and shape.normal).
  *  Same validation as sh_tool_create. Thread: sim. Alloc: may. */

@@ -30,7 +30,8 @@ public:
     sh_shape_kind kind() const { return kind_; }
 
     /// Half the thinnest width of the shape (m): a point moving less than this per query
-    /// cannot cross it unseen. INFINITY for a plane.
+    /// cannot cross it unseen. INFINITY for a plane. For a convex hull it is an estimate (the
+    /// thinnest width over a fixed set of sampled directions, so never below the exact value).
     double inner_radius() const { return inner_radius_; }
 
     /// World-frame bounds of the shape at pose, grown by margin (m); a plane's are infinite
@@ -55,12 +56,29 @@ public:
                             Penetration& out, double bary[3]) const;
 
 private:
+    static constexpr int kMaxDirections = 17;  ///< convex: sampled directions (see shape.cpp)
+
+    void init_convex(const sh_shape& def);
+    /// Convex: index of the point farthest along local direction d.
+    int convex_support_index(const double d[3]) const;
+    /// Convex: penetration of local point xl (depth, local outward normal nl).
+    bool penetrate_convex(const double xl[3], double& depth, double nl[3]) const;
+
     sh_shape_kind kind_;
     double radius_ = 0.0;
     double half_length_ = 0.0;
     double half_extents_[3] = {};
     vec<double> points_;  ///< convex: 3 per point, local frame
     double inner_radius_ = 0.0;
+    // convex only:
+    double local_lo_[3] = {}, local_hi_[3] = {};  ///< bounding box in the local frame
+    double dirs_[kMaxDirections][3] = {};         ///< sampled unit directions, local frame
+    double dir_max_[kMaxDirections] = {};         ///< max over the points of dirs_[i] . p
+    double dir_min_[kMaxDirections] = {};         ///< min over the points of dirs_[i] . p
+    int dir_count_ = 0;
+    double ccd_center_[3] = {};  ///< libccd works on (p - ccd_center_) / ccd_scale_ so that its
+    double ccd_scale_ = 1.0;     ///< absolute tolerances are relative to the hull's size
+    vec<double> ccd_points_;     ///< the points in that normalised frame
 };
 
 /// Pose of a plane through point with outward normal n (normalised here): local z = n.

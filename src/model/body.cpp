@@ -1,7 +1,10 @@
 #include "model/body.hpp"
 
+#include "model/external_field.hpp"
+
 #include "mesh/io/mesh_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace sh {
@@ -54,7 +57,8 @@ double Body::critical_dt() const {
     // 2*sqrt(2)/omega. Forward Euler and RK2 have no undamped stable step at all (their energy
     // grows at every dt); they get the leapfrog limit, beyond which growth is explosive.
     const double factor = settings.integrator == SH_INTEGRATOR_RK4 ? 1.4142135623730951 : 1.0;
-    return factor * stable_step(x.data());
+    const double own = factor * stable_step(x.data());
+    return field ? std::min(own, factor * field->stable_step(x.data(), v.data(), mass.data())) : own;
 }
 
 }  // namespace sh

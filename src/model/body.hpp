@@ -11,6 +11,7 @@
 
 namespace sh {
 
+class ExternalField;
 class SparseSystem;
 
 /// Per-body integration settings shared by FEM and mass-spring bodies.
@@ -102,10 +103,14 @@ public:
     vec<double> target;          ///< 3 per node, where kinematic nodes go in the next step
     vec<double> external_force;  ///< 3 per node (N), held
     vec<double> node_damping;    ///< per-node viscous coefficient (1/s); empty if unused
+    vec<int32_t> surface_triangles;  ///< 3 per boundary triangle, outward; empty for springs
     /// Bumped whenever M, D or K change other than through x (a material or node-damping
     /// change): a factorisation kept by the implicit integrator is valid only for the version it
     /// was built at.
     uint64_t matrix_version = 0;
+    /// Forces from outside the body (contact), attached by the world during a step; null when
+    /// nothing touches the body.
+    const ExternalField* field = nullptr;
     IntegratorWorkspace workspace;
 };
 

@@ -64,6 +64,7 @@ vec<uint32_t> locality_order(const vec<int32_t>& tets, const vec<double>& p) {
 
 FemBody::FemBody(const TetMesh& mesh, const sh_material& material, IntegrationSettings s, double damping_stiffness)
     : Body(s, mesh.nodes), tets_(mesh.tets), damping_stiffness_(damping_stiffness) {
+    surface_triangles = mesh.surface_triangles;
     const size_t tet_count = tets_.size() / 4;
     inverse_rest_.resize(9 * tet_count);
     volume_.resize(tet_count);

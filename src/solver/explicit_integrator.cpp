@@ -1,5 +1,6 @@
 #include "solver/explicit_integrator.hpp"
 
+#include "model/external_field.hpp"
 #include "solver/node_checks.hpp"
 #include "solver/step_support.hpp"
 
@@ -107,6 +108,7 @@ void compute_accelerations(const Body& body, const double* x, const double* v, c
     const size_t n = body.mass.size();
     std::fill(a, a + 3 * n, 0.0);
     body.add_internal_forces(x, v, a);
+    if (body.field) body.field->add_forces(x, v, a);
     const double alpha = body.settings.damping_mass;
     const bool per_node = !body.node_damping.empty();
     const double* inv_mass = body.inverse_mass.data();
@@ -277,6 +279,7 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
         double* f = w.a[0].data();
         std::fill(f, f + body.x.size(), 0.0);
         body.add_internal_forces(body.x.data(), body.v.data(), f);
+        if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
         const bool per_node = !body.node_damping.empty();
         const bool symplectic = integrator == SH_INTEGRATOR_SYMPLECTIC_EULER;
         const size_t n = body.mass.size();

@@ -1,6 +1,7 @@
 #include "solver/implicit_integrator.hpp"
 
 #include "core/error.hpp"
+#include "model/external_field.hpp"
 #include "solver/step_support.hpp"
 
 #include <algorithm>
@@ -162,6 +163,9 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
                 state.factor_valid = false;
                 state.system.clear_values();
                 body.add_tangent(body.x.data(), dt * dt, dt, state.system);
+                if (body.field)
+                    body.field->add_tangent(body.x.data(), body.v.data(), dt * dt, dt, state.free_index.data(),
+                                            state.system);
                 state.roundoff_floor = force_roundoff(state.system, body.x, 1.0 / dt);  // system: dt^2 K
                 state.system.add_diagonal(state.diagonal.data(), 1.0);
                 state.solver->factorize(state.system);

@@ -200,6 +200,27 @@ void SparseSystem::add_element(size_t element, const double* Ke, double scale) {
     }
 }
 
+void SparseSystem::add_block(int32_t free_i, int32_t free_j, const double* B, double scale) {
+    // Stored upper triangle: entry (row, column) with row <= column. Block (I, J) with I > J is
+    // stored as the transpose of (J, I).
+    const bool transpose = free_i > free_j;
+    const int32_t I = transpose ? free_j : free_i, J = transpose ? free_i : free_j;
+    for (int s = 0; s < 3; ++s) {
+        const int32_t column = 3 * J + s;
+        const int32_t* first = row_indices_.data() + column_starts_[static_cast<size_t>(column)];
+        const int32_t* last = row_indices_.data() + column_starts_[static_cast<size_t>(column) + 1];
+        for (int r = 0; r < 3; ++r) {
+            const int32_t row = 3 * I + r;
+            if (row > column) continue;
+            const int32_t* slot = std::lower_bound(first, last, row);
+            SH_REQUIRE(slot != last && *slot == row, SH_ERR_INTERNAL,
+                       "sparse system: no block for free nodes %d and %d", free_i, free_j);
+            const double b = transpose ? B[3 * s + r] : B[3 * r + s];
+            values_[static_cast<size_t>(slot - row_indices_.data())] += scale * b;
+        }
+    }
+}
+
 void SparseSystem::add_diagonal(const double* diag, double scale) {
     double* v = values_.data();
     const int32_t* cs = column_starts_.data();

@@ -38,6 +38,10 @@ public:
     /// Precisely: local entry (p, q) is added to global entry (g(p), g(q)) when both are free
     /// DOFs and g(p) <= g(q), so a full symmetric Ke gives the exact global sum.
     void add_element(size_t element, const double* Ke, double scale);
+    /// Adds scale * B (3x3, row-major) to the block of free nodes (I, J) and, for I != J, its
+    /// transpose to (J, I): only the stored upper triangle is touched. The nodes must share an
+    /// element (or be equal); otherwise throws SH_ERR_INTERNAL.
+    void add_block(int32_t free_i, int32_t free_j, const double* B, double scale);
     /// Adds diag[d] to diagonal entry d, for d < dof_count() (lumped mass, per-DOF terms).
     void add_diagonal(const double* diag, double scale);
     const vec<int32_t>& column_starts() const { return column_starts_; }  ///< dof_count()+1

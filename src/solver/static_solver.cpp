@@ -1,6 +1,7 @@
 #include "solver/static_solver.hpp"
 
 #include "core/error.hpp"
+#include "model/external_field.hpp"
 #include "solver/implicit_integrator.hpp"
 #include "solver/step_support.hpp"
 
@@ -15,6 +16,7 @@ double out_of_balance(const Body& body, const ImplicitState& state, const double
                       vec<double>& force_scratch, vec<double>& out) {
     std::fill(force_scratch.begin(), force_scratch.end(), 0.0);
     body.add_internal_forces(body.x.data(), nullptr, force_scratch.data());
+    if (body.field) body.field->add_forces(body.x.data(), nullptr, force_scratch.data());
     const vec<int32_t>& global = state.system.dof_to_global();
     double s = 0.0;
     for (size_t d = 0; d < out.size(); ++d) {
@@ -32,7 +34,8 @@ double potential(const Body& body, const ImplicitState& state, const double g[3]
         const size_t k = static_cast<size_t>(j);
         work += body.applied_load(k, g) * body.x[k];
     }
-    return body.elastic_energy(body.x.data()) - load_factor * work;
+    const double field = body.field ? body.field->energy(body.x.data()) : 0.0;
+    return body.elastic_energy(body.x.data()) + field - load_factor * work;
 }
 
 }  // namespace
@@ -73,6 +76,7 @@ void solve_static_body(Body& body, const double g[3], const sh_static_def& def, 
         for (int32_t iteration = 0; iteration < def.max_iterations && !converged; ++iteration) {
             state.system.clear_values();
             body.add_tangent(body.x.data(), 1.0, 0.0, state.system);
+            if (body.field) body.field->add_tangent(body.x.data(), nullptr, 1.0, 0.0, state.free_index.data(), state.system);
             // Below the round-off of the internal forces the residual cannot fall further.
             floor = std::max(floor, force_roundoff(state.system, body.x, 1.0) / load_norm);
             state.solver->factorize(state.system);

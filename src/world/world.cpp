@@ -1,5 +1,7 @@
 #include "world/world.hpp"
 
+#include "contact/body_contacts.hpp"
+#include "contact/collider.hpp"
 #include "core/error.hpp"
 #include "solver/explicit_integrator.hpp"
 #include "solver/implicit_integrator.hpp"
@@ -23,6 +25,10 @@ uint32_t generation_of(sh_body_id id) { return static_cast<uint32_t>(id >> 32); 
 // other than the one that issued it.
 std::atomic<uint32_t> g_next_generation{1};
 
+// More contact sub-steps than this in one step are not taken (the tool then moves farther
+// per sub-step).
+constexpr double kMaxContactSubsteps = 1024.0;
+
 uint32_t next_generation() {
     uint32_t g = g_next_generation.fetch_add(1);
     while (g == 0) g = g_next_generation.fetch_add(1);
@@ -37,15 +43,19 @@ World::World(const sh_world_def& def) : error_estimate_(def.error_estimate != 0)
 
 World::~World() {
     for (Slot& slot : slots_) destroy_slot(slot);
+    for (ColliderSlot& c : colliders_) sh::destroy(c.collider);
 }
 
 void World::destroy_slot(Slot& slot) {
     sh::destroy(slot.body);
     sh::destroy(slot.implicit);
     sh::destroy(slot.doubling);
+    sh::destroy(slot.contacts);
     slot.body = nullptr;
     slot.implicit = nullptr;
     slot.doubling = nullptr;
+    slot.contacts = nullptr;
+    slot.saved = vec<double>();
 }
 
 sh_body_id World::add_body(Body* body) {
@@ -101,28 +111,85 @@ void World::remove_body(sh_body_id id) {
     const uint32_t index = slot_of(id);
     free_slots_.push_back(index);  // within the capacity reserved in add_body
     destroy_slot(slots_[index]);
+    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(), [&](const BodyPair& p) { return p.a == id || p.b == id; }),
+                 pairs_.end());
 }
 
-void World::step(double dt, sh_step_report* report) {
-    SH_REQUIRE(std::isfinite(dt) && dt > 0.0, SH_ERR_INVALID_ARGUMENT, "dt = %g s, must be finite and > 0", dt);
-    const auto start = std::chrono::steady_clock::now();
-    sh_step_report r{};
-    r.substeps = 1;
-    r.error_estimate = error_estimate_ ? 0.0 : -1.0;
-    r.dt_critical = INFINITY;
-    sh_body_id first_failed = SH_NULL_BODY;
-    BodyStepResult first_failure;
+uint64_t World::add_collider(const sh_collider_def& def, bool is_tool) {
+    Collider* collider = sh::create<Collider>(def, is_tool);
+    uint32_t index;
+    if (!free_colliders_.empty()) {
+        index = free_colliders_.back();
+        free_colliders_.pop_back();
+    } else {
+        try {
+            if (free_colliders_.capacity() < colliders_.size() + 1) free_colliders_.reserve(2 * colliders_.size() + 1);
+            colliders_.push_back(ColliderSlot{});
+        } catch (...) {
+            sh::destroy(collider);
+            throw;
+        }
+        index = static_cast<uint32_t>(colliders_.size() - 1);
+    }
+    colliders_[index].collider = collider;
+    colliders_[index].generation = next_generation();
+    ++collider_count_;
+    return (static_cast<uint64_t>(colliders_[index].generation) << 32) | (static_cast<uint64_t>(index) + 1);
+}
+
+bool World::is_valid_collider(uint64_t id, bool is_tool) const {
+    if (id == 0) return false;
+    const uint32_t index = slot_of(id);
+    return index < colliders_.size() && colliders_[index].collider && colliders_[index].generation == generation_of(id) &&
+           colliders_[index].collider->is_tool == is_tool;
+}
+
+Collider& World::collider(uint64_t id, bool is_tool) const {
+    const char* kind = is_tool ? "tool" : "obstacle";
+    if (!is_valid_collider(id, is_tool))
+        throw Error(SH_ERR_INVALID_HANDLE, id == 0 ? format("%s id is null (0)", kind)
+                                                   : format("%s id 0x%llx is not a live %s of this world (removed or never created)",
+                                                            kind, static_cast<unsigned long long>(id), kind));
+    return *colliders_[slot_of(id)].collider;
+}
+
+void World::remove_collider(uint64_t id, bool is_tool) {
+    collider(id, is_tool);  // validates
+    const uint32_t index = slot_of(id);
+    free_colliders_.push_back(index);  // within the capacity reserved in add_collider
+    sh::destroy(colliders_[index].collider);
+    colliders_[index].collider = nullptr;
+    --collider_count_;
+}
+
+void World::set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params* params) {
+    require(body(a).is_fem() && body(b).is_fem(), SH_ERR_UNSUPPORTED,
+            "body contact needs two FEM bodies (a mass-spring body has no tets to be inside of)");
+    require(a != b, SH_ERR_INVALID_ARGUMENT, "a and b are the same body: self-contact is not supported");
+    if (params) validate_contact_params(*params, "params");
+    const auto same = [&](const BodyPair& p) { return (p.a == a && p.b == b) || (p.a == b && p.b == a); };
+    const auto it = std::find_if(pairs_.begin(), pairs_.end(), same);
+    if (!params) {
+        if (it != pairs_.end()) pairs_.erase(it);
+    } else if (it != pairs_.end()) {
+        it->params = *params;
+    } else {
+        pairs_.push_back(BodyPair{a, b, *params});
+    }
+}
+
+void World::step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed) {
     for (size_t index = 0; index < slots_.size(); ++index) {
         Slot& slot = slots_[index];
-        if (!slot.body) continue;
+        if (!slot.body || (failed && (*failed)[index])) continue;
         bool half_steps_stable = false;
         if (slot.doubling) {
             const auto t0 = std::chrono::steady_clock::now();
-            half_steps_stable = take_half_steps(*slot.body, *slot.doubling, dt, gravity);
+            half_steps_stable = take_half_steps(*slot.body, *slot.doubling, h, gravity);
             r.error_estimate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         }
         slot.body->clear_inverted_elements();
-        const BodyStepResult result = step_body(*slot.body, slot.implicit, dt, gravity);
+        const BodyStepResult result = step_body(*slot.body, slot.implicit, h, gravity);
         if (slot.doubling) {
             if (half_steps_stable && result.stable && r.error_estimate >= 0.0)
                 r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*slot.body, *slot.doubling));
@@ -142,11 +209,130 @@ void World::step(double dt, sh_step_report* report) {
         if (!result.stable) {
             r.warnings |= 1u << SH_WARN_UNSTABLE;
             ++r.unstable_body_count;
-            if (first_failed == SH_NULL_BODY) {
-                first_failed = id_of(index);
-                first_failure = result;
+            if (failed) (*failed)[index] = 1;
+            if (failure.body == SH_NULL_BODY) {
+                failure.body = id_of(index);
+                failure.result = result;
             }
         }
+    }
+}
+
+uint32_t World::detect_contacts(double h, double travel_fraction, double extra_reach) {
+    uint32_t warning_bits = 0;
+    for (Slot& slot : slots_) {
+        if (!slot.body) continue;
+        Body& body = *slot.body;
+        if (!slot.contacts) slot.contacts = sh::create<BodyContacts>(body);
+        BodyContacts& contacts = *slot.contacts;
+        contacts.clear();
+        // How far a node may go in the (sub)step: twice its speed's reach, plus a little.
+        double speed2 = 0.0;
+        for (size_t j = 0; j < body.v.size(); j += 3)
+            speed2 = std::max(speed2, body.v[j] * body.v[j] + body.v[j + 1] * body.v[j + 1] + body.v[j + 2] * body.v[j + 2]);
+        const double margin = 2.0 * h * std::sqrt(speed2) + extra_reach;
+        contacts.refit(margin);
+        double anticipated = margin;
+        for (const ColliderSlot& c : colliders_) {
+            if (!c.collider) continue;
+            const double reach = margin + travel_fraction * c.collider->travel();
+            anticipated = std::max(anticipated, reach);
+            if (contacts.detect(*c.collider, reach)) warning_bits |= 1u << SH_WARN_CAPACITY;
+        }
+        contacts.anticipated_depth = anticipated;
+        contacts.friction_rate_limit = body.settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER ? 0.0 : 1.0 / h;
+    }
+    for (const BodyPair& pair : pairs_) {
+        Slot& a = slots_[slot_of(pair.a)];
+        Slot& b = slots_[slot_of(pair.b)];
+        if (BodyContacts::detect_pair(*a.contacts, *b.contacts, pair.params)) warning_bits |= 1u << SH_WARN_CAPACITY;
+        if (BodyContacts::detect_pair(*b.contacts, *a.contacts, pair.params)) warning_bits |= 1u << SH_WARN_CAPACITY;
+    }
+    for (Slot& slot : slots_)
+        if (slot.body) slot.body->field = slot.contacts->candidate_count() > 0 ? slot.contacts : nullptr;
+    return warning_bits;
+}
+
+int32_t World::finish_contacts() {
+    for (ColliderSlot& c : colliders_)
+        if (c.collider) c.collider->state = sh_contact_state{};
+    int32_t count = 0;
+    for (Slot& slot : slots_) {
+        if (!slot.body || !slot.contacts) continue;
+        if (slot.body->field) count += slot.contacts->accumulate_reactions();
+        slot.body->field = nullptr;
+    }
+    for (ColliderSlot& c : colliders_) {
+        if (!c.collider) continue;
+        c.collider->start = c.collider->target;
+        c.collider->pose = c.collider->target;
+        c.collider->velocity_given = false;
+    }
+    return count;
+}
+
+void World::step(double dt, sh_step_report* report) {
+    SH_REQUIRE(std::isfinite(dt) && dt > 0.0, SH_ERR_INVALID_ARGUMENT, "dt = %g s, must be finite and > 0", dt);
+    const auto start = std::chrono::steady_clock::now();
+    sh_step_report r{};
+    r.substeps = 1;
+    r.contact_substeps = 1;
+    r.error_estimate = error_estimate_ ? 0.0 : -1.0;
+    r.dt_critical = INFINITY;
+    Failure failure;
+    if (!has_contact()) {
+        step_bodies(dt, r, failure, nullptr);
+    } else {
+        // Tools move from their last pose to the host's in sub-steps short enough that none
+        // crosses more than half its inner radius at once.
+        double substeps = 1.0;
+        for (ColliderSlot& c : colliders_) {
+            if (!c.collider) continue;
+            c.collider->begin_step(dt);
+            const double travel = c.collider->travel(), limit = 0.5 * c.collider->shape.inner_radius();
+            if (travel > limit) substeps = std::max(substeps, std::ceil(travel / limit));
+        }
+        substeps = std::min(substeps, kMaxContactSubsteps);
+        r.contact_substeps = static_cast<int32_t>(substeps);
+        const double h = dt / substeps;
+        if (r.contact_substeps > 1) {
+            // A body that fails in a later sub-step goes back to its state before the call.
+            failed_.assign(slots_.size(), 0);
+            for (Slot& slot : slots_) {
+                if (!slot.body) continue;
+                slot.saved.assign(slot.body->x.begin(), slot.body->x.end());
+                slot.saved.insert(slot.saved.end(), slot.body->v.begin(), slot.body->v.end());
+            }
+        }
+        try {
+            for (int32_t s = 0; s < r.contact_substeps; ++s) {
+                const double fraction = (s + 1) / substeps;
+                for (ColliderSlot& c : colliders_)
+                    if (c.collider && c.collider->is_tool) c.collider->pose = interpolate(c.collider->start, c.collider->target, fraction);
+                const auto t0 = std::chrono::steady_clock::now();
+                r.warnings |= detect_contacts(h, 1.0 / substeps, 0.0);
+                r.collision_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                step_bodies(h, r, failure, r.contact_substeps > 1 ? &failed_ : nullptr);
+            }
+        } catch (...) {
+            for (Slot& slot : slots_)
+                if (slot.body) slot.body->field = nullptr;
+            throw;
+        }
+        if (r.contact_substeps > 1)
+            for (size_t index = 0; index < slots_.size(); ++index) {
+                Slot& slot = slots_[index];
+                if (!slot.body || !failed_[index]) continue;
+                const size_t n = slot.body->x.size();
+                std::copy(slot.saved.begin(), slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.body->x.begin());
+                std::copy(slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.saved.end(), slot.body->v.begin());
+            }
+        const auto t0 = std::chrono::steady_clock::now();
+        r.contact_count = finish_contacts();
+        r.collision_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        for (const Slot& slot : slots_)
+            if (slot.contacts) r.collision_seconds += slot.contacts->take_evaluation_seconds();
+        if (r.warnings & (1u << SH_WARN_CAPACITY)) ++warnings[SH_WARN_CAPACITY];
     }
     if (r.warnings & (1u << SH_WARN_SUBSTEPPED)) ++warnings[SH_WARN_SUBSTEPPED];
     if (r.warnings & (1u << SH_WARN_INVERTED)) ++warnings[SH_WARN_INVERTED];
@@ -168,14 +354,14 @@ void World::step(double dt, sh_step_report* report) {
         r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         *report = r;
     }
-    if (first_failed == SH_NULL_BODY) return;
-    const unsigned long long id = static_cast<unsigned long long>(first_failed);
-    if (first_failure.rejected)
+    if (failure.body == SH_NULL_BODY) return;
+    const unsigned long long id = static_cast<unsigned long long>(failure.body);
+    if (failure.result.rejected)
         throw Error(SH_ERR_UNSTABLE, format("body 0x%llx: dt = %g s exceeds its critical step %g s (policy: reject); "
                                             "%d body(ies) left unchanged",
-                                            id, dt, first_failure.dt_critical, r.unstable_body_count));
-    throw Error(first_failure.status, format("body 0x%llx: %s (%d body(ies) left as before the step)", id,
-                                             first_failure.reason, r.unstable_body_count));
+                                            id, dt, failure.result.dt_critical, r.unstable_body_count));
+    throw Error(failure.result.status, format("body 0x%llx: %s (%d body(ies) left as before the step)", id,
+                                              failure.result.reason, r.unstable_body_count));
 }
 
 void World::solve_static(const sh_static_def& def, sh_static_report* report) {
@@ -184,11 +370,31 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
     for (Slot& slot : slots_)
         if (slot.body) save_start_state(*slot.body);
     try {
+        if (has_contact()) {
+            // Tools rest at their host-set poses; candidates reach as far as the tool's size,
+            // since the solve may move the surface that far.
+            for (ColliderSlot& c : colliders_) {
+                if (!c.collider) continue;
+                c.collider->start = c.collider->pose = c.collider->target;
+                c.collider->velocity_given = false;
+                for (int k = 0; k < 3; ++k) c.collider->velocity[k] = c.collider->angular[k] = 0.0;
+            }
+            for (Slot& slot : slots_)
+                if (slot.body) std::fill(slot.body->v.begin(), slot.body->v.end(), 0.0);
+            double reach = 0.0;
+            for (const ColliderSlot& c : colliders_)
+                if (c.collider && c.collider->shape.kind() != SH_SHAPE_PLANE) reach = std::max(reach, c.collider->shape.inner_radius());
+            detect_contacts(1.0, 0.0, reach);
+        }
         for (Slot& slot : slots_)
             if (slot.body) solve_static_body(*slot.body, gravity, def, r);
+        if (has_contact()) finish_contacts();
     } catch (...) {
         for (Slot& slot : slots_)
-            if (slot.body) restore_start_state(*slot.body);
+            if (slot.body) {
+                slot.body->field = nullptr;
+                restore_start_state(*slot.body);
+            }
         r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (report) *report = r;  // what was tried, for the host's diagnosis
         throw;

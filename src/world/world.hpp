@@ -3,6 +3,7 @@
 
 #include "core/memory.hpp"
 #include "model/body.hpp"
+#include "solver/explicit_integrator.hpp"
 
 #include <softhap/softhap.h>
 
@@ -10,6 +11,8 @@
 
 namespace sh {
 
+class BodyContacts;
+struct Collider;
 struct ImplicitState;
 struct StepDoubling;
 
@@ -33,6 +36,22 @@ public:
     /// The body named by id; throws SH_ERR_INVALID_HANDLE if the id is null, stale or foreign.
     Body& body(sh_body_id id) const;
 
+    /// Adds a tool (is_tool) or an obstacle made from def; returns its id.
+    uint64_t add_collider(const sh_collider_def& def, bool is_tool);
+
+    /// Destroys a tool or obstacle; throws SH_ERR_INVALID_HANDLE if id is not a live one of
+    /// that kind.
+    void remove_collider(uint64_t id, bool is_tool);
+
+    /// True if id names a live tool (is_tool) or obstacle of this world.
+    bool is_valid_collider(uint64_t id, bool is_tool) const;
+
+    /// The tool or obstacle named by id; throws SH_ERR_INVALID_HANDLE otherwise.
+    Collider& collider(uint64_t id, bool is_tool) const;
+
+    /// Enables contact between bodies a and b with params, or disables it for null.
+    void set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params* params);
+
     /// Steps every body by dt; fills report if not null. Throws SH_ERR_UNSTABLE (after
     /// filling report and advancing the stable bodies) if any body was rejected or rolled back.
     void step(double dt, sh_step_report* report);
@@ -49,9 +68,38 @@ private:
         Body* body = nullptr;
         ImplicitState* implicit = nullptr;  ///< built on the first implicit step
         StepDoubling* doubling = nullptr;   ///< with error_estimate_ only
+        BodyContacts* contacts = nullptr;   ///< built on the first step with contact
+        vec<double> saved;                  ///< x then v before a sub-stepped contact step
         uint32_t generation = 0;
     };
+    struct ColliderSlot {
+        Collider* collider = nullptr;
+        uint32_t generation = 0;
+    };
+    struct BodyPair {
+        sh_body_id a, b;
+        sh_contact_params params;
+    };
+    /// The first body that failed in a step and why.
+    struct Failure {
+        sh_body_id body = 0;
+        BodyStepResult result;
+    };
     void destroy_slot(Slot& slot);
+    bool has_contact() const { return collider_count_ > 0 || !pairs_.empty(); }
+    /// Steps every body (not in skip) by h, adding to r and recording the first failure.
+    void step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed);
+    /// Finds the contact candidates of every body for a (sub)step of h with colliders at their
+    /// current poses, each tool moving by travel_fraction of its step, every box grown by
+    /// extra_reach (m); attaches the fields; returns SH_WARN bits.
+    uint32_t detect_contacts(double h, double travel_fraction, double extra_reach);
+    /// Contact forces at the end state into every collider's state; detaches the fields.
+    int32_t finish_contacts();
+    int32_t collider_count_ = 0;
+    vec<ColliderSlot> colliders_;
+    vec<uint32_t> free_colliders_;
+    vec<BodyPair> pairs_;
+    vec<uint8_t> failed_;  ///< per slot, during a sub-stepped step
     bool error_estimate_ = false;
     sh_body_id id_of(size_t index) const;
     vec<Slot> slots_;

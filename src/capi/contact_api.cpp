@@ -1,0 +1,137 @@
+// C API: tools, obstacles and contact between bodies.
+#include "capi/guard.hpp"
+#include "capi/world_handle.hpp"
+#include "contact/collider.hpp"
+#include "core/enum_value.hpp"
+
+using namespace sh;
+
+namespace {
+
+// Copies a collider's contact state, with the wrench's parts optional.
+void read_contact(const Collider& c, sh_contact_state* out) {
+    capi::require_pointer(out, "out");
+    *out = c.state;
+}
+
+sh_collider_def checked_def(const sh_collider_def* def) {
+    capi::require_initialised(def, "def");
+    sh_collider_def out = *def;
+    const int kind = enum_value(def->shape.kind);
+    SH_REQUIRE(kind >= SH_SHAPE_SPHERE && kind <= SH_SHAPE_PLANE, SH_ERR_INVALID_ARGUMENT,
+               "def->shape.kind = %d is not a sh_shape_kind", kind);
+    out.shape.kind = static_cast<sh_shape_kind>(kind);
+    return out;
+}
+
+}  // namespace
+
+extern "C" {
+
+SH_API void sh_contact_params_default(sh_contact_params* params) {
+    if (!params) return;
+    *params = sh_contact_params{};
+    params->stiffness = 1e4;
+    params->exponent = 1.5;
+    params->damping = 0.2;
+    params->static_friction = 0.0;
+    params->dynamic_friction = 0.0;
+    params->slip_velocity = 1e-3;
+    params->capacity = 4096;
+}
+
+SH_API void sh_collider_def_default(sh_collider_def* def) {
+    if (!def) return;
+    *def = sh_collider_def{};
+    def->internal_init = capi::kDefInitialised;
+    def->shape.kind = SH_SHAPE_SPHERE;
+    def->shape.radius = 5e-3;
+    def->shape.normal[2] = 1.0;
+    def->orientation[0] = 1.0;
+    sh_contact_params_default(&def->contact);
+}
+
+SH_API sh_status sh_tool_create(sh_world* world, const sh_collider_def* def, sh_tool_id* out_tool) {
+    return capi::guard([&] {
+        capi::require_pointer(out_tool, "out_tool");
+        *out_tool = 0;
+        World& w = capi::world_of(world);
+        *out_tool = w.add_collider(checked_def(def), true);
+    });
+}
+
+SH_API sh_status sh_tool_destroy(sh_world* world, sh_tool_id tool) {
+    return capi::guard([&] { capi::world_of(world).remove_collider(tool, true); });
+}
+
+SH_API int32_t sh_tool_is_valid(const sh_world* world, sh_tool_id tool) {
+    int32_t valid = 0;
+    capi::guard([&] { valid = capi::world_of(world).is_valid_collider(tool, true) ? 1 : 0; });
+    return valid;
+}
+
+SH_API sh_status sh_tool_set_pose(sh_world* world, sh_tool_id tool, const double position[3],
+                                  const double orientation[4]) {
+    return capi::guard([&] {
+        Collider& c = capi::world_of(world).collider(tool, true);
+        c.target = checked_pose(position, orientation, "sh_tool_set_pose");
+    });
+}
+
+SH_API sh_status sh_tool_set_velocity(sh_world* world, sh_tool_id tool, const double linear[3],
+                                      const double angular[3]) {
+    return capi::guard([&] {
+        Collider& c = capi::world_of(world).collider(tool, true);
+        capi::require_pointer(linear, "linear");
+        capi::require_pointer(angular, "angular");
+        for (int k = 0; k < 3; ++k) {
+            capi::require_finite(linear[k], "linear");
+            capi::require_finite(angular[k], "angular");
+        }
+        for (int k = 0; k < 3; ++k) {
+            c.given_velocity[k] = linear[k];
+            c.given_angular[k] = angular[k];
+        }
+        c.velocity_given = true;
+    });
+}
+
+SH_API sh_status sh_tool_get_contact(const sh_world* world, sh_tool_id tool, sh_contact_state* out) {
+    return capi::guard([&] { read_contact(capi::world_of(world).collider(tool, true), out); });
+}
+
+SH_API sh_status sh_tool_get_wrench(const sh_world* world, sh_tool_id tool, double force[3], double torque[3]) {
+    return capi::guard([&] {
+        const Collider& c = capi::world_of(world).collider(tool, true);
+        capi::require_pointer(force, "force");
+        capi::require_pointer(torque, "torque");
+        for (int k = 0; k < 3; ++k) {
+            force[k] = c.state.force[k];
+            torque[k] = c.state.torque[k];
+        }
+    });
+}
+
+SH_API sh_status sh_obstacle_create(sh_world* world, const sh_collider_def* def, sh_obstacle_id* out_obstacle) {
+    return capi::guard([&] {
+        capi::require_pointer(out_obstacle, "out_obstacle");
+        *out_obstacle = 0;
+        World& w = capi::world_of(world);
+        *out_obstacle = w.add_collider(checked_def(def), false);
+    });
+}
+
+SH_API sh_status sh_obstacle_destroy(sh_world* world, sh_obstacle_id obstacle) {
+    return capi::guard([&] { capi::world_of(world).remove_collider(obstacle, false); });
+}
+
+SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id obstacle, sh_contact_state* out) {
+    return capi::guard([&] { read_contact(capi::world_of(world).collider(obstacle, false), out); });
+}
+
+SH_API sh_status sh_world_set_body_contact(sh_world* world, sh_body_id a, sh_body_id b,
+                                           const sh_contact_params* params) {
+    return capi::guard([&] { capi::world_of(world).set_body_contact(a, b, params); });
+}
+
+}  // extern "C"

@@ -78,6 +78,7 @@ private:
     int dir_count_ = 0;
     double ccd_center_[3] = {};  ///< libccd works on (p - ccd_center_) / ccd_scale_ so that its
     double ccd_scale_ = 1.0;     ///< absolute tolerances are relative to the hull's size
+    double ccd_centroid_[3] = {};  ///< mean of the points, normalised frame (MPR's centre)
     vec<double> ccd_points_;     ///< the points in that normalised frame
 };
 

@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* ---- The Hunt-Crossley impact, independently of the library ------------------------------ */
@@ -124,9 +125,344 @@ static void test_impact_restitution_matches_hunt_crossley(void** state) {
     }
 }
 
+/* ---- FEM bodies against obstacles and tools ---------------------------------------------- */
+
+/* An FEM cube of side a (n cells per side) with its lowest corner at (x0, y0, z0). */
+static sh_body_id fem_cube(sh_world* world, double a, int n, double x0, double y0, double z0, double young,
+                           sh_integrator integrator) {
+    sh_mesh* unit = sh_test_box(a, a, a, n, n, n);
+    const double shift[3] = {x0, y0, z0};
+    sh_mesh* mesh = NULL;
+    assert_ok(sh_mesh_transform(unit, 1.0, shift, &mesh));
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.material.model = SH_MATERIAL_COROTATIONAL;
+    def.material.young = young;
+    def.material.poisson = 0.3;
+    def.integrator = integrator;
+    def.damping_mass = 20.0;
+    sh_body_id body = 0;
+    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_mesh_destroy(unit));
+    assert_ok(sh_mesh_destroy(mesh));
+    return body;
+}
+
+static double body_mass(const sh_world* world, sh_body_id body) {
+    sh_body_info info;
+    assert_ok(sh_body_get_info(world, body, &info));
+    return info.total_mass;
+}
+
+/* An implicit body dropped on a very stiff plane at dt = 10 ms: the contact's stiffness is in
+ * the implicit system, so every step is stable without sub-steps (its contact frequency is
+ * ~1e4 times 1/dt), and at rest the plane carries exactly the weight. */
+static void test_implicit_body_rests_on_stiff_plane(void** state) {
+    (void)state;
+    sh_world* world = sh_test_world(-9.81);
+    sh_contact_params law;
+    sh_contact_params_default(&law);
+    law.stiffness = 1e9;
+    law.exponent = 1.0;
+    const sh_obstacle_id plane = floor_plane(world, &law);
+    const sh_body_id cube = fem_cube(world, 0.02, 3, -0.01, -0.01, 0.001, 3e4, SH_INTEGRATOR_IMPLICIT_EULER);
+    const double weight = body_mass(world, cube) * 9.81;
+    sh_step_report report;
+    for (int i = 0; i < 300; ++i) {
+        assert_ok(sh_world_step(world, 0.01, &report));
+        assert_int_equal(report.substeps, 1);
+    }
+    sh_contact_state contact;
+    assert_ok(sh_obstacle_get_contact(world, plane, &contact));
+    printf("implicit cube on a 1e9 N/m plane: reaction %.6g N, weight %.6g N, depth %.3g m, %d contacts\n",
+           contact.force[2], weight, contact.max_depth, contact.contact_count);
+    assert_close(-contact.force[2], weight, 1e-3);
+    assert_true(contact.max_depth < 1e-9 * 4 /* weight / (stiffness * bottom nodes), order of */ + 1e-10);
+    assert_true(fabs(contact.force[0]) < 1e-9 && fabs(contact.force[1]) < 1e-9);
+    assert_ok(sh_world_destroy(world));
+}
+
+/* The same cube pressed by a sphere tool while resting on the plane, explicit: in equilibrium
+ * (heavy mass damping) the plane carries the weight plus the tool's push, and the tool feels
+ * the opposite of its push. */
+static void test_tool_reaction_balances_the_plane(void** state) {
+    (void)state;
+    sh_world* world = sh_test_world(-9.81);
+    sh_contact_params law;
+    sh_contact_params_default(&law);
+    law.stiffness = 1e5;
+    const sh_obstacle_id plane = floor_plane(world, &law);
+    const sh_body_id cube = fem_cube(world, 0.02, 4, -0.01, -0.01, 0.0, 3e4, SH_INTEGRATOR_IMPLICIT_EULER);
+    const double weight = body_mass(world, cube) * 9.81;
+    sh_collider_def def;
+    sh_collider_def_default(&def);
+    def.shape.radius = 0.005;
+    def.position[2] = 0.02 + 0.005 + 1e-3;
+    def.contact = law;
+    sh_tool_id tool = 0;
+    assert_ok(sh_tool_create(world, &def, &tool));
+    const double q[4] = {1, 0, 0, 0};
+    for (int i = 0; i < 400; ++i) {
+        const double depth = fmin(1.0, i / 100.0) * 0.003; /* press 2 mm into the top */
+        const double p[3] = {0.0, 0.0, 0.02 + 0.005 + 1e-3 - depth};
+        assert_ok(sh_tool_set_pose(world, tool, p, q));
+        assert_ok(sh_world_step(world, 0.005, NULL));
+    }
+    sh_contact_state on_tool, on_plane;
+    assert_ok(sh_tool_get_contact(world, tool, &on_tool));
+    assert_ok(sh_obstacle_get_contact(world, plane, &on_plane));
+    double force[3], torque[3];
+    assert_ok(sh_tool_get_wrench(world, tool, force, torque));
+    printf("cube pressed by a sphere: tool %.6g N (%d contacts, depth %.3g mm), plane %.6g N, weight %.6g N\n",
+           on_tool.force[2], on_tool.contact_count, 1e3 * on_tool.max_depth, on_plane.force[2], weight);
+    assert_true(on_tool.force[2] > 0.05);  /* pushed up by the tissue */
+    assert_true(on_tool.contact_count >= 4);
+    assert_close(-on_plane.force[2], weight + on_tool.force[2], 2e-3);
+    assert_close(force[2], on_tool.force[2], 0.0);
+    /* A centred push on a symmetric cube: no sideways force, no torque about the centre. */
+    assert_true(fabs(on_tool.force[0]) < 1e-3 * on_tool.force[2] && fabs(on_tool.force[1]) < 1e-3 * on_tool.force[2]);
+    assert_true(fabs(torque[0]) < 1e-6 && fabs(torque[1]) < 1e-6 && fabs(torque[2]) < 1e-6);
+    assert_ok(sh_world_destroy(world));
+}
+
+/* A 2 mm membrane clamped on its rim, hit by a small sphere at 1 m/s and stepped at 1 kHz:
+ * the sphere (radius 0.5 mm, smaller than the 1 mm elements, aimed between nodes) moves 1 mm
+ * per step, twice its radius, yet stays on its side: the step is split so that no tool moves
+ * more than half its radius at once, and triangle contacts catch it between the nodes. */
+static void test_fast_tool_does_not_pass_through_membrane(void** state) {
+    (void)state;
+    sh_world* world = sh_test_world(0.0);
+    sh_mesh* unit = sh_test_box(0.02, 0.02, 0.002, 20, 20, 2);
+    const double shift[3] = {-0.01, -0.01, -0.002};
+    sh_mesh* mesh = NULL;
+    assert_ok(sh_mesh_transform(unit, 1.0, shift, &mesh));
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.material.model = SH_MATERIAL_NEOHOOKEAN;
+    def.material.young = 3e5;
+    def.material.poisson = 0.3;
+    sh_body_id membrane = 0;
+    assert_ok(sh_world_add_fem_body(world, &def, &membrane));
+    const sh_mesh_info info = sh_test_mesh_info(mesh);
+    double* x = malloc(3 * sizeof(double) * (size_t)info.node_count);
+    int32_t* rim = malloc(sizeof(int32_t) * (size_t)info.node_count);
+    assert_ok(sh_mesh_get_nodes(mesh, x, 3 * (int64_t)info.node_count));
+    int32_t rim_count = 0;
+    for (int32_t i = 0; i < info.node_count; ++i)
+        if (fabs(fabs(x[3 * i]) - 0.01) < 1e-9 || fabs(fabs(x[3 * i + 1]) - 0.01) < 1e-9) rim[rim_count++] = i;
+    assert_ok(sh_body_fix_nodes(world, membrane, rim, rim_count));
+
+    sh_collider_def tool_def;
+    sh_collider_def_default(&tool_def);
+    tool_def.shape.radius = 0.0005;
+    tool_def.contact.stiffness = 1e7; /* stiff enough to hold the depth well below the radius */
+    const double cx = 0.0003, cy = 0.0006; /* inside a surface triangle, away from its nodes */
+    tool_def.position[0] = cx;
+    tool_def.position[1] = cy;
+    tool_def.position[2] = 0.003;
+    sh_tool_id tool = 0;
+    assert_ok(sh_tool_create(world, &tool_def, &tool));
+    const double q[4] = {1, 0, 0, 0};
+    double peak = 0.0;
+    int face_contact_steps = 0;
+    for (int i = 1; i <= 10; ++i) { /* 1 m/s, 1 kHz: from 3 mm above the top down to 7 mm */
+        const double p[3] = {cx, cy, 0.003 - 0.001 * i};
+        assert_ok(sh_tool_set_pose(world, tool, p, q));
+        sh_step_report report;
+        assert_ok(sh_world_step(world, 1e-3, &report));
+        assert_true(report.contact_substeps >= 2);
+        sh_contact_state contact;
+        assert_ok(sh_tool_get_contact(world, tool, &contact));
+        peak = fmax(peak, contact.force[2]);
+        if (contact.contact_count > 0 && contact.penetration_volume == 0.0) ++face_contact_steps;
+        /* No node of the membrane under the sphere is above its centre: it has not come
+         * through, and it is not deeper in the sphere than a fraction of its radius. */
+        assert_ok(sh_body_get_positions(world, membrane, x, 3 * (int64_t)info.node_count));
+        for (int32_t k = 0; k < info.node_count; ++k) {
+            const double dx = x[3 * k] - cx, dy = x[3 * k + 1] - cy, dz = x[3 * k + 2] - p[2];
+            if (dx * dx + dy * dy < 0.0005 * 0.0005) assert_true(dz < 0.0);
+            assert_true(sqrt(dx * dx + dy * dy + dz * dz) > 0.5 * 0.0005);
+        }
+        printf("step %d: tool z %.1f mm, force %.4g N, %d contacts, depth %.3g mm, %d sub-steps\n", i, 1e3 * p[2],
+               contact.force[2], contact.contact_count, 1e3 * contact.max_depth, report.contact_substeps);
+    }
+    assert_true(peak > 0.0);
+    assert_true(face_contact_steps >= 1); /* the first touch is between nodes */
+    free(x);
+    free(rim);
+    assert_ok(sh_mesh_destroy(unit));
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* ---- Degenerate inputs and capacity -------------------------------------------------------- */
+
+static sh_status try_tool(sh_world* world, const sh_collider_def* def) {
+    sh_tool_id id = 0;
+    return sh_tool_create(world, def, &id);
+}
+
+static void test_invalid_shapes_are_rejected(void** state) {
+    (void)state;
+    sh_world* world = sh_test_world(-9.81);
+    sh_collider_def def;
+    sh_collider_def_default(&def);
+    def.shape.radius = 0.0;
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(sh_last_error_message(), "radius"));
+    sh_collider_def_default(&def);
+    def.shape.kind = SH_SHAPE_BOX;
+    def.shape.half_extents[0] = def.shape.half_extents[1] = 0.01;
+    def.shape.half_extents[2] = 0.0;
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(sh_last_error_message(), "half_extents"));
+    sh_collider_def_default(&def);
+    def.shape.kind = SH_SHAPE_PLANE;
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+    sh_collider_def_default(&def);
+    def.position[1] = NAN;
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+    sh_collider_def_default(&def);
+    def.shape.kind = SH_SHAPE_CONVEX;
+    const double same[12] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}; /* coincident points */
+    const double flat[12] = {0, 0, 0, 1e-2, 0, 0, 0, 1e-2, 0, 1e-2, 1e-2, 0}; /* one plane */
+    def.shape.points = same;
+    def.shape.point_count = 4;
+#ifdef SOFTHAP_TEST_WITH_CCD
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+    def.shape.points = flat;
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+    def.shape.point_count = 3;
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+#else
+    (void)flat;
+    assert_status(try_tool(world, &def), SH_ERR_UNSUPPORTED);
+#endif
+    sh_contact_params law;
+    sh_contact_params_default(&law);
+    sh_collider_def_default(&def);
+    def.contact.exponent = 0.5;
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(sh_last_error_message(), "exponent"));
+    sh_collider_def_default(&def);
+    def.contact.static_friction = 0.1;
+    def.contact.dynamic_friction = 0.2;
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+    sh_collider_def_default(&def);
+    def.contact.capacity = 0;
+    assert_status(try_tool(world, &def), SH_ERR_INVALID_ARGUMENT);
+    assert_ok(sh_world_destroy(world));
+}
+
+/* A particle exactly at a sphere tool's centre, on a box obstacle's face and a box exactly
+ * touching a body's face: finite forces, no NaN, zero force at zero depth. A NaN pose is
+ * refused and the tool keeps working; a destroyed tool's id is stale. */
+static void test_degenerate_contacts_stay_finite(void** state) {
+    (void)state;
+    sh_world* world = sh_test_world(0.0);
+    const sh_body_id p = particle(world, 1e-3, 0.0, 0.0, SH_INTEGRATOR_SYMPLECTIC_EULER);
+    sh_collider_def def;
+    sh_collider_def_default(&def); /* sphere at the origin: the particle is at its centre */
+    sh_tool_id tool = 0;
+    assert_ok(sh_tool_create(world, &def, &tool));
+    assert_ok(sh_world_step(world, 1e-5, NULL));
+    double x[3], v[3];
+    assert_ok(sh_body_get_positions(world, p, x, 3));
+    assert_ok(sh_body_get_velocities(world, p, v, 3));
+    for (int k = 0; k < 3; ++k) assert_true(isfinite(x[k]) && isfinite(v[k]));
+    sh_contact_state contact;
+    assert_ok(sh_tool_get_contact(world, tool, &contact));
+    assert_int_equal(contact.contact_count, 1);
+    assert_close(contact.max_depth, def.shape.radius, 0.01);
+
+    const double bad[3] = {0.0, NAN, 0.0}, q[4] = {1, 0, 0, 0}, zero_q[4] = {0, 0, 0, 0}, far[3] = {1, 1, 1};
+    assert_status(sh_tool_set_pose(world, tool, bad, q), SH_ERR_INVALID_ARGUMENT);
+    assert_status(sh_tool_set_pose(world, tool, far, zero_q), SH_ERR_INVALID_ARGUMENT);
+    assert_ok(sh_tool_set_pose(world, tool, far, q));
+    assert_ok(sh_world_step(world, 1e-5, NULL));
+    assert_ok(sh_tool_get_contact(world, tool, &contact));
+    assert_int_equal(contact.contact_count, 0);
+    assert_true(contact.force[0] == 0.0 && contact.force[1] == 0.0 && contact.force[2] == 0.0);
+    assert_ok(sh_tool_destroy(world, tool));
+    assert_int_equal(sh_tool_is_valid(world, tool), 0);
+    assert_status(sh_tool_set_pose(world, tool, far, q), SH_ERR_INVALID_HANDLE);
+    assert_status(sh_tool_destroy(world, tool), SH_ERR_INVALID_HANDLE);
+    assert_status(sh_obstacle_destroy(world, tool), SH_ERR_INVALID_HANDLE);
+
+    assert_ok(sh_world_destroy(world));
+
+    /* A box obstacle whose top face is exactly a cube's bottom face. */
+    world = sh_test_world(0.0);
+    const sh_body_id cube = fem_cube(world, 0.01, 2, -0.005, -0.005, 0.0, 3e4, SH_INTEGRATOR_SYMPLECTIC_EULER);
+    sh_collider_def_default(&def);
+    def.shape.kind = SH_SHAPE_BOX;
+    def.shape.half_extents[0] = def.shape.half_extents[1] = def.shape.half_extents[2] = 0.005;
+    def.position[2] = -0.005;
+    sh_obstacle_id box = 0;
+    assert_ok(sh_obstacle_create(world, &def, &box));
+    assert_ok(sh_world_step(world, 1e-5, NULL));
+    assert_ok(sh_obstacle_get_contact(world, box, &contact));
+    /* Zero depth up to the round-off of the box's frame (1e-23 m here): a force of that order. */
+    assert_true(fabs(contact.force[2]) < 1e-20 && contact.max_depth < 1e-20);
+    double* y = malloc(3 * sizeof(double) * 27);
+    assert_ok(sh_body_get_positions(world, cube, y, 81));
+    for (int k = 0; k < 81; ++k) assert_true(isfinite(y[k]));
+    free(y);
+    assert_ok(sh_world_destroy(world));
+}
+
+/* A flat box pressed into a cube's top with room for 5 contacts: 5 act, the deepest ones,
+ * and SH_WARN_CAPACITY is counted. */
+static void test_contact_capacity_keeps_the_deepest(void** state) {
+    (void)state;
+    double depth[2];
+    int32_t count[2];
+    uint64_t warnings[2][SH_WARN_COUNT];
+    for (int run = 0; run < 2; ++run) {
+        sh_world* world = sh_test_world(0.0);
+        const sh_body_id cube = fem_cube(world, 0.01, 4, -0.005, -0.005, -0.01, 3e4, SH_INTEGRATOR_SYMPLECTIC_EULER);
+        (void)cube;
+        sh_collider_def def;
+        sh_collider_def_default(&def);
+        def.shape.kind = SH_SHAPE_BOX;
+        def.shape.half_extents[0] = def.shape.half_extents[1] = 0.02;
+        def.shape.half_extents[2] = 0.005;
+        /* Tilted about x so that the nodes' depths differ. */
+        def.orientation[0] = cos(0.05);
+        def.orientation[1] = sin(0.05);
+        def.position[2] = 0.005 - 0.0002;
+        def.contact.capacity = run == 0 ? 5 : 4096;
+        sh_tool_id tool = 0;
+        assert_ok(sh_tool_create(world, &def, &tool));
+        sh_step_report report;
+        assert_ok(sh_world_step(world, 1e-6, &report));
+        sh_contact_state contact;
+        assert_ok(sh_tool_get_contact(world, tool, &contact));
+        depth[run] = contact.max_depth;
+        count[run] = contact.contact_count;
+        assert_ok(sh_world_get_warnings(world, warnings[run]));
+        assert_ok(sh_world_destroy(world));
+    }
+    printf("capacity 5: %d contacts, deepest %.4g mm; unlimited: %d contacts, deepest %.4g mm\n", count[0], 1e3 * depth[0],
+           count[1], 1e3 * depth[1]);
+    assert_int_equal(count[0], 5);
+    assert_true(count[1] > 5);
+    assert_close(depth[0], depth[1], 1e-9);
+    assert_int_equal(warnings[0][SH_WARN_CAPACITY], 1);
+    assert_int_equal(warnings[1][SH_WARN_CAPACITY], 0);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_impact_restitution_matches_hunt_crossley),
+        cmocka_unit_test(test_implicit_body_rests_on_stiff_plane),
+        cmocka_unit_test(test_tool_reaction_balances_the_plane),
+        cmocka_unit_test(test_fast_tool_does_not_pass_through_membrane),
+        cmocka_unit_test(test_invalid_shapes_are_rejected),
+        cmocka_unit_test(test_degenerate_contacts_stay_finite),
+        cmocka_unit_test(test_contact_capacity_keeps_the_deepest),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

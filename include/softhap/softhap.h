@@ -295,7 +295,10 @@ typedef enum sh_linear_solver {
 typedef struct sh_implicit_settings {
     sh_linear_solver linear_solver; /**< default SH_LINEAR_SOLVER_DEFAULT */
     int32_t newton_max_iterations;  /**< 1 = one linearised solve per step (default); more =
-                                         Newton iterations until newton_tolerance */
+                                         Newton iterations until newton_tolerance. A body with
+                                         contact candidates in a step always iterates (up to
+                                         max(20, this)): contacts that switch on within the
+                                         step would make a linearised step oscillate */
     double newton_tolerance;        /**< stop when the residual |g| <= tol max(|g_0|, dt |f_ext +
                                          m g|) or the velocity correction <= tol max(|v|, dt |g|,
                                          1e-9 m/s); default 1e-6 */
@@ -506,7 +509,7 @@ SH_API sh_status sh_body_write_vtu(const sh_world* world, sh_body_id body, const
 /* ------------------------------------------------------------------------------------------ */
 /* Tools, obstacles and contact                                                                 */
 
-/** Generation-checked id of a tool or an obstacle. 0 is the null id. */
+/** Generation-checked id of a tool. 0 is the null id. */
 typedef uint64_t sh_tool_id;
 
 /** Generation-checked id of a static obstacle. 0 is the null id. */
@@ -583,6 +586,11 @@ SH_API sh_status sh_tool_destroy(sh_world* world, sh_tool_id tool);
 /** 1 if tool is a live tool of world, else 0. Thread: sim. Alloc: none. */
 SH_API int32_t sh_tool_is_valid(const sh_world* world, sh_tool_id tool);
 
+/** Read the pose the next step takes the tool to (the last one set): position (m) and unit
+ *  quaternion (w, x, y, z). Thread: sim. Alloc: none. */
+SH_API sh_status sh_tool_get_pose(const sh_world* world, sh_tool_id tool, double position[3],
+                                  double orientation[4]);
+
 /** Pose the tool for the next sh_world_step: the step moves it from its last pose to this
  *  one (its velocity is the difference over dt unless set with sh_tool_set_velocity). A
  *  non-finite position or a quaternion that is not finite or is zero is
@@ -625,6 +633,9 @@ SH_API sh_status sh_obstacle_create(sh_world* world, const sh_collider_def* def,
 /** Remove an obstacle; its id becomes stale. Thread: sim. Alloc: none. */
 SH_API sh_status sh_obstacle_destroy(sh_world* world, sh_obstacle_id obstacle);
 
+/** 1 if obstacle is a live obstacle of world, else 0. Thread: sim. Alloc: none. */
+SH_API int32_t sh_obstacle_is_valid(const sh_world* world, sh_obstacle_id obstacle);
+
 /** Read an obstacle's reaction wrench and contact measures after the last step.
  *  Thread: sim. Alloc: none. */
 SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id obstacle,
@@ -633,7 +644,10 @@ SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id o
 /** Enable contact between two deformable bodies with params (NULL disables it): each step,
  *  the surface nodes of each body that lie inside the other's tets are pushed out through the
  *  other's nearest surface triangle, the reaction spread over that triangle's nodes. Both
- *  bodies must be FEM bodies of world, and different. Thread: sim. Alloc: may. */
+ *  bodies must be FEM bodies of world, and different. The bodies are stepped one after the
+ *  other, each against the other's latest state (staggered): stiff contact between two
+ *  implicit bodies can creep instead of settling, and sh_world_solve_static solves them in
+ *  turn rather than for a joint equilibrium. Thread: sim. Alloc: may. */
 SH_API sh_status sh_world_set_body_contact(sh_world* world, sh_body_id a, sh_body_id b,
                                            const sh_contact_params* params);
 

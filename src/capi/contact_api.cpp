@@ -78,6 +78,16 @@ SH_API sh_status sh_tool_set_pose(sh_world* world, sh_tool_id tool, const double
     });
 }
 
+SH_API sh_status sh_tool_get_pose(const sh_world* world, sh_tool_id tool, double position[3], double orientation[4]) {
+    return capi::guard([&] {
+        const Collider& c = capi::world_of(world).collider(tool, true);
+        capi::require_pointer(position, "position");
+        capi::require_pointer(orientation, "orientation");
+        for (int k = 0; k < 3; ++k) position[k] = c.target.p[k];
+        for (int k = 0; k < 4; ++k) orientation[k] = c.target.q[k];
+    });
+}
+
 SH_API sh_status sh_tool_set_velocity(sh_world* world, sh_tool_id tool, const double linear[3],
                                       const double angular[3]) {
     return capi::guard([&] {
@@ -123,6 +133,12 @@ SH_API sh_status sh_obstacle_create(sh_world* world, const sh_collider_def* def,
 
 SH_API sh_status sh_obstacle_destroy(sh_world* world, sh_obstacle_id obstacle) {
     return capi::guard([&] { capi::world_of(world).remove_collider(obstacle, false); });
+}
+
+SH_API int32_t sh_obstacle_is_valid(const sh_world* world, sh_obstacle_id obstacle) {
+    int32_t valid = 0;
+    capi::guard([&] { valid = capi::world_of(world).is_valid_collider(obstacle, false) ? 1 : 0; });
+    return valid;
 }
 
 SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id obstacle, sh_contact_state* out) {

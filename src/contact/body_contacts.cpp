@@ -122,7 +122,8 @@ BodyContacts::BodyContacts(const Body& body) : body_(body) {
         if (on_surface[i]) surface_nodes_.push_back(static_cast<int32_t>(i));
     if (tris.empty()) boxes_.resize(surface_nodes_.size());
     stamp_.assign(n, 0);
-    touching_.assign(n, 0);
+    node_depth_.assign(n, 0.0);
+    node_normal_.assign(3 * n, 0.0);
 }
 
 void BodyContacts::clear() {
@@ -314,14 +315,24 @@ bool BodyContacts::contact(const ContactCandidate& c, const double* x, const dou
             break;
         }
         case ContactCandidate::kFaceShape: {
-            for (int k = 0; k < 3; ++k)
-                if (touching_[static_cast<size_t>(c.face[k])]) return false;  // its nodes carry the contact
             Penetration pen;
             double w[3];
             if (!c.collider->shape.penetrate_triangle(c.collider->pose, at(x, c.face[0]), at(x, c.face[1]),
                                                       at(x, c.face[2]), pen, w))
                 return false;
+            // The face carries only the penetration its nodes' own contacts do not: all of it
+            // for a tool between nodes, little (the bulge between them) under a large tool.
             out.depth = pen.depth;
+            for (int k = 0; k < 3; ++k) out.depth -= w[k] * node_depth_[static_cast<size_t>(c.face[k])];
+            if (!(out.depth > 0.0)) return false;
+            // Moving node k changes that depth by -w_k (n - n_k) (n_k its own contact's
+            // normal, if any): under a large tool the face's force hardly changes with x. The
+            // tangent keeps this through a symmetric scale per node.
+            for (int k = 0; k < 3; ++k) {
+                const size_t node = static_cast<size_t>(c.face[k]);
+                const double along = node_depth_[node] > 0.0 ? dot(pen.normal, &node_normal_[3 * node]) : 0.0;
+                out.tangent_scale[k] = std::sqrt(std::max(0.0, 1.0 - along));
+            }
             for (int k = 0; k < 3; ++k) {
                 out.normal[k] = pen.normal[k];
                 out.point[k] = pen.point[k];
@@ -398,12 +409,15 @@ void BodyContacts::evaluate(const double* x, const double* v, Emit&& emit) const
             const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
             ContactPoint point;
             if (!contact(c, x, v, point)) continue;
-            if (c.kind == ContactCandidate::kNodeShape) touching_[static_cast<size_t>(c.node)] = 1;
+            if (c.kind == ContactCandidate::kNodeShape) {
+                node_depth_[static_cast<size_t>(c.node)] = point.depth;
+                for (int k = 0; k < 3; ++k) node_normal_[3 * static_cast<size_t>(c.node) + k] = point.normal[k];
+            }
             emit(c, point);
         }
         for (int32_t i = group.begin; i < group.end; ++i) {
             const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
-            if (c.kind == ContactCandidate::kNodeShape) touching_[static_cast<size_t>(c.node)] = 0;
+            if (c.kind == ContactCandidate::kNodeShape) node_depth_[static_cast<size_t>(c.node)] = 0.0;
         }
     }
 }
@@ -433,7 +447,7 @@ void BodyContacts::add_tangent(const double* x, const double* v, double stiffnes
             for (int b = a; b < p.count; ++b) {
                 const int32_t fb = free_index[p.nodes[b]];
                 if (fb < 0) continue;
-                system.add_block(fa, fb, block, p.weights[a] * p.weights[b]);
+                system.add_block(fa, fb, block, p.weights[a] * p.weights[b] * p.tangent_scale[a] * p.tangent_scale[b]);
             }
         }
     });

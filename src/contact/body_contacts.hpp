@@ -44,6 +44,7 @@ struct ContactPoint {
     double stiffness;    ///< dFn/dx (N/m)
     double damping;      ///< dFn/dx' (N s/m)
     double friction;     ///< viscous coefficient of the friction (N s/m)
+    double tangent_scale[3] = {1.0, 1.0, 1.0};  ///< per own node: share of the tangent it feels
 };
 
 /// The contact state of one body: surface, broad phase and candidates.
@@ -121,7 +122,8 @@ private:
     uint32_t pass_ = 0;
     vec<ContactCandidate> candidates_;
     vec<Group> groups_;
-    mutable vec<uint8_t> touching_;  ///< per node: in contact with the current group's collider
+    mutable vec<double> node_depth_; ///< per node: its depth in the current group's collider
+    mutable vec<double> node_normal_;///< per node: that contact's normal (3 per node)
     vec<double> keys_;               ///< scratch for keep_deepest
     mutable double evaluation_seconds_ = 0.0;
 };

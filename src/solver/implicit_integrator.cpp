@@ -20,6 +20,9 @@ constexpr double kSpeedFloor = 1e-9;
 constexpr double kStaleContraction = 0.5;
 constexpr int kMaxStaleSolves = 4;
 
+// Newton iterations allowed to a body with contact candidates, whatever its settings.
+constexpr int kContactNewtonIterations = 20;
+
 LinearSolverKind solver_kind(sh_linear_solver kind) {
     switch (kind) {
         case SH_LINEAR_SOLVER_CHOLMOD: return LinearSolverKind::Cholmod;
@@ -132,7 +135,9 @@ BodyStepResult attempt_step(Body& body, ImplicitState& state, double dt, const d
         return result;
     };
 
-    const int max_iterations = std::max(1, s.newton_max_iterations);
+    // Contacts switch on and off within a step, which a single linearised update cannot
+    // follow (it cycles between too deep and too shallow): a body in contact iterates.
+    const int max_iterations = std::max(body.field ? kContactNewtonIterations : 1, s.newton_max_iterations);
     const bool linearised = max_iterations == 1;
     double r = residual_norm(), r_max = largest_residual;
     const double residual0 = std::max(r, dt * applied_load);

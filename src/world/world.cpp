@@ -1,5 +1,6 @@
 #include "world/world.hpp"
 
+#include "collision/aabb_tree.hpp"
 #include "contact/body_contacts.hpp"
 #include "contact/collider.hpp"
 #include "core/error.hpp"
@@ -381,11 +382,20 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
             }
             for (Slot& slot : slots_)
                 if (slot.body) std::fill(slot.body->v.begin(), slot.body->v.end(), 0.0);
-            double reach = 0.0;
-            for (const ColliderSlot& c : colliders_)
-                if (c.collider && c.collider->shape.kind() != SH_SHAPE_PLANE) reach = std::max(reach, c.collider->shape.inner_radius());
-            detect_contacts(1.0, 0.0, reach);
         }
+        double reach = 0.0, extent = 0.0;
+        for (const ColliderSlot& c : colliders_)
+            if (c.collider && c.collider->shape.kind() != SH_SHAPE_PLANE) reach = std::max(reach, c.collider->shape.inner_radius());
+        for (const Slot& slot : slots_) {
+            if (!slot.body) continue;
+            Aabb box;
+            for (size_t j = 0; j < slot.body->x.size(); j += 3) box.add(&slot.body->x[j]);
+            for (int k = 0; k < 3; ++k) extent = std::max(extent, box.hi[k] - box.lo[k]);
+        }
+        reach = std::max(reach, 0.05 * extent);
+        // Bodies pressing on each other are solved one after the other, each against the
+        // others' current shape: not a joint equilibrium (see sh_world_set_body_contact).
+        if (has_contact()) detect_contacts(1.0, 0.0, reach);
         for (Slot& slot : slots_)
             if (slot.body) solve_static_body(*slot.body, gravity, def, r);
         if (has_contact()) finish_contacts();

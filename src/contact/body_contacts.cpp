@@ -489,8 +489,12 @@ int32_t BodyContacts::accumulate_reactions() {
         ++count;
         if (!c.collider) return;
         sh_contact_state& s = c.collider->state;
-        double r[3], torque[3];
-        sub(p.point, c.collider->pose.p, r);
+        // The force acts where the body's nodes take it: at the node, or at the weighted point
+        // of the face (the deepest point's projection, up to the clamping of its weights).
+        double applied[3] = {0.0, 0.0, 0.0}, r[3], torque[3];
+        for (int a = 0; a < p.count; ++a)
+            for (int k = 0; k < 3; ++k) applied[k] += p.weights[a] * body_.x[3 * static_cast<size_t>(p.nodes[a]) + k];
+        sub(applied, c.collider->pose.p, r);
         const double reaction[3] = {-p.force[0], -p.force[1], -p.force[2]};
         cross(r, reaction, torque);
         for (int k = 0; k < 3; ++k) {

@@ -6,8 +6,9 @@ simulation. They mirror the C API of include/softhap/softhap.h:
     with softhap.World(gravity=(0, 0, -9.81)) as world:
         body = world.add_fem_body(liver, model="corotational", young=5e3, poisson=0.45)
         body.fix_nodes([0, 1, 2])
+        tool = world.add_tool("sphere", radius=0.005, position=(0, 0, 0.1))
         report = world.step(1e-3)
-        print(report.substeps, body.positions[:3])
+        print(report.substeps, report.contact_count, tool.force, body.positions[:3])
 
 The C library is found through $SOFTHAP_LIBRARY, else libsofthap.so next to this package, else
 <repo>/build/libsofthap.so; importing refuses a library of another version. Every failing C
@@ -19,6 +20,7 @@ from ._lib import SH_VERSION, FeatureKind, Status, WarningKind, version_string
 from ._loaded import lib as _c_library
 from ._loaded import status_string
 from ._record import BodyInfo, MeshInfo, StaticReport, StepReport
+from .contact import ContactState, Obstacle, Tool
 from .mesh import Mesh
 from .world import Body, World
 
@@ -44,14 +46,17 @@ def build_features():
 __all__ = [
     "Body",
     "BodyInfo",
+    "ContactState",
     "Error",
     "FeatureKind",
     "Mesh",
     "MeshInfo",
+    "Obstacle",
     "SH_VERSION",
     "StaticReport",
     "Status",
     "StepReport",
+    "Tool",
     "WarningKind",
     "World",
     "build_features",

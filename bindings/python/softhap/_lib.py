@@ -121,10 +121,21 @@ SPRING_LAWS = {
     "table": 3,
 }
 
+SHAPE_KINDS = {
+    "sphere": 0,
+    "capsule": 1,
+    "box": 2,
+    "convex": 3,
+    "plane": 4,
+}
+
 # ------------------------------------------------------------------------------------------------
-# Structs. Enums are C ints; sh_body_id is uint64_t; opaque handles are void pointers.
+# Structs. Enums are C ints; sh_body_id, sh_tool_id and sh_obstacle_id are uint64_t; opaque
+# handles are void pointers.
 
 sh_body_id = c_uint64
+sh_tool_id = c_uint64
+sh_obstacle_id = c_uint64
 
 
 class sh_mesh_info(Structure):
@@ -174,6 +185,9 @@ class sh_step_report(Structure):
         ("factorizations", c_int32),
         ("error_estimate", c_double),
         ("error_estimate_seconds", c_double),
+        ("contact_count", c_int32),
+        ("collision_seconds", c_double),
+        ("contact_substeps", c_int32),
     ]
 
 
@@ -293,6 +307,58 @@ class sh_static_report(Structure):
     ]
 
 
+class sh_shape(Structure):
+    """Mirror of struct sh_shape."""
+
+    _fields_ = [
+        ("kind", c_int),
+        ("radius", c_double),
+        ("half_length", c_double),
+        ("half_extents", c_double * 3),
+        ("points", POINTER(c_double)),
+        ("point_count", c_int32),
+        ("normal", c_double * 3),
+    ]
+
+
+class sh_contact_params(Structure):
+    """Mirror of struct sh_contact_params."""
+
+    _fields_ = [
+        ("stiffness", c_double),
+        ("exponent", c_double),
+        ("damping", c_double),
+        ("static_friction", c_double),
+        ("dynamic_friction", c_double),
+        ("slip_velocity", c_double),
+        ("capacity", c_int32),
+    ]
+
+
+class sh_collider_def(Structure):
+    """Mirror of struct sh_collider_def."""
+
+    _fields_ = [
+        ("internal_init", c_uint32),
+        ("shape", sh_shape),
+        ("position", c_double * 3),
+        ("orientation", c_double * 4),
+        ("contact", sh_contact_params),
+    ]
+
+
+class sh_contact_state(Structure):
+    """Mirror of struct sh_contact_state."""
+
+    _fields_ = [
+        ("force", c_double * 3),
+        ("torque", c_double * 3),
+        ("contact_count", c_int32),
+        ("max_depth", c_double),
+        ("penetration_volume", c_double),
+    ]
+
+
 # Every struct the header declares that the bindings use, by C name (for the layout test).
 STRUCTS = {
     "sh_mesh_info": sh_mesh_info,
@@ -306,6 +372,10 @@ STRUCTS = {
     "sh_implicit_settings": sh_implicit_settings,
     "sh_static_def": sh_static_def,
     "sh_static_report": sh_static_report,
+    "sh_shape": sh_shape,
+    "sh_contact_params": sh_contact_params,
+    "sh_collider_def": sh_collider_def,
+    "sh_contact_state": sh_contact_state,
 }
 
 # ------------------------------------------------------------------------------------------------
@@ -368,6 +438,28 @@ PROTOTYPES = {
     "sh_body_get_elastic_forces": (_status, [_handle, sh_body_id, _pd, c_int64]),
     "sh_body_get_elastic_energy": (_status, [_handle, sh_body_id, _pd]),
     "sh_body_write_vtu": (_status, [_handle, sh_body_id, c_char_p]),
+    # tools, obstacles and contact
+    "sh_contact_params_default": (None, [POINTER(sh_contact_params)]),
+    "sh_collider_def_default": (None, [POINTER(sh_collider_def)]),
+    "sh_tool_create": (_status, [_handle, POINTER(sh_collider_def), POINTER(sh_tool_id)]),
+    "sh_tool_destroy": (_status, [_handle, sh_tool_id]),
+    "sh_tool_is_valid": (c_int32, [_handle, sh_tool_id]),
+    "sh_tool_set_pose": (_status, [_handle, sh_tool_id, _pd, _pd]),
+    "sh_tool_get_pose": (_status, [_handle, sh_tool_id, _pd, _pd]),
+    "sh_tool_set_velocity": (_status, [_handle, sh_tool_id, _pd, _pd]),
+    "sh_tool_get_contact": (_status, [_handle, sh_tool_id, POINTER(sh_contact_state)]),
+    "sh_tool_get_wrench": (_status, [_handle, sh_tool_id, _pd, _pd]),
+    "sh_obstacle_create": (
+        _status,
+        [_handle, POINTER(sh_collider_def), POINTER(sh_obstacle_id)],
+    ),
+    "sh_obstacle_destroy": (_status, [_handle, sh_obstacle_id]),
+    "sh_obstacle_is_valid": (c_int32, [_handle, sh_obstacle_id]),
+    "sh_obstacle_get_contact": (_status, [_handle, sh_obstacle_id, POINTER(sh_contact_state)]),
+    "sh_world_set_body_contact": (
+        _status,
+        [_handle, sh_body_id, sh_body_id, POINTER(sh_contact_params)],
+    ),
     # static equilibrium
     "sh_static_def_default": (None, [POINTER(sh_static_def)]),
     "sh_world_solve_static": (

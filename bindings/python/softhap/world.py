@@ -10,21 +10,27 @@ from ._lib import (
     LINEAR_SOLVERS,
     MATERIAL_MODELS,
     SH_WARN_COUNT,
+    SHAPE_KINDS,
     SPRING_LAWS,
     UNSTABLE_POLICIES,
     WarningKind,
     sh_body_id,
     sh_body_info,
+    sh_collider_def,
+    sh_contact_params,
     sh_fem_body_def,
     sh_spring_body_def,
     sh_static_def,
     sh_static_report,
+    sh_obstacle_id,
     sh_step_report,
+    sh_tool_id,
     sh_world_def,
 )
 from ._handle import OwnedHandle
 from ._loaded import check, closed_error, lib
 from ._record import BodyInfo, StaticReport, StepReport, record_of
+from .contact import Obstacle, Tool
 from .mesh import Mesh
 
 # Which sh_spring_params fields each law reads (damping is read by every law).
@@ -33,6 +39,15 @@ _SPRING_LAW_PARAMETERS = {
     "cubic": ("lambda1", "lambda2", "damping"),
     "hyperbolic": ("a", "b", "damping"),
     "table": ("table", "damping"),
+}
+
+# Which sh_shape fields each shape kind reads.
+_SHAPE_PARAMETERS = {
+    "sphere": ("radius",),
+    "capsule": ("radius", "half_length"),
+    "box": ("half_extents",),
+    "convex": ("points",),
+    "plane": ("normal",),
 }
 
 
@@ -96,6 +111,15 @@ _IMPLICIT_FIELDS = {
     "cg_max_iterations": _int32("cg_max_iterations"),
     "factor_reuse": float,
 }
+_CONTACT_FIELDS = {
+    "stiffness": float,
+    "exponent": float,
+    "damping": float,
+    "static_friction": float,
+    "dynamic_friction": float,
+    "slip_velocity": float,
+    "capacity": _int32("capacity"),
+}
 _STATIC_FIELDS = {
     "tolerance": float,
     "max_iterations": _int32("max_iterations"),
@@ -118,6 +142,74 @@ def _set_body_options(definition, arguments):
     settings) from a method's keyword arguments."""
     _fill(definition, _BODY_FIELDS, arguments)
     _fill(definition.implicit, _IMPLICIT_FIELDS, arguments)
+
+
+def _contact_arguments(arguments):
+    """The sh_contact_params keyword arguments of a method, with the shorthand friction=mu
+    turned into static_friction = dynamic_friction = mu."""
+    arguments = dict(arguments)
+    friction = arguments.get("friction")
+    if friction is not None:
+        for name in ("static_friction", "dynamic_friction"):
+            if arguments.get(name) is not None:
+                raise ValueError(
+                    "friction= sets both static_friction and dynamic_friction; give either "
+                    "friction= or %s=, not both" % name
+                )
+            arguments[name] = friction
+    return arguments
+
+
+def _contact_params(arguments):
+    """An sh_contact_params with the C defaults of sh_contact_params_default, the fields named
+    in arguments (not None) replaced."""
+    params = sh_contact_params()
+    lib.sh_contact_params_default(ctypes.byref(params))
+    _fill(params, _CONTACT_FIELDS, _contact_arguments(arguments))
+    return params
+
+
+def _collider_def(kind, arguments, position, orientation):
+    """An sh_collider_def (C defaults of sh_collider_def_default) of shape kind with the shape
+    fields and contact law in arguments, at position and orientation (None keeps the default).
+    Returns (def, arrays): arrays must stay alive until the create call returns (the def points
+    into them)."""
+    definition = sh_collider_def()
+    lib.sh_collider_def_default(ctypes.byref(definition))
+    shape = definition.shape
+    shape.kind = _choose(kind, SHAPE_KINDS, "kind")
+    accepted = _SHAPE_PARAMETERS[kind]
+    for name in ("radius", "half_length", "half_extents", "points", "normal"):
+        if arguments.get(name) is not None and name not in accepted:
+            raise ValueError(
+                "%s= is not a parameter of a %r shape (it takes: %s)"
+                % (name, kind, ", ".join(p + "=" for p in accepted))
+            )
+    arrays = []
+    if arguments.get("radius") is not None:
+        shape.radius = float(arguments["radius"])
+    if arguments.get("half_length") is not None:
+        shape.half_length = float(arguments["half_length"])
+    for name in ("half_extents", "normal"):
+        if arguments.get(name) is not None:
+            value = _arrays.float_array(arguments[name], name, (3,))
+            for k in range(3):
+                getattr(shape, name)[k] = value[k]
+    if arguments.get("points") is not None:
+        points = _arrays.float_array(arguments["points"], "points", (None, 3))
+        arrays.append(points)
+        shape.points = _arrays.double_ptr(points)
+        shape.point_count = _arrays.count(points.shape[0], "point count")
+    if position is not None:
+        position = _arrays.float_array(position, "position", (3,))
+        for k in range(3):
+            definition.position[k] = position[k]
+    if orientation is not None:
+        orientation = _arrays.float_array(orientation, "orientation", (4,))
+        for k in range(4):
+            definition.orientation[k] = orientation[k]
+    _fill(definition.contact, _CONTACT_FIELDS, _contact_arguments(arguments))
+    return definition, arrays
 
 
 def _default_material():
@@ -197,7 +289,10 @@ class World(OwnedHandle):
     def step(self, dt):
         """Advance every body by dt seconds and return the StepReport (a dict with attribute
         access: wall_seconds, substeps, dt_critical, kinetic_energy, elastic_energy,
-        potential_energy, warnings (set of names), warning_bits, unstable_body_count).
+        potential_energy, warnings (set of names), warning_bits, unstable_body_count, ...;
+        with tools or obstacles: contact_count (contact points at the step's end state),
+        collision_seconds and contact_substeps (sub-steps taken so that no tool moves more
+        than half its inner radius at once; 1 = none)).
 
         If a body's step failed (rejected or rolled back: SH_ERR_UNSTABLE; an implicit body's
         SH_ERR_SOLVER or SH_ERR_NOT_CONVERGED) that body is as before and the other bodies still
@@ -395,6 +490,165 @@ class World(OwnedHandle):
         status = lib.sh_world_add_spring_body(handle, ctypes.byref(definition), ctypes.byref(body))
         check(status, "sh_world_add_spring_body")
         return Body(self, body.value)
+
+    def _own_body(self, body, name):
+        if not isinstance(body, Body):
+            raise TypeError("%s must be a softhap.Body, got %s" % (name, type(body).__name__))
+        if body.world is not self:
+            raise ValueError("%r belongs to another world" % (body,))
+        return body.id
+
+    # -- tools, obstacles and contact -------------------------------------------------------
+
+    def add_tool(
+        self,
+        kind,
+        radius=None,
+        half_length=None,
+        half_extents=None,
+        points=None,
+        position=(0.0, 0.0, 0.0),
+        orientation=(1.0, 0.0, 0.0, 0.0),
+        stiffness=None,
+        exponent=None,
+        damping=None,
+        static_friction=None,
+        dynamic_friction=None,
+        slip_velocity=None,
+        capacity=None,
+        friction=None,
+    ):
+        """Add a rigid tool posed by the host (sh_tool_create) and return its Tool.
+
+        kind and its shape parameters (only the kind's are accepted; None keeps the C default
+        of sh_collider_def_default):
+            "sphere": radius (m, default 5 mm), centred on the pose;
+            "capsule": radius and half_length (m, default 0) of the segment along local z;
+            "box": half_extents, 3 half widths along the local axes (m);
+            "convex": points, an (n, 3) array (m, local frame, n >= 4, not all in one plane;
+            needs a library built with libccd, else SH_ERR_UNSUPPORTED);
+            "plane" is an obstacle only: the C library rejects it as a tool.
+        position (m, world) and orientation (unit quaternion (w, x, y, z)): the initial pose.
+        The contact law against every body (sh_contact_params; None keeps the C default):
+            stiffness lambda (N/m^n, default 1e4), exponent n (default 1.5), damping alpha
+            (s/m, default 0.2) of the Hunt-Crossley force F = lambda x^n (1 + 3/2 alpha x');
+            static_friction mu_s and dynamic_friction mu_d (default 0; mu_s >= mu_d is
+            required, so set both, or use friction=mu for mu_s = mu_d = mu); slip_velocity
+            (m/s, default 1e-3) below which friction is viscous; capacity (most contact points
+            kept per step, default 4096).
+        Unknown names raise ValueError; invalid values raise softhap.Error
+        (SH_ERR_INVALID_ARGUMENT, the message naming the field).
+        """
+        arguments = dict(locals())
+        handle = self._require_handle("sh_tool_create")
+        definition, arrays = _collider_def(kind, arguments, position, orientation)
+        tool = sh_tool_id()
+        check(
+            lib.sh_tool_create(handle, ctypes.byref(definition), ctypes.byref(tool)),
+            "sh_tool_create",
+        )
+        del arrays  # the C library has copied the points
+        return Tool(self, tool.value)
+
+    def add_obstacle(
+        self,
+        kind,
+        point=None,
+        normal=None,
+        center=None,
+        half_extents=None,
+        orientation=None,
+        radius=None,
+        half_length=None,
+        points=None,
+        stiffness=None,
+        exponent=None,
+        damping=None,
+        static_friction=None,
+        dynamic_friction=None,
+        slip_velocity=None,
+        capacity=None,
+        friction=None,
+    ):
+        """Add a static rigid obstacle (sh_obstacle_create) and return its Obstacle.
+
+        kind and its placement and shape (only the kind's are accepted; None keeps the C
+        default of sh_collider_def_default):
+            "plane": point (m, default the origin) on the plane and its outward normal
+            (default (0, 0, 1)); the obstacle is the half-space behind it;
+            "sphere": radius (m, default 5 mm); "capsule": radius and half_length (m) of the
+            segment along local z; "box": half_extents (3 half widths, m); "convex": points,
+            an (n, 3) array (m, local frame, n >= 4, not all in one plane; needs libccd);
+            each with center (m, world, default the origin) and orientation (unit quaternion
+            (w, x, y, z), default (1, 0, 0, 0)).
+        The contact law (stiffness, exponent, damping, static_friction, dynamic_friction,
+        friction, slip_velocity, capacity): as World.add_tool.
+        Unknown names raise ValueError; invalid values raise softhap.Error.
+        """
+        arguments = dict(locals())
+        handle = self._require_handle("sh_obstacle_create")
+        if kind == "plane":
+            for name in ("center", "orientation"):
+                if arguments[name] is not None:
+                    raise ValueError(
+                        "%s= is not a parameter of a 'plane' obstacle (it takes: point=, "
+                        "normal=)" % name
+                    )
+            position = point
+        else:
+            if point is not None:
+                raise ValueError(
+                    "point= is a parameter of a 'plane' obstacle only; a %r obstacle is placed "
+                    "with center= and orientation=" % (kind,)
+                )
+            position = center
+        definition, arrays = _collider_def(kind, arguments, position, orientation)
+        obstacle = sh_obstacle_id()
+        check(
+            lib.sh_obstacle_create(handle, ctypes.byref(definition), ctypes.byref(obstacle)),
+            "sh_obstacle_create",
+        )
+        del arrays  # the C library has copied the points
+        return Obstacle(self, obstacle.value)
+
+    def set_body_contact(
+        self,
+        body_a,
+        body_b,
+        stiffness=None,
+        exponent=None,
+        damping=None,
+        static_friction=None,
+        dynamic_friction=None,
+        slip_velocity=None,
+        capacity=None,
+        friction=None,
+    ):
+        """Enable contact between two different FEM bodies of this world with the given
+        contact law (sh_world_set_body_contact; keywords as World.add_tool, None keeping the C
+        default of sh_contact_params_default); calling it again replaces the law. Each step
+        the surface nodes of each body inside the other are pushed out through the other's
+        nearest surface triangle. A mass-spring body raises softhap.Error (SH_ERR_UNSUPPORTED).
+        """
+        arguments = dict(locals())
+        handle = self._require_handle("sh_world_set_body_contact")
+        a = self._own_body(body_a, "body_a")
+        b = self._own_body(body_b, "body_b")
+        params = _contact_params(arguments)
+        check(
+            lib.sh_world_set_body_contact(handle, a, b, ctypes.byref(params)),
+            "sh_world_set_body_contact",
+        )
+
+    def clear_body_contact(self, body_a, body_b):
+        """Disable contact between two bodies (sh_world_set_body_contact with NULL params); a
+        pair without contact is left as it is."""
+        handle = self._require_handle("sh_world_set_body_contact")
+        a = self._own_body(body_a, "body_a")
+        b = self._own_body(body_b, "body_b")
+        check(lib.sh_world_set_body_contact(handle, a, b, None), "sh_world_set_body_contact")
+
+    # -- removal ------------------------------------------------------------------------------
 
     def remove_body(self, body):
         """Destroy body; its id becomes stale (using the Body afterwards raises softhap.Error with

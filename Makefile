@@ -4,7 +4,7 @@ PYTHON ?= python3
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-c test-python test-reduced demo bench report clean
+.PHONY: all deps build test test-c test-python test-reduced demo palpation bench report clean
 
 all: build
 
@@ -32,6 +32,11 @@ test-reduced: deps
 
 demo: build
 	$(BUILD)/examples/liver_sag
+
+# A sphere tool presses into the liver on a table, slides and lifts off (~5 s): CSV of the tool
+# force on stdout, a summary on stderr.
+palpation: build
+	$(BUILD)/examples/palpation
 
 bench: build
 	$(BUILD)/bench/softhap_bench

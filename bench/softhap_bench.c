@@ -4,6 +4,7 @@
  *   softhap_bench [FILTER] [--steps N] [--meshes DIR]      FEM materials and springs
  *   softhap_bench integrators [FILTER] [--steps N]          forward/symplectic Euler, RK2, RK4
  *   softhap_bench implicit [FILTER] [--steps N]             implicit Euler step, direct vs CG
+ *   softhap_bench contact [FILTER] [--steps N]              collision and contact time per step
  *   softhap_bench accuracy [--quick] [--jobs N]             error against run time (accuracy.c)
  *
  * Each case builds a world with one body from a mesh in ../shared/meshes (scaled so its largest
@@ -114,9 +115,10 @@ static int cmp_node_height(const void* a, const void* b) {
     return za > zb ? -1 : za < zb;
 }
 
-static int load_mesh(const char* name, bench_mesh* m) {
+/* Loads g_mesh_dir/file as m, named name. */
+static int load_mesh_file(const char* file, const char* name, bench_mesh* m) {
     char path[4096];
-    snprintf(path, sizeof path, "%s/%s.vtu", g_mesh_dir, name);
+    snprintf(path, sizeof path, "%s/%s", g_mesh_dir, file);
     sh_mesh* raw = NULL;
     if (sh_mesh_load(path, &raw) != SH_OK) {
         fprintf(stderr, "softhap_bench: cannot load %s: %s\n", path, sh_last_error_message());
@@ -165,6 +167,13 @@ static int load_mesh(const char* name, bench_mesh* m) {
     m->mean_edge = sum / m->edge_count;
     free(edges);
     return 1;
+}
+
+/* Loads g_mesh_dir/<name>.vtu. */
+static int load_mesh(const char* name, bench_mesh* m) {
+    char file[1024];
+    snprintf(file, sizeof file, "%s.vtu", name);
+    return load_mesh_file(file, name, m);
 }
 
 static void free_mesh(bench_mesh* m) {
@@ -455,11 +464,171 @@ static void run_implicit(const char* filter) {
     free_mesh(&m);
 }
 
+/* Collision detection and contact forces per step against mesh size. Each mesh (scaled so its
+ * largest extent is kMeshSize, lowest point at z = 0) is a free StVK body (no fixed nodes) on a
+ * plane obstacle through z = kContactTablePress (so the nodes of its lowest kContactTablePress
+ * start in contact), with a sphere tool of radius kContactToolRadius pressed kContactToolPress
+ * into its highest surface node; both with friction (table mu 0.5 / 0.4, tool 0.3 / 0.2).
+ * Symplectic Euler at dt = kDtFraction * dt_crit (the material's critical step; "substeps" says
+ * whether the contacts made it sub-step). The tool is posed at the same place every step. After
+ * kWarmupSteps (the first one builds the surface trees), each step is timed on its own with a
+ * step report: wall time around sh_world_step (the report adds its energy passes), and from the
+ * report collision_seconds (detection, contact forces in every sub-step, reactions) and
+ * contact_count. The run covers well under a millisecond of simulated time: the body as a whole
+ * barely moves, but the pressed surface nodes are light and their contacts undamped, so they
+ * bounce in and out of contact (contact_count_min and _max show how much). The same body in a
+ * world without tool and obstacle, stepped the same way, gives "no_contact_median_us". */
+static const double kContactTablePress = 5e-4;  /* m */
+static const double kContactToolRadius = 0.01;  /* m */
+static const double kContactToolPress = 2e-3;   /* m */
+/* Hunt-Crossley stiffness of both (N/m^1.5), without damping: the surface nodes of the finer
+ * meshes weigh micrograms, and a contact's damping (its dashpot at the anticipated depth) would
+ * cut the stable explicit step to a small fraction of dt, so the step would sub-step and the
+ * time would measure the sub-steps rather than the contact. */
+static const double kContactStiffness = 1e4;
+
+/* Per-step samples of one contact run. */
+typedef struct {
+    double* wall;      /* ns, sorted */
+    double* collision; /* ns, sorted */
+    double* contacts;  /* sorted */
+    int substeps, contact_substeps, failed;
+    double dt;
+} contact_run;
+
+/* Steps m's body (with the table and the tool if colliders) and fills r. */
+static void run_contact_world(const bench_mesh* m, int colliders, int steps, const char* name, contact_run* r) {
+    sh_world_def wd;
+    sh_world_def_default(&wd);
+    sh_world* world = NULL;
+    CHECK(sh_world_create(&wd, &world));
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = m->mesh;
+    def.material.model = SH_MATERIAL_STVK;
+    def.material.young = kYoung;
+    def.material.poisson = kPoisson;
+    def.material.density = kDensity;
+    def.integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
+    def.on_unstable = SH_UNSTABLE_SUBSTEP;
+    sh_body_id body;
+    CHECK(sh_world_add_fem_body(world, &def, &body));
+    r->dt = kDtFraction * body_dt_crit(world, body);
+
+    sh_tool_id tool = 0;
+    sh_collider_def tool_def;
+    sh_collider_def_default(&tool_def);
+    if (colliders) {
+        sh_collider_def table;
+        sh_collider_def_default(&table);
+        table.shape.kind = SH_SHAPE_PLANE; /* normal +z */
+        table.position[2] = kContactTablePress;
+        table.contact.stiffness = kContactStiffness;
+        table.contact.damping = 0.0;
+        table.contact.static_friction = 0.5;
+        table.contact.dynamic_friction = 0.4;
+        sh_obstacle_id obstacle;
+        CHECK(sh_obstacle_create(world, &table, &obstacle));
+
+        /* The highest surface node. */
+        const int32_t tri_count = m->info.surface_triangle_count;
+        int32_t* tris = (int32_t*)xmalloc(sizeof(int32_t) * 3 * (size_t)tri_count);
+        CHECK(sh_mesh_get_surface_triangles(m->mesh, tris, 3 * (int64_t)tri_count));
+        int32_t top = tris[0];
+        for (int32_t i = 1; i < 3 * tri_count; ++i)
+            if (m->rest[3 * tris[i] + 2] > m->rest[3 * top + 2]) top = tris[i];
+        free(tris);
+        tool_def.shape.kind = SH_SHAPE_SPHERE;
+        tool_def.shape.radius = kContactToolRadius;
+        for (int c = 0; c < 3; ++c) tool_def.position[c] = m->rest[3 * top + c];
+        tool_def.position[2] += kContactToolRadius - kContactToolPress;
+        tool_def.contact.stiffness = kContactStiffness;
+        tool_def.contact.damping = 0.0;
+        tool_def.contact.static_friction = 0.3;
+        tool_def.contact.dynamic_friction = 0.2;
+        CHECK(sh_tool_create(world, &tool_def, &tool));
+    }
+    const double orientation[4] = {1.0, 0.0, 0.0, 0.0};
+
+    r->wall = (double*)xmalloc(sizeof(double) * (size_t)steps);
+    r->collision = (double*)xmalloc(sizeof(double) * (size_t)steps);
+    r->contacts = (double*)xmalloc(sizeof(double) * (size_t)steps);
+    r->failed = 0;
+    r->substeps = r->contact_substeps = 1;
+    sh_step_report report;
+    for (int s = -kWarmupSteps; s < steps; ++s) {
+        if (colliders) CHECK(sh_tool_set_pose(world, tool, tool_def.position, orientation));
+        const double t0 = now_ns();
+        const sh_status st = sh_world_step(world, r->dt, &report);
+        const double ns = now_ns() - t0;
+        if (st != SH_OK) {
+            if (!r->failed) fprintf(stderr, "softhap_bench: %s step %d: %s\n", name, s, sh_last_error_message());
+            ++r->failed;
+        }
+        if (s < 0) continue;
+        r->wall[s] = ns;
+        r->collision[s] = report.collision_seconds * 1e9;
+        r->contacts[s] = report.contact_count;
+        if (report.substeps > r->substeps) r->substeps = report.substeps;
+        if (report.contact_substeps > r->contact_substeps) r->contact_substeps = report.contact_substeps;
+    }
+    qsort(r->wall, (size_t)steps, sizeof(double), cmp_double);
+    qsort(r->collision, (size_t)steps, sizeof(double), cmp_double);
+    qsort(r->contacts, (size_t)steps, sizeof(double), cmp_double);
+    CHECK(sh_world_destroy(world));
+}
+
+static void free_contact_run(contact_run* r) {
+    free(r->wall);
+    free(r->collision);
+    free(r->contacts);
+}
+
+static void run_contact(const char* filter) {
+    static const struct {
+        const char* name;
+        const char* file;
+    } kContactMeshes[] = {{"liver", "liver.msh"},
+                          {"liver2", "liver2.msh"},
+                          {"Armadillo_Tetra_4406", "Armadillo_Tetra_4406.vtu"},
+                          {"raptorTetra_8418", "raptorTetra_8418.vtu"},
+                          {"raptorTetra_19409", "raptorTetra_19409.vtu"}};
+    const int steps = g_steps > 0 ? g_steps : 200;
+    for (size_t k = 0; k < sizeof kContactMeshes / sizeof kContactMeshes[0]; ++k) {
+        char name[256];
+        snprintf(name, sizeof name, "contact/%s", kContactMeshes[k].name);
+        if (!matches(name, filter)) continue;
+        bench_mesh m;
+        if (!load_mesh_file(kContactMeshes[k].file, kContactMeshes[k].name, &m)) continue; /* message printed */
+        contact_run base, r;
+        run_contact_world(&m, 0, steps, name, &base);
+        run_contact_world(&m, 1, steps, name, &r);
+        const double wall_median = median(r.wall, steps), collision_median = median(r.collision, steps);
+        printf("{\"case\":\"%s\",\"mesh\":\"%s\",\"tets\":%d,\"surface_triangles\":%d,\"nodes\":%d,"
+               "\"contact_count\":%g,\"contact_count_min\":%g,\"contact_count_max\":%g,"
+               "\"collision_median_us\":%.2f,\"collision_p99_us\":%.2f,\"collision_p999_us\":%.2f,"
+               "\"median_us\":%.2f,\"p99_us\":%.2f,\"p999_us\":%.2f,\"no_contact_median_us\":%.2f,"
+               "\"collision_share\":%.3f,\"collision_ns_per_surface_triangle\":%.2f,\"substeps\":%d,"
+               "\"contact_substeps\":%d,\"steps\":%d,\"failed_steps\":%d,\"dt\":%.4g,\"dt_crit\":%.4g}\n",
+               name, m.name, m.info.tet_count, m.info.surface_triangle_count, m.info.node_count,
+               median(r.contacts, steps), r.contacts[0], r.contacts[steps - 1], collision_median * 1e-3,
+               quantile(r.collision, steps, 0.99) * 1e-3, quantile(r.collision, steps, 0.999) * 1e-3,
+               wall_median * 1e-3, quantile(r.wall, steps, 0.99) * 1e-3, quantile(r.wall, steps, 0.999) * 1e-3,
+               median(base.wall, steps) * 1e-3, collision_median / wall_median,
+               collision_median / m.info.surface_triangle_count, r.substeps, r.contact_substeps, steps,
+               r.failed + base.failed, r.dt, r.dt / kDtFraction);
+        fflush(stdout);
+        free_contact_run(&base);
+        free_contact_run(&r);
+        free_mesh(&m);
+    }
+}
+
 static void usage(void) {
     fprintf(stderr,
-            "usage: softhap_bench [integrators|implicit] [FILTER] [--steps N] [--meshes DIR]\n"
+            "usage: softhap_bench [integrators|implicit|contact] [FILTER] [--steps N] [--meshes DIR]\n"
             "  FILTER  keep the cases whose name contains it (e.g. stvk/raptorTetra_19409)\n"
-            "  --steps N  timed steps per case (default: adaptive, %d..%d)\n"
+            "  --steps N  timed steps per case (default: adaptive, %d..%d; implicit 100, contact 200)\n"
             "  --meshes DIR  mesh folder (default $SOFTHAP_MESHES, " SOFTHAP_BENCH_MESH_DIR
             ", ../shared/meshes)\n",
             kMinSteps, kMaxSteps);
@@ -476,7 +645,7 @@ static int file_exists(const char* dir, const char* name) {
 int main(int argc, char** argv) {
     if (argc > 1 && strcmp(argv[1], "accuracy") == 0) return run_accuracy(argc - 1, argv + 1);
     const char* filter = NULL;
-    int integrators = 0, implicit = 0;
+    int integrators = 0, implicit = 0, contact = 0;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
             g_steps = atoi(argv[++i]);
@@ -491,10 +660,12 @@ int main(int argc, char** argv) {
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage();
             return 0;
-        } else if (strcmp(argv[i], "integrators") == 0 && !integrators && !implicit) {
+        } else if (strcmp(argv[i], "integrators") == 0 && !integrators && !implicit && !contact) {
             integrators = 1;
-        } else if (strcmp(argv[i], "implicit") == 0 && !integrators && !implicit) {
+        } else if (strcmp(argv[i], "implicit") == 0 && !integrators && !implicit && !contact) {
             implicit = 1;
+        } else if (strcmp(argv[i], "contact") == 0 && !integrators && !implicit && !contact) {
+            contact = 1;
         } else if (!filter && argv[i][0] != '-') {
             filter = argv[i];
         } else {
@@ -533,6 +704,10 @@ int main(int argc, char** argv) {
     }
     if (implicit) {
         run_implicit(filter);
+        return 0;
+    }
+    if (contact) {
+        run_contact(filter);
         return 0;
     }
     for (size_t k = 0; k < sizeof kMeshes / sizeof kMeshes[0]; ++k) {

@@ -123,7 +123,6 @@ BodyContacts::BodyContacts(const Body& body) : body_(body) {
     if (tris.empty()) boxes_.resize(surface_nodes_.size());
     stamp_.assign(n, 0);
     node_depth_.assign(n, 0.0);
-    node_normal_.assign(3 * n, 0.0);
 }
 
 void BodyContacts::clear() {
@@ -291,9 +290,19 @@ bool BodyContacts::keep_deepest(Group& group, int32_t capacity) {
 
 bool BodyContacts::contact(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const {
     const sh_contact_params& p = *c.params;
-    double vrel[3] = {0.0, 0.0, 0.0};
-    double touched_mass = INFINITY;  // smallest own mass the friction acts on
+    double vrel[3] = {0.0, 0.0, 0.0};  // velocity of the node side relative to the other side
+    double touched_mass = INFINITY;    // smallest own mass the friction acts on
     const double* mass = body_.mass.data();
+    auto set_nodes = [&](int count, const int32_t* nodes, const double* weights) {
+        out.count = count;
+        for (int a = 0; a < count; ++a) {
+            out.nodes[a] = nodes[a];
+            out.weights[a] = weights[a];
+            for (int k = 0; k < 3; ++k) out.gradient[a][k] = weights[a] * out.normal[k];
+            touched_mass = std::min(touched_mass, mass[nodes[a]]);
+        }
+    };
+    const double one = 1.0;
     switch (c.kind) {
         case ContactCandidate::kNodeShape: {
             Penetration pen;
@@ -303,10 +312,7 @@ bool BodyContacts::contact(const ContactCandidate& c, const double* x, const dou
                 out.normal[k] = pen.normal[k];
                 out.point[k] = pen.point[k];
             }
-            out.count = 1;
-            out.nodes[0] = c.node;
-            out.weights[0] = 1.0;
-            touched_mass = mass[c.node];
+            set_nodes(1, &c.node, &one);
             if (v) {
                 double vc[3];
                 c.collider->point_velocity(out.point, vc);
@@ -320,27 +326,16 @@ bool BodyContacts::contact(const ContactCandidate& c, const double* x, const dou
             if (!c.collider->shape.penetrate_triangle(c.collider->pose, at(x, c.face[0]), at(x, c.face[1]),
                                                       at(x, c.face[2]), pen, w))
                 return false;
-            // The face carries only the penetration its nodes' own contacts do not: all of it
-            // for a tool between nodes, little (the bulge between them) under a large tool.
+            // A tool between the nodes: once one of them touches the same collider, the node
+            // contacts carry it (their constraint is what the mesh can resolve).
+            for (int k = 0; k < 3; ++k)
+                if (node_depth_[static_cast<size_t>(c.face[k])] > 0.0) return false;
             out.depth = pen.depth;
-            for (int k = 0; k < 3; ++k) out.depth -= w[k] * node_depth_[static_cast<size_t>(c.face[k])];
-            if (!(out.depth > 0.0)) return false;
-            // Moving node k changes that depth by -w_k (n - n_k) (n_k its own contact's
-            // normal, if any): under a large tool the face's force hardly changes with x. The
-            // tangent keeps this through a symmetric scale per node.
-            for (int k = 0; k < 3; ++k) {
-                const size_t node = static_cast<size_t>(c.face[k]);
-                const double along = node_depth_[node] > 0.0 ? dot(pen.normal, &node_normal_[3 * node]) : 0.0;
-                out.tangent_scale[k] = std::sqrt(std::max(0.0, 1.0 - along));
-            }
             for (int k = 0; k < 3; ++k) {
                 out.normal[k] = pen.normal[k];
                 out.point[k] = pen.point[k];
-                out.nodes[k] = c.face[k];
-                out.weights[k] = w[k];
-                touched_mass = std::min(touched_mass, mass[c.face[k]]);
             }
-            out.count = 3;
+            set_nodes(3, c.face, w);
             if (v) {
                 double vc[3];
                 c.collider->point_velocity(out.point, vc);
@@ -360,17 +355,10 @@ bool BodyContacts::contact(const ContactCandidate& c, const double* x, const dou
                 return false;
             for (int k = 0; k < 3; ++k) out.point[k] = at(xn, c.node)[k];
             if (own_node) {
-                out.count = 1;
-                out.nodes[0] = c.node;
-                out.weights[0] = 1.0;
-                touched_mass = mass[c.node];
+                set_nodes(1, &c.node, &one);
             } else {
-                out.count = 3;
-                for (int k = 0; k < 3; ++k) {
-                    out.nodes[k] = c.face[k];
-                    out.weights[k] = -w[k];
-                    touched_mass = std::min(touched_mass, mass[c.face[k]]);
-                }
+                const double far_side[3] = {-w[0], -w[1], -w[2]};
+                set_nodes(3, c.face, far_side);
             }
             if (v) {
                 const double* vn = own_node ? v : c.other->v.data();
@@ -398,22 +386,23 @@ bool BodyContacts::contact(const ContactCandidate& c, const double* x, const dou
             for (double& f : ft) f *= scale;
         }
     }
-    for (int k = 0; k < 3; ++k) out.force[k] = fn.force * out.normal[k] + ft[k];
+    for (int a = 0; a < out.count; ++a)
+        for (int k = 0; k < 3; ++k) out.node_force[a][k] = fn.force * out.gradient[a][k] + out.weights[a] * ft[k];
     return true;
 }
 
 template <class Emit>
-void BodyContacts::evaluate(const double* x, const double* v, Emit&& emit) const {
+void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& emit) const {
     for (const Group& group : groups_) {
         for (int32_t i = group.begin; i < group.end; ++i) {
             const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
             ContactPoint point;
-            if (!contact(c, x, v, point)) continue;
-            if (c.kind == ContactCandidate::kNodeShape) {
-                node_depth_[static_cast<size_t>(c.node)] = point.depth;
-                for (int k = 0; k < 3; ++k) node_normal_[3 * static_cast<size_t>(c.node) + k] = point.normal[k];
+            if (!contact(c, x, v, point)) {
+                emit(c, static_cast<const ContactPoint*>(nullptr));
+                continue;
             }
-            emit(c, point);
+            if (c.kind == ContactCandidate::kNodeShape) node_depth_[static_cast<size_t>(c.node)] = point.depth;
+            emit(c, &point);
         }
         for (int32_t i = group.begin; i < group.end; ++i) {
             const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
@@ -422,11 +411,18 @@ void BodyContacts::evaluate(const double* x, const double* v, Emit&& emit) const
     }
 }
 
+template <class Emit>
+void BodyContacts::evaluate(const double* x, const double* v, Emit&& emit) const {
+    evaluate_candidates(x, v, [&](const ContactCandidate& c, const ContactPoint* point) {
+        if (point) emit(c, *point);
+    });
+}
+
 void BodyContacts::add_forces(const double* x, const double* v, double* f) const {
     const Timer timer(evaluation_seconds_);
     evaluate(x, v, [&](const ContactCandidate&, const ContactPoint& p) {
         for (int a = 0; a < p.count; ++a)
-            for (int k = 0; k < 3; ++k) f[3 * static_cast<size_t>(p.nodes[a]) + k] += p.weights[a] * p.force[k];
+            for (int k = 0; k < 3; ++k) f[3 * static_cast<size_t>(p.nodes[a]) + k] += p.node_force[a][k];
     });
 }
 
@@ -434,20 +430,21 @@ void BodyContacts::add_tangent(const double* x, const double* v, double stiffnes
                                const int32_t* free_index, SparseSystem& system) const {
     const Timer timer(evaluation_seconds_);
     evaluate(x, v, [&](const ContactCandidate&, const ContactPoint& p) {
-        double block[9];
-        for (int r = 0; r < 3; ++r)
-            for (int s = 0; s < 3; ++s) {
-                const double nn = p.normal[r] * p.normal[s];
-                const double tangential = (r == s ? 1.0 : 0.0) - nn;
-                block[3 * r + s] = stiffness_scale * p.stiffness * nn + damping_scale * (p.damping * nn + p.friction * tangential);
-            }
+        // K_ab = k g_a g_b^T, D_ab = c g_a g_b^T + friction w_a w_b (I - n n^T).
         for (int a = 0; a < p.count; ++a) {
             const int32_t fa = free_index[p.nodes[a]];
             if (fa < 0) continue;
             for (int b = a; b < p.count; ++b) {
                 const int32_t fb = free_index[p.nodes[b]];
                 if (fb < 0) continue;
-                system.add_block(fa, fb, block, p.weights[a] * p.weights[b] * p.tangent_scale[a] * p.tangent_scale[b]);
+                const double sliding = damping_scale * p.friction * p.weights[a] * p.weights[b];
+                double block[9];
+                for (int r = 0; r < 3; ++r)
+                    for (int s = 0; s < 3; ++s)
+                        block[3 * r + s] =
+                            (stiffness_scale * p.stiffness + damping_scale * p.damping) * p.gradient[a][r] * p.gradient[b][s] +
+                            sliding * ((r == s ? 1.0 : 0.0) - p.normal[r] * p.normal[s]);
+                system.add_block(fa, fb, block, 1.0);
             }
         }
     });
@@ -460,25 +457,30 @@ double BodyContacts::energy(const double* x) const {
 }
 
 double BodyContacts::stable_step(const double* x, const double* v, const double* mass) const {
+    // Each own node's row of k g g^T, bounded by k |g_a| sum_b |g_b| (Gershgorin), at the depth
+    // the contact has now plus what the step may add.
     double step = INFINITY;
-    for (const ContactCandidate& c : candidates_) {
-        ContactPoint point;
-        double depth = anticipated_depth;
-        int32_t nodes[3] = {c.node, -1, -1};
-        int count = 1;
-        if (c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kFaceNode) {
-            for (int k = 0; k < 3; ++k) nodes[k] = c.face[k];
-            count = 3;
+    evaluate_candidates(x, v, [&](const ContactCandidate& c, const ContactPoint* point) {
+        ContactPoint guess;
+        if (!point) {  // not touching yet: a node-side guess at the anticipated depth
+            guess.depth = 0.0;
+            guess.count = c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kFaceNode ? 3 : 1;
+            for (int a = 0; a < guess.count; ++a) {
+                guess.nodes[a] = guess.count == 3 ? c.face[a] : c.node;
+                guess.gradient[a][0] = guess.gradient[a][1] = 0.0;
+                guess.gradient[a][2] = 1.0;
+            }
+            point = &guess;
         }
-        if (contact(c, x, v, point)) depth += point.depth;
-        if (!(depth > 0.0)) continue;
-        const sh_contact_params& p = *c.params;
-        const NormalForce fn = hunt_crossley(p, depth, 0.0);
-        for (int k = 0; k < count; ++k) {
-            if (!body_.is_free(nodes[k])) continue;
-            step = std::min(step, damped_stable_step(fn.stiffness, fn.damping, mass[nodes[k]]));
+        const NormalForce fn = hunt_crossley(*c.params, point->depth + anticipated_depth, 0.0);
+        double row = 0.0;
+        for (int b = 0; b < point->count; ++b) row += std::sqrt(dot(point->gradient[b], point->gradient[b]));
+        for (int a = 0; a < point->count; ++a) {
+            if (!body_.is_free(point->nodes[a])) continue;
+            const double share = std::sqrt(dot(point->gradient[a], point->gradient[a])) * row;
+            step = std::min(step, damped_stable_step(share * fn.stiffness, share * fn.damping, mass[point->nodes[a]]));
         }
-    }
+    });
     return step;
 }
 
@@ -489,17 +491,15 @@ int32_t BodyContacts::accumulate_reactions() {
         ++count;
         if (!c.collider) return;
         sh_contact_state& s = c.collider->state;
-        // The force acts where the body's nodes take it: at the node, or at the weighted point
-        // of the face (the deepest point's projection, up to the clamping of its weights).
-        double applied[3] = {0.0, 0.0, 0.0}, r[3], torque[3];
-        for (int a = 0; a < p.count; ++a)
-            for (int k = 0; k < 3; ++k) applied[k] += p.weights[a] * body_.x[3 * static_cast<size_t>(p.nodes[a]) + k];
-        sub(applied, c.collider->pose.p, r);
-        const double reaction[3] = {-p.force[0], -p.force[1], -p.force[2]};
-        cross(r, reaction, torque);
-        for (int k = 0; k < 3; ++k) {
-            s.force[k] += reaction[k];
-            s.torque[k] += torque[k];
+        for (int a = 0; a < p.count; ++a) {
+            double r[3], torque[3];
+            const double reaction[3] = {-p.node_force[a][0], -p.node_force[a][1], -p.node_force[a][2]};
+            sub(&body_.x[3 * static_cast<size_t>(p.nodes[a])], c.collider->pose.p, r);
+            cross(r, reaction, torque);
+            for (int k = 0; k < 3; ++k) {
+                s.force[k] += reaction[k];
+                s.torque[k] += torque[k];
+            }
         }
         ++s.contact_count;
         s.max_depth = std::max(s.max_depth, p.depth);

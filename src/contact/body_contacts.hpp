@@ -32,19 +32,19 @@ struct ContactCandidate {
 
 /// One acting contact, as evaluate() reports it.
 struct ContactPoint {
-    double depth;        ///< penetration (m), > 0
-    double normal[3];    ///< unit direction of the push on the own-side point (node or face)
-    double point[3];     ///< touching point (world)
-    double force[3];     ///< force on the node side of the contact (N): the node for node kinds,
-                         ///< the face for kFaceShape
-    double weights[3];   ///< own nodes' shares of the force (sign included: kFaceNode's own
-                         ///< face feels minus the force)
-    int32_t nodes[3];    ///< own nodes the force is spread over
-    int count;           ///< 1 or 3
-    double stiffness;    ///< dFn/dx (N/m)
-    double damping;      ///< dFn/dx' (N s/m)
-    double friction;     ///< viscous coefficient of the friction (N s/m)
-    double tangent_scale[3] = {1.0, 1.0, 1.0};  ///< per own node: share of the tangent it feels
+    double depth;            ///< penetration (m), > 0
+    double normal[3];        ///< unit direction of the push on the node side (node or face)
+    double point[3];         ///< touching point (world)
+    int32_t nodes[3];        ///< own nodes the contact acts on
+    int count;               ///< 1 or 3
+    double weights[3];       ///< own nodes' shares of the node side's motion and friction (sign
+                             ///< included: kFaceNode's own face is the far side)
+    double gradient[3][3];   ///< per own node: -d depth / d x, its weight times the normal (the
+                             ///< normal force on it is the normal force times this)
+    double node_force[3][3]; ///< per own node: the force it feels (N)
+    double stiffness;        ///< dFn/dx (N/m)
+    double damping;          ///< dFn/dx' (N s/m)
+    double friction;         ///< viscous coefficient of the friction (N s/m)
 };
 
 /// The contact state of one body: surface, broad phase and candidates.
@@ -70,10 +70,6 @@ public:
     /// nearest surface triangle. Both must be FEM bodies.
     static bool detect_pair(BodyContacts& a, BodyContacts& b, const sh_contact_params& params);
 
-    /// Calls emit(candidate, point) for every candidate in contact at (x, v) (v null: at rest,
-    /// without damping or friction).
-    template <class Emit>
-    void evaluate(const double* x, const double* v, Emit&& emit) const;
 
     /// Adds the reactions at the body's current state to each touched collider's state and
     /// returns how many contacts act (a body-pair contact counts on its node's side only).
@@ -108,6 +104,14 @@ private:
         int32_t begin, end;  ///< candidates [begin, end): node kinds first, then faces
     };
     bool contact(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const;
+    /// Calls emit(candidate, point) for every candidate at (x, v) (v null: at rest, without
+    /// damping or friction), point null for one not in contact. Group by group, node contacts
+    /// before the faces they share depth with.
+    template <class Emit>
+    void evaluate_candidates(const double* x, const double* v, Emit&& emit) const;
+    /// evaluate_candidates for the candidates in contact only, with a reference to the point.
+    template <class Emit>
+    void evaluate(const double* x, const double* v, Emit&& emit) const;
     bool keep_deepest(Group& group, int32_t capacity);
     void ensure_tet_tree();
 
@@ -123,7 +127,6 @@ private:
     vec<ContactCandidate> candidates_;
     vec<Group> groups_;
     mutable vec<double> node_depth_; ///< per node: its depth in the current group's collider
-    mutable vec<double> node_normal_;///< per node: that contact's normal (3 per node)
     vec<double> keys_;               ///< scratch for keep_deepest
     mutable double evaluation_seconds_ = 0.0;
 };

@@ -2,8 +2,9 @@
 
 #include <stdlib.h>
 
-void sh_test_box_arrays(double lx, double ly, double lz, int nx, int ny, int nz, double** out_nodes,
-                        int32_t* out_node_count, int32_t** out_tets, int32_t* out_tet_count) {
+void sh_test_grid_arrays(const double* xs, int nx, const double* ys, int ny, const double* zs, int nz,
+                         double** out_nodes, int32_t* out_node_count, int32_t** out_tets,
+                         int32_t* out_tet_count) {
     const int px = nx + 1, py = ny + 1, pz = nz + 1;
     const int node_count = px * py * pz, tet_count = 6 * nx * ny * nz;
     double* nodes = malloc(sizeof(double) * 3 * (size_t)node_count);
@@ -17,9 +18,9 @@ void sh_test_box_arrays(double lx, double ly, double lz, int nx, int ny, int nz,
         for (int j = 0; j < py; ++j)
             for (int i = 0; i < px; ++i) {
                 double* p = &nodes[3 * (size_t)((k * py + j) * px + i)];
-                p[0] = lx * i / nx;
-                p[1] = ly * j / ny;
-                p[2] = lz * k / nz;
+                p[0] = xs[i];
+                p[1] = ys[j];
+                p[2] = zs[k];
             }
     static const int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
     int t = 0;
@@ -34,4 +35,24 @@ void sh_test_box_arrays(double lx, double ly, double lz, int nx, int ny, int nz,
                 for (int s = 0; s < 6; ++s, ++t)
                     for (int a = 0; a < 4; ++a) tets[4 * t + a] = c[kuhn[s][a]];
             }
+}
+
+void sh_test_box_arrays(double lx, double ly, double lz, int nx, int ny, int nz, double** out_nodes,
+                        int32_t* out_node_count, int32_t** out_tets, int32_t* out_tet_count) {
+    const int px = nx + 1, py = ny + 1, pz = nz + 1;
+    /* One allocation holds the three plane arrays. */
+    double* planes = malloc(sizeof(double) * (size_t)(px + py + pz));
+    if (planes == NULL) {
+        *out_nodes = NULL;
+        *out_tets = NULL;
+        *out_node_count = px * py * pz;
+        *out_tet_count = 6 * nx * ny * nz;
+        return;
+    }
+    double *xs = planes, *ys = planes + px, *zs = planes + px + py;
+    for (int i = 0; i < px; ++i) xs[i] = lx * i / nx;
+    for (int j = 0; j < py; ++j) ys[j] = ly * j / ny;
+    for (int k = 0; k < pz; ++k) zs[k] = lz * k / nz;
+    sh_test_grid_arrays(xs, nx, ys, ny, zs, nz, out_nodes, out_node_count, out_tets, out_tet_count);
+    free(planes);
 }

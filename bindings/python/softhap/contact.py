@@ -11,8 +11,9 @@ import ctypes
 import numpy as np
 
 from . import _arrays
-from ._lib import Status, sh_contact_state
-from ._loaded import check, closed_error, lib
+from ._lib import sh_contact_state
+from ._entity import WorldEntity
+from ._loaded import check, lib
 from ._record import Record, record_of
 
 
@@ -33,35 +34,25 @@ def _contact_state(raw):
     )
 
 
-class _Collider:
-    """What Tool and Obstacle share: an id in a World and the contact state read after a step.
+class _Collider(WorldEntity):
+    """What Tool and Obstacle share: an id in a World, the contact state read after a step and
+    destroy().
 
-    A subclass sets _kind ("tool") and _get_contact (the C function reading its state)."""
+    A subclass sets _kind, _is_valid, _get_contact (the C function reading its state) and
+    _destroy (the C function removing it)."""
 
-    _kind = None
     _get_contact = None
-
-    def __init__(self, world, collider_id):
-        self._world = world
-        self._id = int(collider_id)
-
-    def __repr__(self):
-        return "<softhap.%s id=%#x>" % (type(self).__name__, self._id)
+    _destroy = None
 
     @property
-    def world(self):
-        """The World this tool or obstacle belongs to."""
-        return self._world
+    def valid(self):
+        """Same as is_valid."""
+        return self.is_valid
 
-    @property
-    def id(self):
-        """The generation-checked id (an int; 0 is the null id)."""
-        return self._id
-
-    def _world_handle(self, function):
-        if self._world.closed:
-            raise closed_error("world of this %s" % self._kind, function)
-        return self._world._handle
+    def destroy(self):
+        """Remove it from its world; its id becomes stale."""
+        handle = self._world_handle(self._destroy)
+        check(getattr(lib, self._destroy)(handle, self._id), self._destroy)
 
     @property
     def contact_state(self):
@@ -111,23 +102,9 @@ class Tool(_Collider):
     """
 
     _kind = "tool"
+    _is_valid = "sh_tool_is_valid"
     _get_contact = "sh_tool_get_contact"
-
-    def __init__(self, world, tool_id):
-        """Wrap the id tool_id of world (use World.add_tool rather than calling this)."""
-        _Collider.__init__(self, world, tool_id)
-
-    @property
-    def is_valid(self):
-        """True while the tool is a live tool of an open world (sh_tool_is_valid)."""
-        if self._world.closed:
-            return False
-        return bool(lib.sh_tool_is_valid(self._world._handle, self._id))
-
-    @property
-    def valid(self):
-        """Same as is_valid."""
-        return self.is_valid
+    _destroy = "sh_tool_destroy"
 
     @property
     def pose(self):
@@ -136,8 +113,12 @@ class Tool(_Collider):
         handle = self._world_handle("sh_tool_get_pose")
         position = np.zeros(3)
         orientation = np.zeros(4)
-        check(lib.sh_tool_get_pose(handle, self._id, _arrays.double_ptr(position), _arrays.double_ptr(orientation)),
-              "sh_tool_get_pose")
+        check(
+            lib.sh_tool_get_pose(
+                handle, self._id, _arrays.double_ptr(position), _arrays.double_ptr(orientation)
+            ),
+            "sh_tool_get_pose",
+        )
         return position, orientation
 
     def set_pose(self, position, orientation=(1.0, 0.0, 0.0, 0.0)):
@@ -169,18 +150,6 @@ class Tool(_Collider):
             "sh_tool_set_velocity",
         )
 
-    @property
-    def force(self):
-        """Reaction force (N) on the tool after the last step, a (3,) array (world frame;
-        sh_tool_get_wrench)."""
-        return self.wrench()[0]
-
-    @property
-    def torque(self):
-        """Reaction torque (N m) on the tool about its position after the last step, a (3,)
-        array (world frame; sh_tool_get_wrench)."""
-        return self.wrench()[1]
-
     def wrench(self):
         """(force, torque): the reaction on the tool after the last step, two (3,) arrays
         (N and N m about the tool's position, world frame; sh_tool_get_wrench)."""
@@ -195,11 +164,6 @@ class Tool(_Collider):
         )
         return force, torque
 
-    def destroy(self):
-        """Remove the tool from its world (sh_tool_destroy); its id becomes stale."""
-        handle = self._world_handle("sh_tool_destroy")
-        check(lib.sh_tool_destroy(handle, self._id), "sh_tool_destroy")
-
 
 class Obstacle(_Collider):
     """A static rigid obstacle of a World (an sh_obstacle_id): a plane, sphere, capsule, box or
@@ -211,25 +175,6 @@ class Obstacle(_Collider):
     """
 
     _kind = "obstacle"
+    _is_valid = "sh_obstacle_is_valid"
     _get_contact = "sh_obstacle_get_contact"
-
-    def __init__(self, world, obstacle_id):
-        """Wrap the id obstacle_id of world (use World.add_obstacle rather than calling this)."""
-        _Collider.__init__(self, world, obstacle_id)
-
-    @property
-    def is_valid(self):
-        """True while the obstacle is a live obstacle of an open world (sh_obstacle_is_valid)."""
-        if self._world.closed:
-            return False
-        return bool(lib.sh_obstacle_is_valid(self._world._handle, self._id))
-
-    @property
-    def valid(self):
-        """Same as is_valid."""
-        return self.is_valid
-
-    def destroy(self):
-        """Remove the obstacle from its world (sh_obstacle_destroy); its id becomes stale."""
-        handle = self._world_handle("sh_obstacle_destroy")
-        check(lib.sh_obstacle_destroy(handle, self._id), "sh_obstacle_destroy")
+    _destroy = "sh_obstacle_destroy"

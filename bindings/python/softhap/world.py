@@ -22,13 +22,12 @@ from ._lib import (
     sh_spring_body_def,
     sh_static_def,
     sh_static_report,
-    sh_obstacle_id,
     sh_step_report,
-    sh_tool_id,
     sh_world_def,
 )
+from ._entity import WorldEntity
 from ._handle import OwnedHandle
-from ._loaded import check, closed_error, lib
+from ._loaded import check, lib
 from ._record import BodyInfo, StaticReport, StepReport, record_of
 from .contact import Obstacle, Tool
 from .mesh import Mesh
@@ -540,15 +539,7 @@ class World(OwnedHandle):
         (SH_ERR_INVALID_ARGUMENT, the message naming the field).
         """
         arguments = dict(locals())
-        handle = self._require_handle("sh_tool_create")
-        definition, arrays = _collider_def(kind, arguments, position, orientation)
-        tool = sh_tool_id()
-        check(
-            lib.sh_tool_create(handle, ctypes.byref(definition), ctypes.byref(tool)),
-            "sh_tool_create",
-        )
-        del arrays  # the C library has copied the points
-        return Tool(self, tool.value)
+        return Tool(self, self._create_collider("sh_tool_create", kind, arguments, position, orientation))
 
     def add_obstacle(
         self,
@@ -586,7 +577,6 @@ class World(OwnedHandle):
         Unknown names raise ValueError; invalid values raise softhap.Error.
         """
         arguments = dict(locals())
-        handle = self._require_handle("sh_obstacle_create")
         if kind == "plane":
             for name in ("center", "orientation"):
                 if arguments[name] is not None:
@@ -602,14 +592,22 @@ class World(OwnedHandle):
                     "with center= and orientation=" % (kind,)
                 )
             position = center
+        return Obstacle(
+            self, self._create_collider("sh_obstacle_create", kind, arguments, position, orientation)
+        )
+
+    def _create_collider(self, function, kind, arguments, position, orientation):
+        """The id that C function (sh_tool_create or sh_obstacle_create) gives the collider of
+        shape kind, its keyword arguments and its pose."""
+        handle = self._require_handle(function)
         definition, arrays = _collider_def(kind, arguments, position, orientation)
-        obstacle = sh_obstacle_id()
+        collider = ctypes.c_uint64()
         check(
-            lib.sh_obstacle_create(handle, ctypes.byref(definition), ctypes.byref(obstacle)),
-            "sh_obstacle_create",
+            getattr(lib, function)(handle, ctypes.byref(definition), ctypes.byref(collider)),
+            function,
         )
         del arrays  # the C library has copied the points
-        return Obstacle(self, obstacle.value)
+        return collider.value
 
     def set_body_contact(
         self,
@@ -661,7 +659,7 @@ class World(OwnedHandle):
         check(lib.sh_world_remove_body(handle, body.id), "sh_world_remove_body")
 
 
-class Body:
+class Body(WorldEntity):
     """A body of a World (an sh_body_id): an FEM body or a mass-spring network.
 
     Made by World.add_fem_body or World.add_spring_body. The World owns the body's data; a
@@ -670,35 +668,8 @@ class Body:
     Arrays read from a body are copies.
     """
 
-    def __init__(self, world, body_id):
-        """Wrap the id body_id of world (use World.add_*_body rather than calling this)."""
-        self._world = world
-        self._id = int(body_id)
-
-    def __repr__(self):
-        return "<softhap.Body id=%#x>" % self._id
-
-    @property
-    def world(self):
-        """The World this body belongs to."""
-        return self._world
-
-    @property
-    def id(self):
-        """The generation-checked sh_body_id (an int; 0 is the null id)."""
-        return self._id
-
-    @property
-    def is_valid(self):
-        """True while the body is a live body of an open world (sh_body_is_valid)."""
-        if self._world.closed:
-            return False
-        return bool(lib.sh_body_is_valid(self._world._handle, self._id))
-
-    def _world_handle(self, function):
-        if self._world.closed:
-            raise closed_error("world of this body", function)
-        return self._world._handle
+    _kind = "body"
+    _is_valid = "sh_body_is_valid"
 
     # -- facts ------------------------------------------------------------------------------
 

@@ -1,0 +1,45 @@
+"""The identity shared by Body, Tool and Obstacle: a generation-checked id in a World."""
+
+from ._loaded import closed_error, lib
+
+
+class WorldEntity:
+    """Base of the Python objects that name one entity of a World by its id.
+
+    A subclass sets _kind (the word used in the closed-world error, "body") and _is_valid (the
+    name of the C function telling whether the id is live, "sh_body_is_valid"). The World owns
+    the entity's data; the object keeps its World alive.
+    """
+
+    _kind = None
+    _is_valid = None
+
+    def __init__(self, world, entity_id):
+        """Wrap the id entity_id of world (use the World's add_* methods rather than this)."""
+        self._world = world
+        self._id = int(entity_id)
+
+    def __repr__(self):
+        return "<softhap.%s id=%#x>" % (type(self).__name__, self._id)
+
+    @property
+    def world(self):
+        """The World this entity belongs to."""
+        return self._world
+
+    @property
+    def id(self):
+        """The generation-checked id (an int; 0 is the null id)."""
+        return self._id
+
+    @property
+    def is_valid(self):
+        """True while the id names a live entity of an open world."""
+        if self._world.closed:
+            return False
+        return bool(getattr(lib, self._is_valid)(self._world._handle, self._id))
+
+    def _world_handle(self, function):
+        if self._world.closed:
+            raise closed_error("world of this %s" % self._kind, function)
+        return self._world._handle

@@ -352,34 +352,24 @@ int Shape::convex_support_index(const double d[3]) const {
 }
 
 void Shape::bounds(const Pose& pose, double margin, double lo[3], double hi[3]) const {
+    // Sphere, capsule and box are symmetric about their centre: a reach per axis.
+    double reach[3] = {radius_, radius_, radius_};
     switch (kind_) {
         case SH_SHAPE_SPHERE:
-            for (int k = 0; k < 3; ++k) {
-                lo[k] = pose.p[k] - radius_;
-                hi[k] = pose.p[k] + radius_;
-            }
             break;
         case SH_SHAPE_CAPSULE: {
             const double half_axis[3] = {0.0, 0.0, half_length_};
             double a[3];
             pose.rotate(half_axis, a);
-            for (int k = 0; k < 3; ++k) {
-                const double reach = std::fabs(a[k]) + radius_;
-                lo[k] = pose.p[k] - reach;
-                hi[k] = pose.p[k] + reach;
-            }
+            for (int k = 0; k < 3; ++k) reach[k] += std::fabs(a[k]);
             break;
         }
         case SH_SHAPE_BOX: {
             double R[3][3];
             rotation_matrix(pose, R);
-            for (int k = 0; k < 3; ++k) {
-                const double reach = std::fabs(R[k][0]) * half_extents_[0] +
-                                     std::fabs(R[k][1]) * half_extents_[1] +
-                                     std::fabs(R[k][2]) * half_extents_[2];
-                lo[k] = pose.p[k] - reach;
-                hi[k] = pose.p[k] + reach;
-            }
+            for (int k = 0; k < 3; ++k)
+                reach[k] = std::fabs(R[k][0]) * half_extents_[0] + std::fabs(R[k][1]) * half_extents_[1] +
+                           std::fabs(R[k][2]) * half_extents_[2];
             break;
         }
         case SH_SHAPE_CONVEX: {
@@ -428,6 +418,10 @@ void Shape::bounds(const Pose& pose, double margin, double lo[3], double hi[3]) 
         }
     }
     for (int k = 0; k < 3; ++k) {
+        if (kind_ != SH_SHAPE_CONVEX) {
+            lo[k] = pose.p[k] - reach[k];
+            hi[k] = pose.p[k] + reach[k];
+        }
         lo[k] -= margin;
         hi[k] += margin;
     }

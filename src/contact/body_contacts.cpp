@@ -1,10 +1,10 @@
 #include "contact/body_contacts.hpp"
 
 #include "contact/hunt_crossley.hpp"
+#include "core/clock.hpp"
 #include "solver/sparse_system.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 namespace sh {
@@ -84,16 +84,6 @@ bool node_behind_face(const double* p, const double* a, const double* b, const d
 
 inline const double* at(const double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
 
-// Adds the seconds of its lifetime to total.
-class Timer {
-public:
-    explicit Timer(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
-    ~Timer() { total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
-
-private:
-    double& total_;
-    std::chrono::steady_clock::time_point start_;
-};
 
 }  // namespace
 
@@ -419,7 +409,7 @@ void BodyContacts::evaluate(const double* x, const double* v, Emit&& emit) const
 }
 
 void BodyContacts::add_forces(const double* x, const double* v, double* f) const {
-    const Timer timer(evaluation_seconds_);
+    const ScopedTimer timer(evaluation_seconds_);
     evaluate(x, v, [&](const ContactCandidate&, const ContactPoint& p) {
         for (int a = 0; a < p.count; ++a)
             for (int k = 0; k < 3; ++k) f[3 * static_cast<size_t>(p.nodes[a]) + k] += p.node_force[a][k];
@@ -428,7 +418,7 @@ void BodyContacts::add_forces(const double* x, const double* v, double* f) const
 
 void BodyContacts::add_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
                                const int32_t* free_index, SparseSystem& system) const {
-    const Timer timer(evaluation_seconds_);
+    const ScopedTimer timer(evaluation_seconds_);
     evaluate(x, v, [&](const ContactCandidate&, const ContactPoint& p) {
         // K_ab = k g_a g_b^T, D_ab = c g_a g_b^T + friction w_a w_b (I - n n^T).
         for (int a = 0; a < p.count; ++a) {

@@ -1,8 +1,9 @@
 #include "solver/linear_solver.hpp"
 
+#include "core/clock.hpp"
+
 #include "core/error.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -60,7 +61,7 @@ void LinearSolver::analyze(const SparseSystem& a) {
 }
 
 void LinearSolver::factorize(const SparseSystem& a) {
-    const double t0 = solver_detail::now_seconds();
+    const double t0 = now_seconds();
     require_analysed(a, analysed_id_, name());
     factorized_ = false;
     if (a.dof_count() > 0) {
@@ -68,11 +69,11 @@ void LinearSolver::factorize(const SparseSystem& a) {
         do_factorize(a);
     }
     factorized_ = true;
-    factorize_seconds = solver_detail::now_seconds() - t0;
+    factorize_seconds = now_seconds() - t0;
 }
 
 int LinearSolver::solve(const SparseSystem& a, const double* b, double* x) {
-    const double t0 = solver_detail::now_seconds();
+    const double t0 = now_seconds();
     require_analysed(a, analysed_id_, name());
     SH_REQUIRE(factorized_, SH_ERR_INTERNAL, "%s: solve before a successful factorize", name());
     int iterations = 0;
@@ -80,12 +81,12 @@ int LinearSolver::solve(const SparseSystem& a, const double* b, double* x) {
         try {
             iterations = do_solve(a, b, x);
         } catch (...) {  // CG out of iterations: its time still counts
-            solve_seconds = solver_detail::now_seconds() - t0;
+            solve_seconds = now_seconds() - t0;
             throw;
         }
         require_finite_solution(a, x, name());
     }
-    solve_seconds = solver_detail::now_seconds() - t0;
+    solve_seconds = now_seconds() - t0;
     return iterations;
 }
 
@@ -114,10 +115,6 @@ LinearSolverPtr make_cholmod_solver() {
 #endif
 
 namespace solver_detail {
-
-double now_seconds() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 void throw_not_positive_definite(const SparseSystem& a, int32_t column, const char* backend, const char* detail) {
     char dof[96];

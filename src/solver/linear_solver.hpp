@@ -70,8 +70,6 @@ LinearSolverPtr make_ldlt_solver();
 LinearSolverPtr make_cg_solver(double tolerance, int max_iterations);
 
 namespace solver_detail {
-/// Seconds on a monotonic clock.
-double now_seconds();
 /// Throws SH_ERR_SOLVER "<backend>: matrix not positive definite at column N (free DOF ..)".
 [[noreturn]] void throw_not_positive_definite(const SparseSystem& a, int32_t column, const char* backend,
                                               const char* detail);

@@ -3,6 +3,7 @@
 #include "collision/aabb_tree.hpp"
 #include "contact/body_contacts.hpp"
 #include "contact/collider.hpp"
+#include "core/clock.hpp"
 #include "core/error.hpp"
 #include "solver/explicit_integrator.hpp"
 #include "solver/implicit_integrator.hpp"
@@ -13,7 +14,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 
 namespace sh {
@@ -185,9 +185,8 @@ void World::step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8
         if (!slot.body || (failed && (*failed)[index])) continue;
         bool half_steps_stable = false;
         if (slot.doubling) {
-            const auto t0 = std::chrono::steady_clock::now();
+            const ScopedTimer timer(r.error_estimate_seconds);
             half_steps_stable = take_half_steps(*slot.body, *slot.doubling, h, gravity);
-            r.error_estimate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         }
         slot.body->clear_inverted_elements();
         const BodyStepResult result = step_body(*slot.body, slot.implicit, h, gravity);
@@ -274,7 +273,7 @@ int32_t World::finish_contacts() {
 
 void World::step(double dt, sh_step_report* report) {
     SH_REQUIRE(std::isfinite(dt) && dt > 0.0, SH_ERR_INVALID_ARGUMENT, "dt = %g s, must be finite and > 0", dt);
-    const auto start = std::chrono::steady_clock::now();
+    const double start = now_seconds();
     sh_step_report r{};
     r.substeps = 1;
     r.contact_substeps = 1;
@@ -310,9 +309,10 @@ void World::step(double dt, sh_step_report* report) {
                 const double fraction = (s + 1) / substeps;
                 for (ColliderSlot& c : colliders_)
                     if (c.collider && c.collider->is_tool) c.collider->pose = interpolate(c.collider->start, c.collider->target, fraction);
-                const auto t0 = std::chrono::steady_clock::now();
-                r.warnings |= detect_contacts(h, 1.0 / substeps, 0.0);
-                r.collision_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                {
+                    const ScopedTimer timer(r.collision_seconds);
+                    r.warnings |= detect_contacts(h, 1.0 / substeps, 0.0);
+                }
                 step_bodies(h, r, failure, r.contact_substeps > 1 ? &failed_ : nullptr);
             }
         } catch (...) {
@@ -328,9 +328,10 @@ void World::step(double dt, sh_step_report* report) {
                 std::copy(slot.saved.begin(), slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.body->x.begin());
                 std::copy(slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.saved.end(), slot.body->v.begin());
             }
-        const auto t0 = std::chrono::steady_clock::now();
-        r.contact_count = finish_contacts();
-        r.collision_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        {
+            const ScopedTimer timer(r.collision_seconds);
+            r.contact_count = finish_contacts();
+        }
         for (const Slot& slot : slots_)
             if (slot.contacts) r.collision_seconds += slot.contacts->take_evaluation_seconds();
         if (r.warnings & (1u << SH_WARN_CAPACITY)) ++warnings[SH_WARN_CAPACITY];
@@ -352,7 +353,7 @@ void World::step(double dt, sh_step_report* report) {
             }
             r.elastic_energy += body->elastic_energy(body->x.data());
         }
-        r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        r.wall_seconds = now_seconds() - start;
         *report = r;
     }
     if (failure.body == SH_NULL_BODY) return;
@@ -366,7 +367,7 @@ void World::step(double dt, sh_step_report* report) {
 }
 
 void World::solve_static(const sh_static_def& def, sh_static_report* report) {
-    const auto start = std::chrono::steady_clock::now();
+    const double start = now_seconds();
     sh_static_report r{};
     for (Slot& slot : slots_)
         if (slot.body) save_start_state(*slot.body);
@@ -405,12 +406,12 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
                 slot.body->field = nullptr;
                 restore_start_state(*slot.body);
             }
-        r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        r.wall_seconds = now_seconds() - start;
         if (report) *report = r;  // what was tried, for the host's diagnosis
         throw;
     }
     r.converged = 1;
-    r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.wall_seconds = now_seconds() - start;
     if (report) *report = r;
 }
 

@@ -138,8 +138,8 @@ void BodyContacts::refit(double margin) {
         tree_.refit(boxes_.data());
 }
 
-bool BodyContacts::detect(const Collider& collider, double reach) {
-    Collider* target = const_cast<Collider*>(&collider);
+bool BodyContacts::detect(Collider& collider, double reach) {
+    Collider* target = &collider;
     Group group{static_cast<int32_t>(candidates_.size()), 0};
     double lo[3], hi[3];
     collider.shape.bounds(collider.pose, reach, lo, hi);
@@ -447,28 +447,21 @@ double BodyContacts::energy(const double* x) const {
 }
 
 double BodyContacts::stable_step(const double* x, const double* v, const double* mass) const {
-    // Each own node's row of k g g^T, bounded by k |g_a| sum_b |g_b| (Gershgorin), at the depth
-    // the contact has now plus what the step may add.
+    // Each own node's row of k g g^T is at most k |g_a| sum_b |g_b| (Gershgorin), at the depth
+    // the contact has now plus what the step may add. A candidate not touching yet is bounded
+    // by a share of 1 (its weights sum to 1) on each node it may touch.
     double step = INFINITY;
     evaluate_candidates(x, v, [&](const ContactCandidate& c, const ContactPoint* point) {
-        ContactPoint guess;
-        if (!point) {  // not touching yet: a node-side guess at the anticipated depth
-            guess.depth = 0.0;
-            guess.count = c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kFaceNode ? 3 : 1;
-            for (int a = 0; a < guess.count; ++a) {
-                guess.nodes[a] = guess.count == 3 ? c.face[a] : c.node;
-                guess.gradient[a][0] = guess.gradient[a][1] = 0.0;
-                guess.gradient[a][2] = 1.0;
-            }
-            point = &guess;
-        }
-        const NormalForce fn = hunt_crossley(*c.params, point->depth + anticipated_depth, 0.0);
+        const bool face = c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kFaceNode;
+        const int count = point ? point->count : face ? 3 : 1;
+        const NormalForce fn = hunt_crossley(*c.params, (point ? point->depth : 0.0) + anticipated_depth, 0.0);
         double row = 0.0;
-        for (int b = 0; b < point->count; ++b) row += std::sqrt(dot(point->gradient[b], point->gradient[b]));
-        for (int a = 0; a < point->count; ++a) {
-            if (!body_.is_free(point->nodes[a])) continue;
-            const double share = std::sqrt(dot(point->gradient[a], point->gradient[a])) * row;
-            step = std::min(step, damped_stable_step(share * fn.stiffness, share * fn.damping, mass[point->nodes[a]]));
+        for (int b = 0; point && b < count; ++b) row += std::sqrt(dot(point->gradient[b], point->gradient[b]));
+        for (int a = 0; a < count; ++a) {
+            const int32_t node = point ? point->nodes[a] : face ? c.face[a] : c.node;
+            if (!body_.is_free(node)) continue;
+            const double share = point ? std::sqrt(dot(point->gradient[a], point->gradient[a])) * row : 1.0;
+            step = std::min(step, damped_stable_step(share * fn.stiffness, share * fn.damping, mass[node]));
         }
     });
     return step;

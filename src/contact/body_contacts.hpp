@@ -64,7 +64,7 @@ public:
     /// Adds the candidates against collider: every surface node (and, for shapes other than
     /// planes, every surface triangle) whose box overlaps the collider's bounds grown by reach
     /// (m). Keeps at most its capacity, the deepest first; returns true if it dropped any.
-    bool detect(const Collider& collider, double reach);
+    bool detect(Collider& collider, double reach);
 
     /// Adds to both a and b the candidates of a's surface nodes inside b's tets, each behind b's
     /// nearest surface triangle. Both must be FEM bodies.

@@ -692,6 +692,103 @@ typedef struct sh_static_report {
 SH_API sh_status sh_world_solve_static(sh_world* world, const sh_static_def* def,
                                        sh_static_report* report);
 
+/* ------------------------------------------------------------------------------------------ */
+/* Haptic rendering: the Volumetric Buffer Model                                               */
+
+/** A haptic context: a small local explicit FEM model (the Volumetric Buffer Model of
+ *  Mendoza & Laugier 2003) around a tool's contact, stepped by sh_haptic_step on the device
+ *  thread at 1-10 kHz in memory fixed at creation, while sh_world_step on the sim thread
+ *  re-extracts it from the full model. Opaque. */
+typedef struct sh_haptic sh_haptic;
+
+/** Definition of a haptic context. Initialise with sh_haptic_def_default. */
+typedef struct sh_haptic_def {
+    uint32_t internal_init;   /**< set by sh_haptic_def_default; do not touch */
+    sh_tool_id tool;          /**< the tool the device moves (a sphere, capsule or box; a
+                                   convex tool is SH_ERR_UNSUPPORTED); required */
+    int32_t capacity_tets;    /**< most tets in the buffer, >= 1; default 2000 */
+    int32_t capacity_nodes;   /**< most nodes in the buffer, >= 4; default 2000 */
+    double radius;            /**< buffer radius (m): tets whose centroid lies within it of the
+                                   contact point; > 0; default 0.02 */
+    int32_t rings;            /**< > 0: instead of radius, the tets within this many rings
+                                   (tets sharing a node) of the tets at the contact; default 0 */
+    double dt;                /**< nominal haptic step (s), > 0; default 1e-3 */
+    double max_force;         /**< largest force output (N), > 0; default 10 */
+    double max_force_rate;    /**< largest change of the force output (N/s), > 0; the output
+                                   moves at most max_force_rate * dt per step; default 2000 */
+    double ramp_time;         /**< force ramp-in on engagement and ramp-out on stale data or a
+                                   fault (s), >= 0; default 0.05 */
+    double stale_after;       /**< full-model data older than this (s of haptic time) is
+                                   stale: the force ramps out; > 0; default 0.1 */
+} sh_haptic_def;
+
+/** Fill a haptic def with defaults (the tool stays 0 and must be set). Thread: any.
+ *  Alloc: none. */
+SH_API void sh_haptic_def_default(sh_haptic_def* def);
+
+/** Bytes of memory a context made from def holds (its whole arena: the three exchanged
+ *  buffers and the haptic side's working state), fixed at creation. Thread: any. Alloc: none. */
+SH_API sh_status sh_haptic_memory_bytes(const sh_haptic_def* def, size_t* out_bytes);
+
+/** Fault bits of sh_haptic_output.faults: why the force is held or ramping out. */
+typedef enum sh_haptic_fault {
+    SH_HAPTIC_FAULT_POSE = 1,     /**< the device pose was not finite (or a zero quaternion):
+                                       the last good pose is kept */
+    SH_HAPTIC_FAULT_DT = 2,       /**< dt was not finite, <= 0 or > 1 s: nothing was stepped */
+    SH_HAPTIC_FAULT_UNSTABLE = 4, /**< the buffer went non-finite or ran away: it was rolled
+                                       back to its state before the step */
+    SH_HAPTIC_FAULT_STALE = 8,    /**< the full-model data is older than stale_after */
+    SH_HAPTIC_FAULT_NO_TOOL = 16  /**< the tool or the world is gone */
+} sh_haptic_fault;
+
+/** What one haptic step rendered. */
+typedef struct sh_haptic_output {
+    double force[3];        /**< force to render on the device (N, world frame): the tissue's
+                                 push on the tool, clamped to max_force and max_force_rate and
+                                 ramped; always finite */
+    double torque[3];       /**< torque on the tool about its position (N m, world frame),
+                                 scaled like the force */
+    int32_t contact;        /**< 1 if the tool touches the buffer (or the proxy surface) */
+    int32_t buffer_tets;    /**< tets in the buffer in use */
+    int32_t buffer_nodes;   /**< nodes in the buffer in use */
+    int32_t substeps;       /**< explicit sub-steps taken to stay below the critical step */
+    double data_age;        /**< haptic time (s) since the newest full-model data arrived */
+    uint32_t faults;        /**< sh_haptic_fault bits raised in this step */
+    uint32_t warnings;      /**< bit (1 << sh_warning) for each kind raised in this step */
+    double raw_force[3];    /**< the buffer's force before clamping and ramps (N) */
+} sh_haptic_output;
+
+/** Create a haptic context on world for def.tool. The buffer is extracted at once and again
+ *  at the end of every sh_world_step, around the point of the nearest FEM body's surface
+ *  nearest the tool; the world then moves the tool to the latest device pose before each
+ *  step, so the full model feels the tool where the device is. Thread: sim. Alloc: may (the
+ *  whole arena, once). */
+SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_haptic** out);
+
+/** Destroy a context (after the haptic thread has stopped calling sh_haptic_step on it). It
+ *  may outlive its world. NULL is a no-op returning SH_OK; a destroyed pointer returns
+ *  SH_ERR_INVALID_HANDLE. Thread: sim. Alloc: none. */
+SH_API sh_status sh_haptic_destroy(sh_haptic* haptic);
+
+/** Step the buffer by dt to the device pose (position m, orientation unit quaternion
+ *  (w, x, y, z), world frame) and fill out. The full model's newest buffer is taken up (its
+ *  interior nodes keep the state the haptic side gave them), its boundary nodes follow the
+ *  full model across the full-model step, the interior is integrated explicitly (sub-stepped
+ *  below its critical step) under the tool's Hunt-Crossley contact, and the force is the
+ *  buffer's push on the tool. Before the first buffer arrives the tool presses on a proxy: the
+ *  plane of the last known nearest surface point. out is always filled and finite; bad input
+ *  (a NULL pointer, a non-finite pose or dt) is a status plus a fault bit, with the force held
+ *  and ramping out; a NULL or destroyed context is SH_ERR_INVALID_HANDLE (checked without a
+ *  lock, so only as far as the freed memory still says so). Thread: haptic (one thread at a
+ *  time per context, concurrent with the sim thread). Alloc: none. Locks: none. */
+SH_API sh_status sh_haptic_step(sh_haptic* haptic, const double position[3],
+                                const double orientation[4], double dt, sh_haptic_output* out);
+
+/** Read the context's warning counters (SH_WARN_COUNT values: SH_WARN_FORCE_CLAMPED for
+ *  clamped forces and rates, SH_WARN_CAPACITY for buffers cut to capacity, SH_WARN_UNSTABLE
+ *  for roll-backs). Thread: sim. Alloc: none. */
+SH_API sh_status sh_haptic_get_warnings(const sh_haptic* haptic, uint64_t out[SH_WARN_COUNT]);
+
 #ifdef __cplusplus
 }
 #endif

@@ -5,7 +5,7 @@
 namespace sh::capi {
 
 /// Kinds of opaque objects handed to the host.
-enum class HandleKind { Mesh, World };
+enum class HandleKind { Mesh, World, Haptic };
 
 /// Records object as live.
 void register_handle(HandleKind kind, const void* object);

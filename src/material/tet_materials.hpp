@@ -13,6 +13,8 @@
 #include "material/lanes.hpp"
 #include "material/polar_decomposition.hpp"
 
+#include <softhap/softhap.h>
+
 #include <cmath>
 
 namespace sh {
@@ -223,5 +225,14 @@ struct NeoHookeanMaterial {
         return 0.5 * m * (ic3 - logs) + 0.5 * l * j1 * (j1 + 2.0 * (1.0 - alpha));
     }
 };
+
+/// Calls visit(material_tag, model) for each sh_material_model and its kernel tag type.
+template <class Visit>
+void for_each_material(Visit&& visit) {
+    visit(LinearMaterial{}, SH_MATERIAL_LINEAR);
+    visit(StvkMaterial{}, SH_MATERIAL_STVK);
+    visit(CorotationalMaterial{}, SH_MATERIAL_COROTATIONAL);
+    visit(NeoHookeanMaterial{}, SH_MATERIAL_NEOHOOKEAN);
+}
 
 }  // namespace sh

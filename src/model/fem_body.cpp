@@ -116,12 +116,7 @@ void FemBody::rebuild(vec<sh_material> materials) {
                 const size_t slot = static_cast<size_t>(l) * nb + k;
                 const bool used = slot < m;
                 const size_t t = members[used ? slot : k];  // unused lanes repeat lane 0's tet, weightless
-                for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j) b.Bm.m[i][j][l] = inverse_rest_[9 * t + 3 * i + j];
-                const double weight = used ? -volume_[t] : 0.0;
-                b.lambda_w[l] = weight * lame_lambda(materials[t]);
-                b.mu_w[l] = weight * lame_mu(materials[t]);
-                for (int a = 0; a < 4; ++a) b.node[a][l] = tets_[4 * t + a];
+                fill_lane(t, materials[t], &tets_[4 * t], used, b, l);
             }
         }
     }
@@ -138,6 +133,15 @@ void FemBody::rebuild(vec<sh_material> materials) {
     for (int model = 0; model < 4; ++model) blocks_[model].swap(new_blocks[model]);
     ++matrix_version;
     update_inverse_mass();
+}
+
+void FemBody::fill_lane(size_t t, const sh_material& m, const int32_t nodes[4], bool used, TetBlock& b, int lane) const {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) b.Bm.m[i][j][lane] = inverse_rest_[9 * t + 3 * i + j];
+    const double weight = used ? -volume_[t] : 0.0;
+    b.lambda_w[lane] = weight * lame_lambda(m);
+    b.mu_w[lane] = weight * lame_mu(m);
+    for (int a = 0; a < 4; ++a) b.node[a][lane] = nodes[a];
 }
 
 double FemBody::element_max_frequency_squared(size_t t, const sh_material& material) const {
@@ -157,23 +161,11 @@ double FemBody::element_max_frequency_squared(size_t t, const sh_material& mater
     return eigen.eigenvalues()(11) * 4.0 / (material.density * v0);
 }
 
-namespace {
-
-// Calls visit(material_tag, blocks) for the block list of each material model.
-template <class Visit>
-void for_each_model(const vec<TetBlock>* blocks, Visit&& visit) {
-    visit(LinearMaterial{}, blocks[SH_MATERIAL_LINEAR]);
-    visit(StvkMaterial{}, blocks[SH_MATERIAL_STVK]);
-    visit(CorotationalMaterial{}, blocks[SH_MATERIAL_COROTATIONAL]);
-    visit(NeoHookeanMaterial{}, blocks[SH_MATERIAL_NEOHOOKEAN]);
-}
-
-}  // namespace
-
 void FemBody::add_internal_forces(const double* xs, const double* vs, double* f) const {
     const double* damped_v = damping_stiffness_ > 0.0 ? vs : nullptr;
     int32_t inverted = 0;
-    for_each_model(blocks_, [&](auto material, const vec<TetBlock>& blocks) {
+    for_each_material([&](auto material, int model) {
+        const vec<TetBlock>& blocks = blocks_[model];
         inverted += add_fem_forces<decltype(material)>(blocks.data(), blocks.size(), xs, damped_v, damping_stiffness_, f);
     });
     inverted_elements_ = std::max(inverted_elements_, inverted);
@@ -181,7 +173,8 @@ void FemBody::add_internal_forces(const double* xs, const double* vs, double* f)
 
 double FemBody::elastic_energy(const double* xs) const {
     double energy = 0.0;
-    for_each_model(blocks_, [&](auto material, const vec<TetBlock>& blocks) {
+    for_each_material([&](auto material, int model) {
+        const vec<TetBlock>& blocks = blocks_[model];
         energy += fem_energy<decltype(material)>(blocks.data(), blocks.size(), xs);
     });
     return energy;

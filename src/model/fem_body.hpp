@@ -30,6 +30,16 @@ public:
     int32_t inverted_elements() const override { return inverted_elements_; }
     void clear_inverted_elements() override { inverted_elements_ = 0; }
 
+    /// The material of tet t.
+    const sh_material& material(size_t t) const { return materials_[t]; }
+
+    /// Rayleigh beta (s).
+    double damping_stiffness() const { return damping_stiffness_; }
+
+    /// Writes tet t with material m into lane `lane` of block b, over node numbers nodes[4]
+    /// (the body's, or a copy's own); an unused lane (used false) gets zero weights.
+    void fill_lane(size_t t, const sh_material& m, const int32_t nodes[4], bool used, TetBlock& b, int lane) const;
+
 private:
     /// Adopts materials (one per tet): masses, blocks and the stable step, all or nothing.
     void rebuild(vec<sh_material> materials);

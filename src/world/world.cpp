@@ -5,6 +5,7 @@
 #include "contact/collider.hpp"
 #include "core/clock.hpp"
 #include "core/error.hpp"
+#include "haptic/haptic_context.hpp"
 #include "solver/explicit_integrator.hpp"
 #include "solver/implicit_integrator.hpp"
 #include "solver/static_solver.hpp"
@@ -43,6 +44,7 @@ World::World(const sh_world_def& def) : error_estimate_(def.error_estimate != 0)
 }
 
 World::~World() {
+    for (HapticContext* haptic : haptics_) haptic->detach();
     for (Slot& slot : slots_) destroy_slot(slot);
     for (ColliderSlot& c : colliders_) sh::destroy(c.collider);
 }
@@ -179,6 +181,12 @@ void World::set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params
     }
 }
 
+void World::add_haptic(HapticContext* haptic) { haptics_.push_back(haptic); }
+
+void World::remove_haptic(HapticContext* haptic) {
+    haptics_.erase(std::remove(haptics_.begin(), haptics_.end(), haptic), haptics_.end());
+}
+
 void World::step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed) {
     for (size_t index = 0; index < slots_.size(); ++index) {
         Slot& slot = slots_[index];
@@ -280,6 +288,7 @@ void World::step(double dt, sh_step_report* report) {
     r.error_estimate = error_estimate_ ? 0.0 : -1.0;
     r.dt_critical = INFINITY;
     Failure failure;
+    for (HapticContext* haptic : haptics_) haptic->before_step(*this);
     if (!has_contact()) {
         step_bodies(dt, r, failure, nullptr);
     } else {
@@ -336,6 +345,7 @@ void World::step(double dt, sh_step_report* report) {
             if (slot.contacts) r.collision_seconds += slot.contacts->take_evaluation_seconds();
         if (r.warnings & (1u << SH_WARN_CAPACITY)) ++warnings[SH_WARN_CAPACITY];
     }
+    for (HapticContext* haptic : haptics_) haptic->after_step(*this, dt);
     if (r.warnings & (1u << SH_WARN_SUBSTEPPED)) ++warnings[SH_WARN_SUBSTEPPED];
     if (r.warnings & (1u << SH_WARN_INVERTED)) ++warnings[SH_WARN_INVERTED];
     warnings[SH_WARN_UNSTABLE] += static_cast<uint64_t>(r.unstable_body_count);

@@ -12,6 +12,7 @@
 namespace sh {
 
 class BodyContacts;
+class HapticContext;
 struct Collider;
 struct ImplicitState;
 struct StepDoubling;
@@ -60,6 +61,20 @@ public:
     /// body is restored and the error rethrown.
     void solve_static(const sh_static_def& def, sh_static_report* report);
 
+    /// Registers a haptic context: each step then takes its device pose first and refreshes
+    /// its buffer last. The context is told (detach) if the world goes first.
+    void add_haptic(HapticContext* haptic);
+
+    /// Unregisters a haptic context.
+    void remove_haptic(HapticContext* haptic);
+
+    /// Calls visit(id, body) for every live body.
+    template <class Visit>
+    void for_each_body(Visit&& visit) const {
+        for (size_t index = 0; index < slots_.size(); ++index)
+            if (slots_[index].body) visit(id_of(index), *slots_[index].body);
+    }
+
     double gravity[3];
     uint64_t warnings[SH_WARN_COUNT] = {};
 
@@ -100,6 +115,7 @@ private:
     vec<uint32_t> free_colliders_;
     vec<BodyPair> pairs_;
     vec<uint8_t> failed_;  ///< per slot, during a sub-stepped step
+    vec<HapticContext*> haptics_;
     bool error_estimate_ = false;
     sh_body_id id_of(size_t index) const;
     vec<Slot> slots_;

@@ -1,0 +1,109 @@
+// C API: haptic contexts (the Volumetric Buffer Model).
+#include "capi/guard.hpp"
+#include "capi/handles.hpp"
+#include "capi/world_handle.hpp"
+#include "haptic/haptic_context.hpp"
+
+using namespace sh;
+
+struct sh_haptic {
+    sh::HapticContext* context;
+    uint32_t magic;  ///< kLive while alive: a cheap, lock-free sanity check for the haptic step
+};
+
+namespace {
+
+constexpr uint32_t kLive = 0x53484850u;  // "SHHP"
+
+HapticContext& context_of(const sh_haptic* haptic) {
+    capi::require_handle(capi::HandleKind::Haptic, haptic, "haptic");
+    return *haptic->context;
+}
+
+sh_haptic_def checked_def(const sh_haptic_def* def) {
+    capi::require_initialised(def, "def");
+    validate_haptic_def(*def);
+    return *def;
+}
+
+}  // namespace
+
+extern "C" {
+
+SH_API void sh_haptic_def_default(sh_haptic_def* def) {
+    if (!def) return;
+    *def = sh_haptic_def{};
+    def->internal_init = capi::kDefInitialised;
+    def->capacity_tets = 2000;
+    def->capacity_nodes = 2000;
+    def->radius = 0.02;
+    def->rings = 0;
+    def->dt = 1e-3;
+    def->max_force = 10.0;
+    def->max_force_rate = 2000.0;
+    def->ramp_time = 0.05;
+    def->stale_after = 0.1;
+}
+
+SH_API sh_status sh_haptic_memory_bytes(const sh_haptic_def* def, size_t* out_bytes) {
+    return capi::guard([&] {
+        capi::require_pointer(out_bytes, "out_bytes");
+        *out_bytes = 0;
+        *out_bytes = HapticContext::memory_bytes(checked_def(def));
+    });
+}
+
+SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_haptic** out) {
+    return capi::guard([&] {
+        capi::require_pointer(out, "out");
+        *out = nullptr;
+        World& w = capi::world_of(world);
+        const sh_haptic_def d = checked_def(def);
+        require(w.is_valid_collider(d.tool, true), SH_ERR_INVALID_HANDLE,
+                format("def->tool = 0x%llx is not a live tool of this world", static_cast<unsigned long long>(d.tool)));
+        HapticContext* context = sh::create<HapticContext>(w, d);
+        sh_haptic* handle = nullptr;
+        try {
+            handle = sh::create<sh_haptic>(sh_haptic{context, kLive});
+            w.add_haptic(context);
+            capi::register_handle(capi::HandleKind::Haptic, handle);
+        } catch (...) {
+            w.remove_haptic(context);
+            sh::destroy(handle);
+            sh::destroy(context);
+            throw;
+        }
+        *out = handle;
+    });
+}
+
+SH_API sh_status sh_haptic_destroy(sh_haptic* haptic) {
+    return capi::guard([&] {
+        if (!haptic) return;
+        require(capi::unregister_handle(capi::HandleKind::Haptic, haptic), SH_ERR_INVALID_HANDLE,
+                "haptic is not a live object (destroyed twice or never created)");
+        if (World* w = haptic->context->world()) w->remove_haptic(haptic->context);
+        haptic->magic = 0;
+        sh::destroy(haptic->context);
+        sh::destroy(haptic);
+    });
+}
+
+SH_API sh_status sh_haptic_step(sh_haptic* haptic, const double position[3], const double orientation[4], double dt,
+                                sh_haptic_output* out) {
+    // No guard: nothing here throws, and the step must not touch the last-error message's
+    // formatting (it allocates).
+    if (!haptic || haptic->magic != kLive) return SH_ERR_INVALID_HANDLE;
+    if (!out) return SH_ERR_INVALID_ARGUMENT;
+    return haptic->context->step(position, orientation, dt, *out);
+}
+
+SH_API sh_status sh_haptic_get_warnings(const sh_haptic* haptic, uint64_t out[SH_WARN_COUNT]) {
+    return capi::guard([&] {
+        HapticContext& context = context_of(haptic);
+        capi::require_pointer(out, "out");
+        context.read_warnings(out);
+    });
+}
+
+}  // extern "C"

@@ -1,0 +1,29 @@
+// Small 3-vector helpers over plain double[3] arrays.
+#pragma once
+
+#include <cmath>
+
+namespace sh {
+
+/// out = a - b.
+inline void sub3(const double* a, const double* b, double* out) {
+    for (int k = 0; k < 3; ++k) out[k] = a[k] - b[k];
+}
+
+/// a . b
+inline double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/// out = a x b (out must not alias a or b).
+inline void cross3(const double* a, const double* b, double* out) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/// |a|
+inline double norm3(const double* a) { return std::sqrt(dot3(a, a)); }
+
+/// True if every component is finite.
+inline bool finite3(const double* a) { return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]); }
+
+}  // namespace sh

@@ -1,0 +1,66 @@
+// Buffer: one extraction of the Volumetric Buffer Model, as the sim side hands it to the
+// haptic side: the buffer's tets (as force-kernel blocks over local node numbers), its nodes
+// with the full model's start and end of step, its surface, and the contact context.
+#pragma once
+
+#include "haptic/arena.hpp"
+#include "model/tet_block.hpp"
+
+#include <softhap/softhap.h>
+
+#include <cstdint>
+
+namespace sh {
+
+/// Capacities of a context's buffers, from its def.
+struct BufferCapacity {
+    int32_t tets, nodes;
+    int32_t blocks() const { return (tets + kLanes - 1) / kLanes + 4; }  ///< one partial per model
+    int32_t triangles() const { return 4 * tets; }  ///< each buffer tet has at most 4 surface faces
+};
+
+/// One exchanged buffer. The arrays are carved at creation with the capacities; the counts
+/// say how much of them is in use.
+struct Buffer {
+    uint64_t sequence = 0;      ///< extraction number (0: nothing extracted yet)
+    sh_body_id body = 0;        ///< the body it was cut from (0: none near the tool)
+    bool tool_alive = true;     ///< false once the tool is destroyed
+    int32_t node_count = 0, tet_count = 0, triangle_count = 0, surface_node_count = 0;
+    int32_t block_begin[5] = {};  ///< blocks of material model m: [block_begin[m], block_begin[m + 1])
+    double period = 0.0;          ///< the full-model step the boundary moves across (s)
+    double gravity[3] = {};       ///< m/s^2
+    double damping_mass = 0.0;       ///< Rayleigh alpha (1/s)
+    double damping_stiffness = 0.0;  ///< Rayleigh beta (s)
+    double dt_stable = 0.0;          ///< critical explicit step of the buffer's tets (s)
+    double runaway_speed = 0.0;      ///< m/s: faster is a fault
+    uint32_t warnings = 0;           ///< SH_WARN bits of the extraction (capacity)
+    bool has_proxy = false;          ///< proxy_point/normal hold the nearest surface point
+    double proxy_point[3] = {}, proxy_normal[3] = {};  ///< outward normal (world)
+    double max_gap = 0.0;            ///< how far from the surface the buffer reaches (m)
+
+    TetBlock* blocks = nullptr;   ///< local node numbers
+    int32_t* node_id = nullptr;   ///< body node of each local node, ascending
+    double* x_start = nullptr;    ///< full model at the start of its step (3 per node)
+    double* x_end = nullptr;      ///< at its end
+    double* v_end = nullptr;      ///< velocity at its end
+    double* inverse_mass = nullptr;  ///< 0 for boundary nodes (driven by the full model)
+    double* mass = nullptr;
+    int32_t* triangles = nullptr;    ///< 3 local nodes per surface triangle, outward
+    int32_t* surface_nodes = nullptr;
+
+    /// Carves the arrays for capacity from arena (or measures them).
+    void carve(Arena& arena, const BufferCapacity& capacity) {
+        const size_t n = static_cast<size_t>(capacity.nodes);
+        blocks = arena.take<TetBlock>(static_cast<size_t>(capacity.blocks()));
+        node_id = arena.take<int32_t>(n);
+        x_start = arena.take<double>(3 * n);
+        x_end = arena.take<double>(3 * n);
+        v_end = arena.take<double>(3 * n);
+        inverse_mass = arena.take<double>(n);
+        mass = arena.take<double>(n);
+        triangles = arena.take<int32_t>(3 * static_cast<size_t>(capacity.triangles()));
+        surface_nodes = arena.take<int32_t>(n);
+    }
+};
+
+}  // namespace sh

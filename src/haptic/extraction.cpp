@@ -1,0 +1,281 @@
+// The sim side of the Volumetric Buffer Model: after each full-model step, the tets around the
+// tool's nearest surface point are copied into the back buffer with the full model's state.
+#include "collision/closest_point.hpp"
+#include "core/vec3.hpp"
+#include "haptic/haptic_context.hpp"
+#include "model/fem_body.hpp"
+#include "world/world.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sh {
+namespace {
+
+inline const double* at(const double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
+
+// The tool's nearest FEM surface: which body, which triangle, the point and the distance.
+struct NearestSurface {
+    sh_body_id body = 0;
+    const FemBody* fem = nullptr;
+    int32_t triangle = -1;
+    double point[3] = {};
+    double distance = INFINITY;
+};
+
+NearestSurface nearest_surface(const World& world, const double p[3]) {
+    NearestSurface best;
+    world.for_each_body([&](sh_body_id id, const Body& body) {
+        if (!body.is_fem()) return;
+        const vec<int32_t>& tris = body.surface_triangles;
+        const double* x = body.x.data();
+        for (size_t t = 0; t < tris.size(); t += 3) {
+            double w[3];
+            const double* a = at(x, tris[t]);
+            const double* b = at(x, tris[t + 1]);
+            const double* c = at(x, tris[t + 2]);
+            const double d = closest_on_triangle(p, a, b, c, w);
+            if (!(d < best.distance)) continue;
+            best.body = id;
+            best.fem = static_cast<const FemBody*>(&body);
+            best.triangle = static_cast<int32_t>(t / 3);
+            best.distance = d;
+            for (int k = 0; k < 3; ++k) best.point[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
+        }
+    });
+    return best;
+}
+
+double centroid_distance(const FemBody& body, int32_t t, const double center[3]) {
+    const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(t);
+    double c[3] = {0.0, 0.0, 0.0};
+    for (int a = 0; a < 4; ++a)
+        for (int k = 0; k < 3; ++k) c[k] += 0.25 * at(body.x.data(), tet[a])[k];
+    double d[3];
+    sub3(c, center, d);
+    return norm3(d);
+}
+
+}  // namespace
+
+void HapticContext::ensure_adjacency(const FemBody& body, sh_body_id id) {
+    if (adjacency_body_ == id && adjacency_tets_ == body.element_count()) return;
+    const size_t n = static_cast<size_t>(body.node_count()), tets = static_cast<size_t>(body.element_count());
+    const int32_t* nodes = body.element_nodes();
+    node_tet_begin_.assign(n + 1, 0);
+    for (size_t j = 0; j < 4 * tets; ++j) ++node_tet_begin_[static_cast<size_t>(nodes[j]) + 1];
+    for (size_t i = 0; i < n; ++i) node_tet_begin_[i + 1] += node_tet_begin_[i];
+    node_tet_.assign(4 * tets, 0);
+    vec<int32_t> fill(node_tet_begin_.begin(), node_tet_begin_.end() - 1);
+    for (size_t j = 0; j < 4 * tets; ++j) node_tet_[static_cast<size_t>(fill[static_cast<size_t>(nodes[j])]++)] = static_cast<int32_t>(j / 4);
+    local_of_.assign(n, -1);
+    in_buffer_.assign(tets, 0);
+    adjacency_body_ = id;
+    adjacency_tets_ = body.element_count();
+}
+
+void HapticContext::select_tets(const FemBody& body, const double center[3], int32_t seed_triangle, Buffer& out) {
+    const int32_t tet_count = body.element_count();
+    const int32_t* tris = body.surface_triangles.data() + 3 * static_cast<size_t>(seed_triangle);
+    ranked_.clear();
+    // The tets at the contact: those with a node of the nearest surface triangle.
+    for (int k = 0; k < 3; ++k)
+        for (int32_t j = node_tet_begin_[static_cast<size_t>(tris[k])]; j < node_tet_begin_[static_cast<size_t>(tris[k]) + 1]; ++j) {
+            const int32_t t = node_tet_[static_cast<size_t>(j)];
+            if (in_buffer_[static_cast<size_t>(t)]) continue;
+            in_buffer_[static_cast<size_t>(t)] = 1;
+            ranked_.push_back({centroid_distance(body, t, center), t});
+        }
+    if (def_.rings > 0) {
+        size_t frontier = 0;
+        for (int32_t ring = 0; ring < def_.rings; ++ring) {
+            const size_t end = ranked_.size();
+            for (size_t r = frontier; r < end; ++r) {
+                const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(ranked_[r].second);
+                for (int a = 0; a < 4; ++a)
+                    for (int32_t j = node_tet_begin_[static_cast<size_t>(tet[a])]; j < node_tet_begin_[static_cast<size_t>(tet[a]) + 1]; ++j) {
+                        const int32_t t = node_tet_[static_cast<size_t>(j)];
+                        if (in_buffer_[static_cast<size_t>(t)]) continue;
+                        in_buffer_[static_cast<size_t>(t)] = 1;
+                        ranked_.push_back({centroid_distance(body, t, center), t});
+                    }
+            }
+            frontier = end;
+        }
+    } else {
+        for (int32_t t = 0; t < tet_count; ++t) {
+            if (in_buffer_[static_cast<size_t>(t)]) continue;
+            const double d = centroid_distance(body, t, center);
+            if (d <= def_.radius) ranked_.push_back({d, t});
+        }
+    }
+    for (const auto& r : ranked_) in_buffer_[static_cast<size_t>(r.second)] = 0;
+    std::sort(ranked_.begin(), ranked_.end());
+    // The nearest first, as many as the capacities hold.
+    chosen_.clear();
+    int32_t nodes = 0;
+    for (const auto& r : ranked_) {
+        const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(r.second);
+        int32_t fresh = 0;
+        for (int a = 0; a < 4; ++a) fresh += local_of_[static_cast<size_t>(tet[a])] < 0;
+        if (static_cast<int32_t>(chosen_.size()) == def_.capacity_tets || nodes + fresh > def_.capacity_nodes) {
+            out.warnings |= 1u << SH_WARN_CAPACITY;
+            continue;  // a later, farther tet may still fit within the node capacity
+        }
+        for (int a = 0; a < 4; ++a)
+            if (local_of_[static_cast<size_t>(tet[a])] < 0) local_of_[static_cast<size_t>(tet[a])] = nodes++;
+        chosen_.push_back(r.second);
+        in_buffer_[static_cast<size_t>(r.second)] = 1;
+    }
+}
+
+void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Buffer& out) {
+    const int32_t* elements = body.element_nodes();
+    // Local numbers in ascending body order, so that the haptic side can match buffers by a merge.
+    int32_t n = 0;
+    ring_.clear();
+    for (const int32_t t : chosen_)
+        for (int a = 0; a < 4; ++a) {
+            const int32_t node = elements[4 * static_cast<size_t>(t) + a];
+            if (local_of_[static_cast<size_t>(node)] >= 0) {
+                ring_.push_back(node);
+                local_of_[static_cast<size_t>(node)] = -1;
+            }
+        }
+    std::sort(ring_.begin(), ring_.end());
+    for (const int32_t node : ring_) local_of_[static_cast<size_t>(node)] = n++;
+    out.node_count = n;
+    out.tet_count = static_cast<int32_t>(chosen_.size());
+
+    const bool have_start = x_before_body_ == out.body && x_before_.size() == body.x.size();
+    const double* start = have_start ? x_before_.data() : body.x.data();
+    for (int32_t i = 0; i < n; ++i) {
+        const int32_t node = ring_[static_cast<size_t>(i)];
+        out.node_id[i] = node;
+        for (int k = 0; k < 3; ++k) {
+            out.x_start[3 * i + k] = at(start, node)[k];
+            out.x_end[3 * i + k] = at(body.x.data(), node)[k];
+            out.v_end[3 * i + k] = at(body.v.data(), node)[k];
+        }
+        out.mass[i] = body.mass[static_cast<size_t>(node)];
+        // A node is interior when every tet around it is in the buffer and the full model
+        // integrates it; the others follow the full model.
+        int32_t around = 0;
+        for (int32_t j = node_tet_begin_[static_cast<size_t>(node)]; j < node_tet_begin_[static_cast<size_t>(node) + 1]; ++j)
+            around += in_buffer_[static_cast<size_t>(node_tet_[static_cast<size_t>(j)])];
+        const bool interior = around == node_tet_begin_[static_cast<size_t>(node) + 1] - node_tet_begin_[static_cast<size_t>(node)] &&
+                              body.is_free(node);
+        out.inverse_mass[i] = interior ? 1.0 / out.mass[i] : 0.0;
+    }
+
+    // Blocks per material model, lanes over local numbers.
+    int32_t block = 0;
+    for (int model = 0; model < 4; ++model) {
+        out.block_begin[model] = block;
+        int32_t lane = 0;
+        size_t first = 0;  // the block's first tet, repeated weightless in unused lanes
+        for (const int32_t t : chosen_) {
+            if (body.material(static_cast<size_t>(t)).model != model) continue;
+            int32_t local[4];
+            for (int a = 0; a < 4; ++a) local[a] = local_of_[static_cast<size_t>(elements[4 * static_cast<size_t>(t) + a])];
+            if (lane == 0) first = static_cast<size_t>(t);
+            body.fill_lane(static_cast<size_t>(t), body.material(static_cast<size_t>(t)), local, true, out.blocks[block], lane);
+            if (++lane == kLanes) {
+                lane = 0;
+                ++block;
+            }
+        }
+        if (lane > 0) {
+            int32_t local[4];
+            for (int a = 0; a < 4; ++a) local[a] = local_of_[static_cast<size_t>(elements[4 * first + a])];
+            for (; lane < kLanes; ++lane) body.fill_lane(first, body.material(first), local, false, out.blocks[block], lane);
+            ++block;
+        }
+    }
+    out.block_begin[4] = block;
+
+    // The body's surface triangles on a buffer tet.
+    const vec<int32_t>& tris = body.surface_triangles;
+    int32_t count = 0;
+    for (size_t t = 0; t < tris.size(); t += 3) {
+        const int32_t a = tris[t], b = tris[t + 1], c = tris[t + 2];
+        if (local_of_[static_cast<size_t>(a)] < 0 || local_of_[static_cast<size_t>(b)] < 0 || local_of_[static_cast<size_t>(c)] < 0)
+            continue;
+        bool owned = false;
+        for (int32_t j = node_tet_begin_[static_cast<size_t>(a)]; j < node_tet_begin_[static_cast<size_t>(a) + 1] && !owned; ++j) {
+            const int32_t tet = node_tet_[static_cast<size_t>(j)];
+            if (!in_buffer_[static_cast<size_t>(tet)]) continue;
+            const int32_t* e = elements + 4 * static_cast<size_t>(tet);
+            bool has_b = false, has_c = false;
+            for (int k = 0; k < 4; ++k) {
+                has_b |= e[k] == b;
+                has_c |= e[k] == c;
+            }
+            owned = has_b && has_c;
+        }
+        if (!owned) continue;
+        out.triangles[3 * count] = local_of_[static_cast<size_t>(a)];
+        out.triangles[3 * count + 1] = local_of_[static_cast<size_t>(b)];
+        out.triangles[3 * count + 2] = local_of_[static_cast<size_t>(c)];
+        ++count;
+    }
+    out.triangle_count = count;
+    int32_t surface = 0;
+    for (int32_t i = 0; i < n; ++i) out.surface_nodes[i] = 0;
+    for (int32_t j = 0; j < 3 * count; ++j) out.surface_nodes[out.triangles[j]] = 1;
+    for (int32_t i = 0; i < n; ++i)
+        if (out.surface_nodes[i]) out.surface_nodes[surface++] = i;  // compacts in place: surface <= i
+    out.surface_node_count = surface;
+
+    for (int k = 0; k < 3; ++k) out.gravity[k] = gravity[k];
+    out.damping_mass = body.settings.damping_mass;
+    out.damping_stiffness = body.damping_stiffness();
+    out.dt_stable = body.stable_step(body.x.data());
+    out.runaway_speed = body.settings.runaway_speed;
+
+    for (const int32_t node : ring_) local_of_[static_cast<size_t>(node)] = -1;
+    for (const int32_t t : chosen_) in_buffer_[static_cast<size_t>(t)] = 0;
+}
+
+void HapticContext::extract(World& world, double period, Buffer& out) {
+    out.sequence = ++extract_count_;
+    out.body = 0;
+    out.node_count = out.tet_count = out.triangle_count = out.surface_node_count = 0;
+    for (int32_t& b : out.block_begin) b = 0;
+    out.warnings = 0;
+    out.has_proxy = false;
+    out.period = period;
+    out.tool_alive = world.is_valid_collider(def_.tool, true);
+    extracted_body_ = 0;
+    if (!out.tool_alive) return;
+    const Collider& tool = world.collider(def_.tool, true);
+    const NearestSurface near = nearest_surface(world, tool.target.p);
+    if (!near.fem) return;
+    const int32_t* tri = near.fem->surface_triangles.data() + 3 * static_cast<size_t>(near.triangle);
+    const double* x = near.fem->x.data();
+    double ab[3], ac[3], n[3];
+    sub3(at(x, tri[1]), at(x, tri[0]), ab);
+    sub3(at(x, tri[2]), at(x, tri[0]), ac);
+    cross3(ab, ac, n);
+    const double length = norm3(n);
+    if (length > 0.0) {
+        out.has_proxy = true;
+        for (int k = 0; k < 3; ++k) {
+            out.proxy_point[k] = near.point[k];
+            out.proxy_normal[k] = n[k] / length;
+        }
+    }
+    // A buffer only where the tool may touch before the next extraction.
+    double lo[3], hi[3], extent[3];
+    tool.shape.bounds(tool.target, 0.0, lo, hi);
+    sub3(hi, lo, extent);
+    out.max_gap = def_.radius + 0.5 * norm3(extent);
+    if (near.distance > out.max_gap) return;
+    out.body = near.body;
+    extracted_body_ = near.body;
+    ensure_adjacency(*near.fem, near.body);
+    select_tets(*near.fem, near.point, near.triangle, out);
+    fill_buffer(*near.fem, world.gravity, out);
+}
+
+}  // namespace sh

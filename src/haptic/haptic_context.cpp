@@ -1,0 +1,138 @@
+#include "haptic/haptic_context.hpp"
+
+#include "core/error.hpp"
+#include "model/fem_body.hpp"
+#include "world/world.hpp"
+
+#include <cmath>
+#include <cstring>
+
+namespace sh {
+namespace {
+
+// The haptic side's working arrays, carved after the three buffers.
+struct WorkingArrays {
+    double* x[2];
+    double* v[2];
+    int32_t* id[2];
+    double* force;
+    double* saved_x;
+    double* saved_v;
+    double* depth;
+};
+
+void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3], WorkingArrays& w) {
+    for (Buffer& b : buffers) b.carve(arena, capacity);
+    const size_t n = static_cast<size_t>(capacity.nodes);
+    for (int k = 0; k < 2; ++k) {
+        w.x[k] = arena.take<double>(3 * n);
+        w.v[k] = arena.take<double>(3 * n);
+        w.id[k] = arena.take<int32_t>(n);
+    }
+    w.force = arena.take<double>(3 * n);
+    w.saved_x = arena.take<double>(3 * n);
+    w.saved_v = arena.take<double>(3 * n);
+    w.depth = arena.take<double>(n);
+}
+
+BufferCapacity capacity_of(const sh_haptic_def& def) { return BufferCapacity{def.capacity_tets, def.capacity_nodes}; }
+
+ForceLimits limits_of(const sh_haptic_def& def) {
+    return ForceLimits{def.max_force, def.max_force_rate, def.ramp_time};
+}
+
+void require_range(double value, double lo, double hi, bool lo_open, const char* name) {
+    const bool ok = std::isfinite(value) && (lo_open ? value > lo : value >= lo) && value <= hi;
+    require(ok, SH_ERR_INVALID_ARGUMENT,
+            format("def->%s = %g must be finite and in %s%g, %g]", name, value, lo_open ? "(" : "[", lo, hi));
+}
+
+}  // namespace
+
+void validate_haptic_def(const sh_haptic_def& def) {
+    require(def.capacity_tets >= 1 && def.capacity_tets <= 10000000, SH_ERR_INVALID_ARGUMENT,
+            format("def->capacity_tets = %d must be in [1, 1e7]", def.capacity_tets));
+    require(def.capacity_nodes >= 4 && def.capacity_nodes <= 10000000, SH_ERR_INVALID_ARGUMENT,
+            format("def->capacity_nodes = %d must be in [4, 1e7]", def.capacity_nodes));
+    require(def.rings >= 0 && def.rings <= 1000, SH_ERR_INVALID_ARGUMENT,
+            format("def->rings = %d must be in [0, 1000]", def.rings));
+    require_range(def.radius, 0.0, 1e3, true, "radius");
+    require_range(def.dt, 0.0, 1.0, true, "dt");
+    require_range(def.max_force, 0.0, 1e6, true, "max_force");
+    require_range(def.max_force_rate, 0.0, 1e12, true, "max_force_rate");
+    require_range(def.ramp_time, 0.0, 1e3, false, "ramp_time");
+    require_range(def.stale_after, 0.0, 1e3, true, "stale_after");
+}
+
+size_t HapticContext::memory_bytes(const sh_haptic_def& def) {
+    Arena measure;
+    Buffer buffers[3];
+    WorkingArrays w{};
+    carve_all(measure, capacity_of(def), buffers, w);
+    return measure.used();
+}
+
+HapticContext::HapticContext(World& world, const sh_haptic_def& def)
+    : def_(def), world_(&world), tool_(world.collider(def.tool, true)), filter_(limits_of(def)) {
+    validate_haptic_def(def);
+    require(tool_.shape.kind() != SH_SHAPE_CONVEX, SH_ERR_UNSUPPORTED,
+            "def->tool is a convex tool: the haptic step supports sphere, capsule and box tools (libccd's "
+            "penetration query allocates)");
+    arena_bytes_ = memory_bytes(def);
+    arena_ = allocate(arena_bytes_, 64);
+    Arena arena(arena_, arena_bytes_);
+    WorkingArrays w{};
+    carve_all(arena, capacity_of(def), buffers_, w);
+    for (int k = 0; k < 2; ++k) {
+        x_[k] = w.x[k];
+        v_[k] = w.v[k];
+        id_[k] = w.id[k];
+    }
+    force_ = w.force;
+    saved_x_ = w.saved_x;
+    saved_v_ = w.saved_v;
+    depth_ = w.depth;
+    pose_ = tool_.target;
+    try {
+        extract(world, 0.0, buffers_[buffer_index_.back()]);
+        buffer_index_.publish();
+    } catch (...) {
+        deallocate(arena_);
+        throw;
+    }
+}
+
+HapticContext::~HapticContext() { deallocate(arena_); }
+
+void HapticContext::detach() {
+    world_ = nullptr;
+    detached_.store(true, std::memory_order_release);
+}
+
+void HapticContext::before_step(World& world) {
+    if (device_index_.take()) {
+        const DevicePose& d = device_[device_index_.front()];
+        if (d.valid && world.is_valid_collider(def_.tool, true)) {
+            Collider& tool = world.collider(def_.tool, true);
+            tool.target = d.pose;
+        }
+    }
+    // The buffer's boundary moves across the step from where the step starts.
+    x_before_body_ = 0;
+    world.for_each_body([&](sh_body_id id, const Body& body) {
+        if (id != extracted_body_) return;
+        x_before_.assign(body.x.begin(), body.x.end());
+        x_before_body_ = id;
+    });
+}
+
+void HapticContext::after_step(World& world, double dt) {
+    extract(world, dt, buffers_[buffer_index_.back()]);
+    buffer_index_.publish();
+}
+
+void HapticContext::read_warnings(uint64_t out[SH_WARN_COUNT]) const {
+    for (int k = 0; k < SH_WARN_COUNT; ++k) out[k] = warnings_[k].load(std::memory_order_relaxed);
+}
+
+}  // namespace sh

@@ -1,0 +1,130 @@
+// HapticContext: the Volumetric Buffer Model of one tool. The sim side (World::step) cuts the
+// tets around the tool's contact out of the full model into a buffer and publishes it; the
+// haptic side (sh_haptic_step) takes the newest buffer, steps it explicitly at the device rate
+// in memory fixed at creation, and renders the tool's force through the ForceFilter. The two
+// sides meet only in two triple buffers (buffers one way, device poses the other).
+#pragma once
+
+#include "contact/collider.hpp"
+#include "core/memory.hpp"
+#include "haptic/buffer.hpp"
+#include "haptic/force_filter.hpp"
+#include "haptic/triple_buffer.hpp"
+
+#include <softhap/softhap.h>
+
+#include <atomic>
+#include <cstdint>
+
+namespace sh {
+
+class Body;
+class FemBody;
+class World;
+
+/// Validates def's fields (messages name them as def->field).
+void validate_haptic_def(const sh_haptic_def& def);
+
+/// One tool's haptic context.
+class HapticContext {
+public:
+    /// Bytes of the arena a context made from (validated) def holds.
+    static size_t memory_bytes(const sh_haptic_def& def);
+
+    /// Validates def against world (a live sphere, capsule or box tool), allocates the arena
+    /// and extracts the first buffer. Does not register with world.
+    HapticContext(World& world, const sh_haptic_def& def);
+    ~HapticContext();
+    HapticContext(const HapticContext&) = delete;
+    HapticContext& operator=(const HapticContext&) = delete;
+
+    // --- sim side ---------------------------------------------------------------------------
+
+    /// Moves the tool to the newest device pose and keeps the buffer body's start state.
+    void before_step(World& world);
+
+    /// Cuts a new buffer from the full model after a step of dt (s) and publishes it.
+    void after_step(World& world, double dt);
+
+    /// The world is gone: from now on the haptic step reports SH_HAPTIC_FAULT_NO_TOOL.
+    void detach();
+
+    /// The world it serves (null once detached).
+    World* world() const { return world_; }
+
+    // --- haptic side ------------------------------------------------------------------------
+
+    /// One haptic step (see sh_haptic_step). Never allocates, locks or throws.
+    sh_status step(const double position[3], const double orientation[4], double dt, sh_haptic_output& out) noexcept;
+
+    /// The warning counters (SH_WARN_COUNT values).
+    void read_warnings(uint64_t out[SH_WARN_COUNT]) const;
+
+private:
+    /// A device pose handed to the sim side.
+    struct DevicePose {
+        Pose pose;
+        bool valid = false;
+    };
+
+    // sim side
+    void extract(World& world, double period, Buffer& out);
+    void select_tets(const FemBody& body, const double center[3], int32_t seed_triangle, Buffer& out);
+    void fill_buffer(const FemBody& body, const double gravity[3], Buffer& out);
+    void ensure_adjacency(const FemBody& body, sh_body_id id);
+
+    // haptic side
+    void adopt(const Buffer& b);
+    bool step_buffer(const Buffer& b, double dt, double force[3], double torque[3], int32_t& substeps, bool& contact);
+    void add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double h, double force[3],
+                            double torque[3], bool& contact);
+    bool proxy_force(const Buffer& b, double force[3], double torque[3]) const;
+    double substep_limit(const Buffer& b, const double* x, double travel) const;
+
+    sh_haptic_def def_;
+    World* world_;
+    std::atomic<bool> detached_{false};
+    Collider tool_;  ///< the haptic side's own copy of the tool (shape, law, pose)
+
+    // the arena and what is carved from it
+    void* arena_ = nullptr;
+    size_t arena_bytes_ = 0;
+    Buffer buffers_[3];
+    TripleIndex buffer_index_;  ///< sim writes, haptic reads
+    DevicePose device_[3];
+    TripleIndex device_index_;  ///< haptic writes, sim reads
+
+    // haptic-side working state (arena)
+    double* x_[2] = {};  ///< node positions, current and spare for the hand-over
+    double* v_[2] = {};
+    int32_t* id_[2] = {};  ///< body node of each working node
+    int current_ = 0;
+    int32_t node_count_ = 0;
+    sh_body_id state_body_ = 0;
+    uint64_t state_sequence_ = 0;
+    double* force_ = nullptr;  ///< 3 per node
+    double* saved_x_ = nullptr;
+    double* saved_v_ = nullptr;
+    double* depth_ = nullptr;  ///< per node: its depth in the tool at this evaluation
+    double age_ = 0.0;         ///< haptic time since the newest buffer arrived (s)
+    Pose pose_;                ///< the last good device pose
+    bool have_pose_ = false;
+    ForceFilter filter_;
+    std::atomic<uint64_t> warnings_[SH_WARN_COUNT] = {};
+
+    // sim side (may allocate)
+    sh_body_id extracted_body_ = 0;  ///< the body of the last extraction
+    uint64_t extract_count_ = 0;
+    sh_body_id adjacency_body_ = 0;
+    int32_t adjacency_tets_ = -1;
+    vec<int32_t> node_tet_begin_, node_tet_;  ///< per body node: its tets (CSR)
+    vec<double> x_before_;                     ///< the buffer body's x before the step
+    sh_body_id x_before_body_ = 0;
+    vec<std::pair<double, int32_t>> ranked_;   ///< candidate tets by distance
+    vec<int32_t> local_of_;                    ///< body node -> local node, -1 outside
+    vec<uint8_t> in_buffer_;                   ///< per body tet
+    vec<int32_t> chosen_;                      ///< the buffer's tets (body numbers)
+    vec<int32_t> ring_;                        ///< ring expansion scratch
+};
+
+}  // namespace sh

@@ -1,0 +1,295 @@
+// The haptic side of the Volumetric Buffer Model: take the newest buffer, step it explicitly
+// to the device pose in the context's fixed memory, and render the tool's force. Nothing here
+// allocates, locks, logs or throws.
+#include "contact/hunt_crossley.hpp"
+#include "contact/shape_contact.hpp"
+#include "core/vec3.hpp"
+#include "haptic/haptic_context.hpp"
+#include "material/tet_materials.hpp"
+#include "model/fem_kernel.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace sh {
+namespace {
+
+// Most explicit sub-steps in one haptic step; beyond, the step is taken with this many and the
+// runaway check decides.
+constexpr int32_t kMaxSubsteps = 64;
+
+// Fraction of the critical step taken per sub-step.
+constexpr double kSafety = 0.9;
+
+// A step longer than this is not a haptic step (s).
+constexpr double kLongestStep = 1.0;
+
+inline double* at(double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
+inline const double* at(const double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
+
+bool boxes_overlap(const double lo[3], const double hi[3], const double* a, const double* b, const double* c) {
+    for (int k = 0; k < 3; ++k) {
+        const double t_lo = std::min({a[k], b[k], c[k]}), t_hi = std::max({a[k], b[k], c[k]});
+        if (t_hi < lo[k] || t_lo > hi[k]) return false;
+    }
+    return true;
+}
+
+bool inside_box(const double lo[3], const double hi[3], const double* p) {
+    return p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] && p[2] <= hi[2];
+}
+
+void add_reaction(const ContactPoint& p, const double* x, const double tool_position[3], double weight, double force[3],
+                  double torque[3]) {
+    for (int a = 0; a < p.count; ++a) {
+        double r[3], t[3];
+        const double reaction[3] = {-weight * p.node_force[a][0], -weight * p.node_force[a][1], -weight * p.node_force[a][2]};
+        sub3(at(x, p.nodes[a]), tool_position, r);
+        cross3(r, reaction, t);
+        for (int k = 0; k < 3; ++k) {
+            force[k] += reaction[k];
+            torque[k] += t[k];
+        }
+    }
+}
+
+}  // namespace
+
+void HapticContext::adopt(const Buffer& b) {
+    // Nodes the old buffer integrated keep the haptic side's state; new ones start from the
+    // full model at the start of its step, where the boundary starts too.
+    const int other = 1 - current_;
+    const bool same_body = b.body != 0 && b.body == state_body_;
+    int32_t j = 0;
+    for (int32_t i = 0; i < b.node_count; ++i) {
+        const int32_t id = b.node_id[i];
+        while (same_body && j < node_count_ && id_[current_][j] < id) ++j;
+        const bool kept = same_body && j < node_count_ && id_[current_][j] == id && b.inverse_mass[i] > 0.0;
+        const double* xs = kept ? at(x_[current_], j) : at(b.x_start, i);
+        const double* vs = kept ? at(v_[current_], j) : at(b.v_end, i);
+        for (int k = 0; k < 3; ++k) {
+            at(x_[other], i)[k] = xs[k];
+            at(v_[other], i)[k] = vs[k];
+        }
+        id_[other][i] = id;
+    }
+    current_ = other;
+    node_count_ = b.node_count;
+    state_body_ = b.body;
+    state_sequence_ = b.sequence;
+    age_ = 0.0;
+    for (int k = 0; k < SH_WARN_COUNT; ++k)
+        if (b.warnings & (1u << k)) warnings_[k].fetch_add(1, std::memory_order_relaxed);
+}
+
+double HapticContext::substep_limit(const Buffer& b, const double* x, double travel) const {
+    // omega^2 of the elements plus the stiffest contact a node may reach within the step.
+    const double omega_fem = b.dt_stable > 0.0 && std::isfinite(b.dt_stable) ? 2.0 / b.dt_stable : 0.0;
+    double lo[3], hi[3];
+    tool_.shape.bounds(tool_.pose, travel, lo, hi);
+    double step = omega_fem > 0.0 ? 2.0 / omega_fem : INFINITY;
+    for (int32_t s = 0; s < b.surface_node_count; ++s) {
+        const int32_t i = b.surface_nodes[s];
+        if (b.inverse_mass[i] == 0.0 || !inside_box(lo, hi, at(x, i))) continue;
+        ContactPoint p;
+        const double depth = node_shape_contact(tool_, x, i, p) ? p.depth : 0.0;
+        const NormalForce fn = hunt_crossley(tool_.params, depth + travel, 0.0);
+        const double m = b.mass[i];
+        step = std::min(step, damped_stable_step(m * omega_fem * omega_fem + fn.stiffness, fn.damping, m));
+    }
+    return kSafety * step;
+}
+
+void HapticContext::add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double h,
+                                       double force[3], double torque[3], bool& contact) {
+    double lo[3], hi[3];
+    tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
+    const sh_contact_params& law = tool_.params;
+    auto act = [&](ContactPoint& p, double touched_mass) {
+        double vrel[3];
+        velocity_against_collider(tool_, p, v, vrel);
+        // Explicit friction may stop a node within a sub-step, never reverse it.
+        apply_contact_law(law, vrel, touched_mass / h, p);
+        for (int a = 0; a < p.count; ++a)
+            for (int k = 0; k < 3; ++k) at(f, p.nodes[a])[k] += p.node_force[a][k];
+        add_reaction(p, x, tool_.pose.p, 1.0, force, torque);
+        contact = true;
+    };
+    for (int32_t s = 0; s < b.surface_node_count; ++s) {
+        const int32_t i = b.surface_nodes[s];
+        depth_[i] = 0.0;
+        if (!inside_box(lo, hi, at(x, i))) continue;
+        ContactPoint p;
+        if (!node_shape_contact(tool_, x, i, p)) continue;
+        depth_[i] = p.depth;
+        act(p, b.mass[i]);
+    }
+    // A tool between nodes: triangles act while none of their nodes touches.
+    for (int32_t t = 0; t < b.triangle_count; ++t) {
+        const int32_t* face = b.triangles + 3 * t;
+        if (depth_[face[0]] > 0.0 || depth_[face[1]] > 0.0 || depth_[face[2]] > 0.0) continue;
+        if (!boxes_overlap(lo, hi, at(x, face[0]), at(x, face[1]), at(x, face[2]))) continue;
+        ContactPoint p;
+        if (!face_shape_contact(tool_, x, face, p)) continue;
+        act(p, std::min({b.mass[face[0]], b.mass[face[1]], b.mass[face[2]]}));
+    }
+}
+
+bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], double torque[3], int32_t& substeps,
+                                bool& contact) {
+    const size_t n3 = 3 * static_cast<size_t>(b.node_count);
+    double* x = x_[current_];
+    double* v = v_[current_];
+    std::memcpy(saved_x_, x, n3 * sizeof(double));
+    std::memcpy(saved_v_, v, n3 * sizeof(double));
+    tool_.pose = tool_.start;
+    const double travel = std::sqrt(dot3(tool_.velocity, tool_.velocity)) * dt;
+    const double limit = substep_limit(b, x, travel);
+    substeps = limit > 0.0 && std::isfinite(limit) ? static_cast<int32_t>(std::min<double>(kMaxSubsteps, std::ceil(dt / limit))) : 1;
+    substeps = std::max(substeps, 1);
+    const double h = dt / substeps;
+    const double t0 = age_ - dt;  // age_ already counts this step
+    const Pose start = tool_.start;
+    for (int32_t s = 0; s < substeps; ++s) {
+        tool_.pose = interpolate(start, tool_.target, static_cast<double>(s + 1) / substeps);
+        // The boundary follows the full model across its step.
+        const double t = t0 + (s + 1) * h;
+        const double fraction = b.period > 0.0 ? std::min(1.0, t / b.period) : 1.0;
+        const double rate = b.period > 0.0 && t < b.period ? 1.0 / b.period : 0.0;
+        for (int32_t i = 0; i < b.node_count; ++i) {
+            if (b.inverse_mass[i] > 0.0) continue;
+            for (int k = 0; k < 3; ++k) {
+                const double d = at(b.x_end, i)[k] - at(b.x_start, i)[k];
+                at(x, i)[k] = at(b.x_start, i)[k] + fraction * d;
+                at(v, i)[k] = rate * d;
+            }
+        }
+        for (int32_t i = 0; i < b.node_count; ++i)
+            for (int k = 0; k < 3; ++k) at(force_, i)[k] = b.mass[i] * b.gravity[k];
+        const double* damped_v = b.damping_stiffness > 0.0 ? v : nullptr;
+        for_each_material([&](auto material, int model) {
+            const int32_t begin = b.block_begin[model], end = b.block_begin[model + 1];
+            add_fem_forces<decltype(material)>(b.blocks + begin, static_cast<size_t>(end - begin), x, damped_v,
+                                               b.damping_stiffness, force_);
+        });
+        double f_tool[3] = {0.0, 0.0, 0.0}, t_tool[3] = {0.0, 0.0, 0.0};
+        bool touching = false;
+        add_contact_forces(b, x, v, force_, h, f_tool, t_tool, touching);
+        for (int k = 0; k < 3; ++k) {  // the step's mean wrench
+            force[k] += f_tool[k] / substeps;
+            torque[k] += t_tool[k] / substeps;
+        }
+        contact = touching;
+        // Symplectic Euler, mass damping implicit.
+        const double damping = 1.0 / (1.0 + h * b.damping_mass);
+        for (int32_t i = 0; i < b.node_count; ++i) {
+            const double w = b.inverse_mass[i];
+            if (w == 0.0) continue;
+            for (int k = 0; k < 3; ++k) {
+                double& vi = at(v, i)[k];
+                vi = (vi + h * w * at(force_, i)[k]) * damping;
+                at(x, i)[k] += h * vi;
+            }
+        }
+    }
+    // Finite and not running away, or back to the state before the step.
+    const double fastest = b.runaway_speed * b.runaway_speed;
+    bool sane = std::isfinite(force[0] + force[1] + force[2] + torque[0] + torque[1] + torque[2]);
+    for (int32_t i = 0; i < b.node_count && sane; ++i)
+        sane = finite3(at(x, i)) && dot3(at(v, i), at(v, i)) <= fastest;
+    if (sane) return true;
+    std::memcpy(x, saved_x_, n3 * sizeof(double));
+    std::memcpy(v, saved_v_, n3 * sizeof(double));
+    for (int k = 0; k < 3; ++k) force[k] = torque[k] = 0.0;
+    return false;
+}
+
+bool HapticContext::proxy_force(const Buffer& b, double force[3], double torque[3]) const {
+    // The tool's deepest point behind the last known surface plane.
+    const double* n = b.proxy_normal;
+    const double inward[3] = {-n[0], -n[1], -n[2]};
+    double s[3], d[3];
+    tool_.shape.support(tool_.target, inward, s);
+    sub3(b.proxy_point, s, d);
+    const double depth = dot3(d, n);
+    const NormalForce fn = hunt_crossley(tool_.params, depth, -dot3(tool_.velocity, n));
+    if (!(fn.force > 0.0)) return false;
+    double r[3];
+    sub3(s, tool_.target.p, r);
+    for (int k = 0; k < 3; ++k) force[k] = fn.force * n[k];
+    cross3(r, force, torque);
+    return true;
+}
+
+sh_status HapticContext::step(const double position[3], const double orientation[4], double dt,
+                              sh_haptic_output& out) noexcept {
+    sh_status status = SH_OK;
+    uint32_t faults = 0;
+    const bool dt_ok = std::isfinite(dt) && dt > 0.0 && dt <= kLongestStep;
+    if (!dt_ok) {
+        faults |= SH_HAPTIC_FAULT_DT;
+        status = SH_ERR_INVALID_ARGUMENT;
+    }
+    const double step_dt = dt_ok ? dt : def_.dt;  // what the force ramps move by
+    Pose pose = pose_;
+    bool pose_ok = position && orientation && finite3(position);
+    double q2 = 0.0;
+    if (pose_ok) {
+        for (int k = 0; k < 4; ++k) q2 += orientation[k] * orientation[k];
+        pose_ok = std::isfinite(q2) && q2 > 0.0;
+    }
+    if (pose_ok) {
+        const double inv = 1.0 / std::sqrt(q2);
+        for (int k = 0; k < 3; ++k) pose.p[k] = position[k];
+        for (int k = 0; k < 4; ++k) pose.q[k] = orientation[k] * inv;
+        DevicePose& d = device_[device_index_.back()];
+        d.pose = pose;
+        d.valid = true;
+        device_index_.publish();
+    } else {
+        faults |= SH_HAPTIC_FAULT_POSE;
+        status = SH_ERR_INVALID_ARGUMENT;
+    }
+    if (buffer_index_.take()) adopt(buffers_[buffer_index_.front()]);
+    const Buffer& b = buffers_[buffer_index_.front()];
+    if (detached_.load(std::memory_order_acquire) || !b.tool_alive) faults |= SH_HAPTIC_FAULT_NO_TOOL;
+    if (dt_ok) age_ += dt;
+
+    double raw_force[3] = {0.0, 0.0, 0.0}, raw_torque[3] = {0.0, 0.0, 0.0};
+    bool contact = false;
+    int32_t substeps = 0;
+    if (dt_ok && pose_ok && !(faults & SH_HAPTIC_FAULT_NO_TOOL)) {
+        tool_.start = have_pose_ ? pose_ : pose;
+        tool_.target = pose;
+        tool_.velocity_given = false;
+        tool_.begin_step(dt);
+        if (b.node_count > 0) {
+            if (!step_buffer(b, dt, raw_force, raw_torque, substeps, contact)) {
+                faults |= SH_HAPTIC_FAULT_UNSTABLE;
+                warnings_[SH_WARN_UNSTABLE].fetch_add(1, std::memory_order_relaxed);
+            }
+        } else if (b.has_proxy) {
+            contact = proxy_force(b, raw_force, raw_torque);
+        }
+        pose_ = pose;
+        have_pose_ = true;
+    }
+    if (age_ > def_.stale_after) faults |= SH_HAPTIC_FAULT_STALE;
+
+    out = sh_haptic_output{};
+    const uint32_t warnings = filter_.update(raw_force, raw_torque, faults == 0, step_dt, out.force, out.torque);
+    for (int k = 0; k < SH_WARN_COUNT; ++k)
+        if (warnings & (1u << k)) warnings_[k].fetch_add(1, std::memory_order_relaxed);
+    for (int k = 0; k < 3; ++k) out.raw_force[k] = std::isfinite(raw_force[k]) ? raw_force[k] : 0.0;
+    out.contact = contact ? 1 : 0;
+    out.buffer_tets = b.tet_count;
+    out.buffer_nodes = b.node_count;
+    out.substeps = substeps;
+    out.data_age = age_;
+    out.faults = faults;
+    out.warnings = warnings | (faults & SH_HAPTIC_FAULT_UNSTABLE ? 1u << SH_WARN_UNSTABLE : 0u);
+    return status;
+}
+
+}  // namespace sh

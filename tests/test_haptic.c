@@ -1,0 +1,587 @@
+/* Haptic rendering with the Volumetric Buffer Model: the buffer's force against the full model
+ * solved at the same tool pose, the force-output contract (finite, clamped, rate-limited,
+ * ramped in, held and ramped out on stale data and faults, rolled back when unstable), the
+ * first force one tick after contact, capacity overflow, and a haptic thread that neither
+ * allocates nor locks over 1e5 steps while the sim thread steps concurrently. */
+#define _GNU_SOURCE
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+
+#include "test_support.h"
+
+#include <dlfcn.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------------------------ */
+/* Allocation and lock counting on the haptic thread                                            */
+
+/* Interposed malloc and pthread locks count calls made from a watched thread (Eigen, libccd and
+ * libstdc++ allocate through malloc, std::mutex locks through pthread_mutex_lock). Sanitizer
+ * builds intercept these themselves: there the counters stay unused and the count test is
+ * skipped (the ThreadSanitizer run checks the same loop for races instead). */
+#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+#define COUNTING_INTERPOSED 0
+#else
+#define COUNTING_INTERPOSED 1
+#endif
+
+static _Thread_local int tl_watched;
+static atomic_long g_watched_allocations;
+static atomic_long g_watched_locks;
+
+#if COUNTING_INTERPOSED
+extern void* __libc_malloc(size_t size);
+extern void* __libc_calloc(size_t count, size_t size);
+extern void* __libc_realloc(void* ptr, size_t size);
+extern void* __libc_memalign(size_t alignment, size_t size);
+extern void __libc_free(void* ptr);
+
+static void note_allocation(void) {
+    if (tl_watched) atomic_fetch_add(&g_watched_allocations, 1);
+}
+void* malloc(size_t size) {
+    note_allocation();
+    return __libc_malloc(size);
+}
+void* calloc(size_t count, size_t size) {
+    note_allocation();
+    return __libc_calloc(count, size);
+}
+void* realloc(void* ptr, size_t size) {
+    note_allocation();
+    return __libc_realloc(ptr, size);
+}
+void* aligned_alloc(size_t alignment, size_t size) {
+    note_allocation();
+    return __libc_memalign(alignment, size);
+}
+void* memalign(size_t alignment, size_t size) {
+    note_allocation();
+    return __libc_memalign(alignment, size);
+}
+int posix_memalign(void** out, size_t alignment, size_t size) {
+    note_allocation();
+    void* p = __libc_memalign(alignment, size);
+    if (!p) return 12; /* ENOMEM */
+    *out = p;
+    return 0;
+}
+void free(void* ptr) {
+    if (ptr) note_allocation();
+    __libc_free(ptr);
+}
+
+typedef int (*mutex_fn)(pthread_mutex_t*);
+typedef int (*rwlock_fn)(pthread_rwlock_t*);
+int pthread_mutex_lock(pthread_mutex_t* m) {
+    static mutex_fn real;
+    if (!real) real = (mutex_fn)dlsym(RTLD_NEXT, "pthread_mutex_lock");
+    if (tl_watched) atomic_fetch_add(&g_watched_locks, 1);
+    return real(m);
+}
+int pthread_mutex_trylock(pthread_mutex_t* m) {
+    static mutex_fn real;
+    if (!real) real = (mutex_fn)dlsym(RTLD_NEXT, "pthread_mutex_trylock");
+    if (tl_watched) atomic_fetch_add(&g_watched_locks, 1);
+    return real(m);
+}
+int pthread_rwlock_rdlock(pthread_rwlock_t* l) {
+    static rwlock_fn real;
+    if (!real) real = (rwlock_fn)dlsym(RTLD_NEXT, "pthread_rwlock_rdlock");
+    if (tl_watched) atomic_fetch_add(&g_watched_locks, 1);
+    return real(l);
+}
+int pthread_rwlock_wrlock(pthread_rwlock_t* l) {
+    static rwlock_fn real;
+    if (!real) real = (rwlock_fn)dlsym(RTLD_NEXT, "pthread_rwlock_wrlock");
+    if (tl_watched) atomic_fetch_add(&g_watched_locks, 1);
+    return real(l);
+}
+#endif
+
+/* The host allocator counts too (everything softhap allocates goes through it). */
+static void* counting_alloc(size_t size, size_t alignment, void* user) {
+    (void)user;
+    if (tl_watched) atomic_fetch_add(&g_watched_allocations, 1);
+    void* p = NULL;
+    return posix_memalign(&p, alignment < sizeof(void*) ? sizeof(void*) : alignment, size) == 0 ? p : NULL;
+}
+static void counting_free(void* ptr, void* user) {
+    (void)user;
+    if (ptr && tl_watched) atomic_fetch_add(&g_watched_allocations, 1);
+    free(ptr);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* The scene: a soft block on a fixed base, a sphere tool above its top face                    */
+
+static const double kBlock[3] = {0.02, 0.02, 0.01}; /* m */
+static const double kRadius = 0.005;                /* tool radius (m) */
+static const double kIdentity[4] = {1.0, 0.0, 0.0, 0.0};
+
+typedef struct scene {
+    sh_world* world;
+    sh_body_id body;
+    sh_tool_id tool;
+} scene;
+
+static scene make_scene(double damping_mass, double tool_z) {
+    scene s;
+    s.world = sh_test_world(0.0);
+    sh_mesh* mesh = sh_test_box(kBlock[0], kBlock[1], kBlock[2], 8, 8, 4);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.material.model = SH_MATERIAL_NEOHOOKEAN;
+    def.material.young = 5e3;
+    def.material.poisson = 0.3;
+    def.material.density = 1000.0;
+    def.damping_mass = damping_mass;
+    assert_ok(sh_world_add_fem_body(s.world, &def, &s.body));
+    const sh_mesh_info info = sh_test_mesh_info(mesh);
+    double* x = malloc(3 * sizeof(double) * (size_t)info.node_count);
+    int32_t* base = malloc(sizeof(int32_t) * (size_t)info.node_count);
+    assert_ok(sh_mesh_get_nodes(mesh, x, 3 * (int64_t)info.node_count));
+    const int base_count = sh_test_nodes_at(x, info.node_count, 2, 0.0, base);
+    assert_ok(sh_body_fix_nodes(s.world, s.body, base, base_count));
+    free(x);
+    free(base);
+    assert_ok(sh_mesh_destroy(mesh));
+
+    sh_collider_def tool;
+    sh_collider_def_default(&tool);
+    tool.shape.radius = kRadius;
+    tool.contact.stiffness = 100.0; /* N/m per contact point */
+    tool.contact.exponent = 1.0;
+    tool.contact.damping = 0.0;
+    tool.position[0] = 0.5 * kBlock[0];
+    tool.position[1] = 0.5 * kBlock[1];
+    tool.position[2] = tool_z;
+    assert_ok(sh_tool_create(s.world, &tool, &s.tool));
+    return s;
+}
+
+static sh_haptic_def haptic_def(const scene* s) {
+    sh_haptic_def def;
+    sh_haptic_def_default(&def);
+    def.tool = s->tool;
+    return def;
+}
+
+static double norm3(const double* a) { return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
+
+/* ------------------------------------------------------------------------------------------ */
+/* The buffer's force against the full model                                                    */
+
+/* With a buffer that holds the whole block, the only boundary nodes are the fixed base: the
+ * buffer is the full model, stepped explicitly at the haptic rate. Pressed slowly and let to
+ * settle (mass damping), its force must equal the full model's static solve at the same tool
+ * pose. */
+static void test_whole_body_buffer_matches_static_solve(void** state) {
+    (void)state;
+    const double depth = 0.002, top = kBlock[2] + kRadius;
+    const double pressed[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top - depth};
+
+    scene reference = make_scene(0.0, top);
+    assert_ok(sh_tool_set_pose(reference.world, reference.tool, pressed, kIdentity));
+    sh_static_def solve;
+    sh_static_def_default(&solve);
+    solve.tolerance = 1e-9;
+    assert_ok(sh_world_solve_static(reference.world, &solve, NULL));
+    double f_static[3], t_static[3];
+    assert_ok(sh_tool_get_wrench(reference.world, reference.tool, f_static, t_static));
+
+    scene s = make_scene(40.0, top);
+    sh_haptic_def def = haptic_def(&s);
+    def.radius = 1.0; /* everything */
+    def.capacity_tets = 2000;
+    def.capacity_nodes = 1000;
+    def.max_force = 100.0;
+    def.max_force_rate = 1e6;
+    def.ramp_time = 0.0;
+    def.stale_after = 1e3; /* the sim thread does not step here */
+    sh_haptic* haptic = NULL;
+    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    sh_haptic_output out;
+    const double dt = 1e-3;
+    for (int i = 0; i < 3000; ++i) {
+        const double s_press = i < 300 ? (i + 1) / 300.0 : 1.0; /* press over 0.3 s, then hold */
+        const double p[3] = {pressed[0], pressed[1], top - s_press * depth};
+        assert_ok(sh_haptic_step(haptic, p, kIdentity, dt, &out));
+        assert_int_equal(out.faults, 0);
+    }
+    printf("whole-body buffer: %d tets, %d nodes, %d sub-steps; force %.6g N against the static solve's %.6g N\n",
+           out.buffer_tets, out.buffer_nodes, out.substeps, out.raw_force[2], f_static[2]);
+    assert_int_equal(out.buffer_tets, 8 * 8 * 4 * 6);
+    assert_true(out.contact);
+    assert_true(f_static[2] > 0.05);
+    assert_close(out.raw_force[2], f_static[2], 2e-3 * f_static[2]);
+    assert_close(out.force[2], out.raw_force[2], 1e-12);
+    for (int k = 0; k < 2; ++k) assert_close(out.raw_force[k], f_static[k], 2e-3 * f_static[2]);
+
+    assert_ok(sh_haptic_destroy(haptic));
+    sh_world_destroy(s.world);
+    sh_world_destroy(reference.world);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* The force-output contract                                                                    */
+
+/* A deep press gives a raw force far above max_force: the output never exceeds it, never moves
+ * more than max_force_rate * dt per tick, ramps in from zero, and stays finite. */
+static void test_force_is_clamped_rate_limited_and_ramped_in(void** state) {
+    (void)state;
+    const double top = kBlock[2] + kRadius;
+    scene s = make_scene(40.0, top);
+    sh_haptic_def def = haptic_def(&s);
+    def.radius = 0.008;
+    def.max_force = 0.05;
+    def.max_force_rate = 20.0; /* N/s: 0.02 N per 1 ms tick */
+    def.ramp_time = 0.02;
+    def.stale_after = 1e3;
+    sh_haptic* haptic = NULL;
+    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    const double dt = 1e-3;
+    double last[3] = {0.0, 0.0, 0.0}, largest_raw = 0.0;
+    uint32_t seen = 0;
+    for (int i = 0; i < 400; ++i) {
+        const double p[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top - 0.004 * fmin(1.0, (i + 1) / 50.0)};
+        sh_haptic_output out;
+        assert_ok(sh_haptic_step(haptic, p, kIdentity, dt, &out));
+        double change[3];
+        for (int k = 0; k < 3; ++k) {
+            assert_true(isfinite(out.force[k]) && isfinite(out.torque[k]));
+            change[k] = out.force[k] - last[k];
+            last[k] = out.force[k];
+        }
+        assert_true(norm3(out.force) <= def.max_force * (1.0 + 1e-12));
+        assert_true(norm3(change) <= def.max_force_rate * dt * (1.0 + 1e-12));
+        /* Ramp-in: the gain after i + 1 ticks is (i + 1) dt / ramp_time. */
+        const double gain = fmin(1.0, (i + 1) * dt / def.ramp_time);
+        assert_true(norm3(out.force) <= gain * norm3(out.raw_force) * (1.0 + 1e-12) + 1e-15);
+        if (norm3(out.raw_force) > largest_raw) largest_raw = norm3(out.raw_force);
+        seen |= out.warnings;
+    }
+    printf("clamp: raw force up to %.4g N rendered at most %.4g N\n", largest_raw, def.max_force);
+    assert_true(largest_raw > 2.0 * def.max_force);
+    assert_close(norm3(last), def.max_force, 1e-9);
+    assert_true(seen & (1u << SH_WARN_FORCE_CLAMPED));
+    uint64_t counters[SH_WARN_COUNT];
+    assert_ok(sh_haptic_get_warnings(haptic, counters));
+    assert_true(counters[SH_WARN_FORCE_CLAMPED] > 0);
+    assert_ok(sh_haptic_destroy(haptic));
+    sh_world_destroy(s.world);
+}
+
+/* Steps the haptic context at a fixed press until `ticks` ticks have passed; returns the last
+ * output. */
+static sh_haptic_output press(sh_haptic* haptic, double z, int ticks, double dt) {
+    sh_haptic_output out;
+    memset(&out, 0, sizeof out);
+    for (int i = 0; i < ticks; ++i) {
+        const double p[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], z};
+        sh_haptic_step(haptic, p, kIdentity, dt, &out);
+    }
+    return out;
+}
+
+/* No full-model data for longer than stale_after: the force holds, then ramps out to zero
+ * within ramp_time (plus the rate limit), with SH_HAPTIC_FAULT_STALE raised; a world step
+ * brings fresh data and the force ramps back in. A NaN pose is a status and a fault, never a
+ * NaN force. */
+static void test_stale_data_and_bad_pose_ramp_the_force_out(void** state) {
+    (void)state;
+    const double top = kBlock[2] + kRadius, z = top - 0.002, dt = 1e-3;
+    scene s = make_scene(40.0, top);
+    sh_haptic_def def = haptic_def(&s);
+    def.radius = 0.008;
+    def.ramp_time = 0.01;
+    def.stale_after = 0.2;
+    sh_haptic* haptic = NULL;
+    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    sh_haptic_output out = press(haptic, z, 150, dt);
+    assert_int_equal(out.faults, 0);
+    const double held = norm3(out.force);
+    assert_true(held > 0.01);
+    out = press(haptic, z, 60, dt); /* age 0.21 s */
+    assert_true(out.faults & SH_HAPTIC_FAULT_STALE);
+    out = press(haptic, z, 10, dt); /* ramp_time later: the gain is 0 */
+    assert_true(out.faults & SH_HAPTIC_FAULT_STALE);
+    printf("stale: %.4g N held, %.3g N after ramp-out, data age %.3f s\n", held, norm3(out.force), out.data_age);
+    assert_true(norm3(out.force) == 0.0);
+
+    assert_ok(sh_world_step(s.world, 1.0 / 60.0, NULL));
+    out = press(haptic, z, 1, dt);
+    assert_int_equal(out.faults, 0);
+    assert_true(out.data_age <= dt * 1.000001);
+    out = press(haptic, z, 30, dt);
+    assert_true(norm3(out.force) > 0.5 * held);
+
+    /* NaN pose: invalid argument, a fault bit, and a finite force that ramps out. */
+    const double bad[3] = {NAN, 0.0, 0.0};
+    for (int i = 0; i < 20; ++i) {
+        assert_int_equal(sh_haptic_step(haptic, bad, kIdentity, dt, &out), SH_ERR_INVALID_ARGUMENT);
+        assert_true(out.faults & SH_HAPTIC_FAULT_POSE);
+        assert_true(isfinite(out.force[0]) && isfinite(out.force[1]) && isfinite(out.force[2]));
+    }
+    assert_true(norm3(out.force) == 0.0);
+    const double zero_q[4] = {0.0, 0.0, 0.0, 0.0};
+    const double p[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], z};
+    assert_int_equal(sh_haptic_step(haptic, p, zero_q, dt, &out), SH_ERR_INVALID_ARGUMENT);
+    assert_int_equal(sh_haptic_step(haptic, p, kIdentity, NAN, &out), SH_ERR_INVALID_ARGUMENT);
+    assert_true(out.faults & SH_HAPTIC_FAULT_DT);
+    assert_int_equal(sh_haptic_step(haptic, p, kIdentity, dt, NULL), SH_ERR_INVALID_ARGUMENT);
+    assert_int_equal(sh_haptic_step(NULL, p, kIdentity, dt, &out), SH_ERR_INVALID_HANDLE);
+    assert_ok(sh_haptic_step(haptic, p, kIdentity, dt, &out));
+    assert_int_equal(out.faults, 0);
+
+    /* The tool destroyed, then the world: a fault, a finite zero force, no crash. */
+    assert_ok(sh_tool_destroy(s.world, s.tool));
+    assert_ok(sh_world_step(s.world, 1.0 / 60.0, NULL));
+    out = press(haptic, z, 30, dt);
+    assert_true(out.faults & SH_HAPTIC_FAULT_NO_TOOL);
+    assert_true(norm3(out.force) == 0.0);
+    sh_world_destroy(s.world);
+    out = press(haptic, z, 2, dt);
+    assert_true(out.faults & SH_HAPTIC_FAULT_NO_TOOL);
+    assert_ok(sh_haptic_destroy(haptic));
+    assert_int_equal(sh_haptic_destroy(haptic), SH_ERR_INVALID_HANDLE);
+}
+
+/* A contact far too stiff for the sub-step budget makes the buffer run away: the step is
+ * rolled back, SH_HAPTIC_FAULT_UNSTABLE raised and counted, and the output stays finite. */
+static void test_unstable_buffer_rolls_back(void** state) {
+    (void)state;
+    const double top = kBlock[2] + kRadius, dt = 1e-3;
+    scene s = make_scene(0.0, top);
+    sh_tool_destroy(s.world, s.tool);
+    sh_collider_def tool;
+    sh_collider_def_default(&tool);
+    tool.shape.radius = kRadius;
+    tool.contact.stiffness = 1e12;
+    tool.contact.exponent = 1.0;
+    tool.contact.damping = 0.0;
+    tool.position[0] = 0.5 * kBlock[0];
+    tool.position[1] = 0.5 * kBlock[1];
+    tool.position[2] = top;
+    assert_ok(sh_tool_create(s.world, &tool, &s.tool));
+    sh_haptic_def def = haptic_def(&s);
+    def.radius = 0.008;
+    def.stale_after = 1e3;
+    sh_haptic* haptic = NULL;
+    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    uint32_t faults = 0;
+    sh_haptic_output out;
+    for (int i = 0; i < 50; ++i) {
+        const double p[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top - 1e-4 * (i + 1)};
+        sh_haptic_step(haptic, p, kIdentity, dt, &out);
+        faults |= out.faults;
+        for (int k = 0; k < 3; ++k) assert_true(isfinite(out.force[k]) && isfinite(out.torque[k]));
+        assert_true(norm3(out.force) <= def.max_force * (1.0 + 1e-12));
+    }
+    uint64_t counters[SH_WARN_COUNT];
+    assert_ok(sh_haptic_get_warnings(haptic, counters));
+    printf("unstable buffer: %llu roll-backs in 50 ticks\n", (unsigned long long)counters[SH_WARN_UNSTABLE]);
+    assert_true(faults & SH_HAPTIC_FAULT_UNSTABLE);
+    assert_true(counters[SH_WARN_UNSTABLE] > 0);
+    assert_ok(sh_haptic_destroy(haptic));
+    sh_world_destroy(s.world);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* First force, proxy and capacity                                                              */
+
+/* The device moves into the tissue between two full-model steps: the very tick whose pose
+ * penetrates renders a force, from the buffer when the tool was near at the last extraction,
+ * and from the proxy plane when it was too far for a buffer. */
+static void test_first_force_one_tick_after_contact(void** state) {
+    (void)state;
+    const double top = kBlock[2] + kRadius, dt = 1e-3;
+    const double heights[2] = {top + 0.001, top + 0.05}; /* near: buffer; far: proxy only */
+    for (int c = 0; c < 2; ++c) {
+        scene s = make_scene(40.0, heights[c]);
+        sh_haptic_def def = haptic_def(&s);
+        def.radius = 0.008;
+        def.ramp_time = 0.0;
+        def.stale_after = 1e3;
+        sh_haptic* haptic = NULL;
+        assert_ok(sh_haptic_create(s.world, &def, &haptic));
+        sh_haptic_output out;
+        const double above[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top + 1e-4};
+        assert_ok(sh_haptic_step(haptic, above, kIdentity, dt, &out));
+        assert_int_equal(out.contact, 0);
+        assert_true(norm3(out.force) == 0.0);
+        const double in[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top - 5e-4};
+        assert_ok(sh_haptic_step(haptic, in, kIdentity, dt, &out));
+        printf("%s: first tick in contact: %d buffer tets, raw %.4g N, rendered %.4g N\n", c ? "proxy" : "buffer",
+               out.buffer_tets, out.raw_force[2], out.force[2]);
+        assert_int_equal(out.contact, 1);
+        assert_true(out.force[2] > 0.0);
+        if (c == 0) assert_true(out.buffer_tets > 0);
+        if (c == 1) {
+            assert_int_equal(out.buffer_tets, 0);
+            /* One Hunt-Crossley point (n = 1, no damping) at the sphere's depth below the plane. */
+            assert_close(out.raw_force[2], 100.0 * 5e-4, 1e-9);
+        }
+        assert_ok(sh_haptic_destroy(haptic));
+        sh_world_destroy(s.world);
+    }
+}
+
+/* Capacity overflow keeps the nearest tets, fills the capacity and counts a warning. */
+static void test_capacity_overflow_keeps_the_nearest(void** state) {
+    (void)state;
+    const double top = kBlock[2] + kRadius, dt = 1e-3;
+    scene s = make_scene(40.0, top);
+    sh_haptic_def def = haptic_def(&s);
+    def.radius = 0.008;
+    def.capacity_tets = 12;
+    def.stale_after = 1e3;
+    sh_haptic* haptic = NULL;
+    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    const double p[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top - 5e-4};
+    sh_haptic_output out;
+    int contact_ticks = 0;
+    for (int i = 0; i < 20; ++i) {
+        assert_ok(sh_haptic_step(haptic, p, kIdentity, dt, &out));
+        contact_ticks += out.contact;
+    }
+    assert_int_equal(out.buffer_tets, 12);
+    /* The nearest tets are those around the node under the tool: it bounces on the tool. */
+    assert_true(contact_ticks > 0);
+    uint64_t counters[SH_WARN_COUNT];
+    assert_ok(sh_haptic_get_warnings(haptic, counters));
+    assert_true(counters[SH_WARN_CAPACITY] >= 1);
+    size_t small = 0, large = 0;
+    assert_ok(sh_haptic_memory_bytes(&def, &small));
+    def.capacity_tets = 2000;
+    assert_ok(sh_haptic_memory_bytes(&def, &large));
+    assert_true(small < large);
+    def.radius = -1.0;
+    assert_int_equal(sh_haptic_memory_bytes(&def, &large), SH_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(sh_last_error_message(), "def->radius"));
+    assert_ok(sh_haptic_destroy(haptic));
+    sh_world_destroy(s.world);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Allocation-free and lock-free, under a concurrent sim thread                                 */
+
+typedef struct run_state {
+    sh_world* world;
+    sh_haptic* haptic;
+    atomic_int haptic_done;
+    long sim_steps;
+    long steps;
+    double largest_force;
+    long contact_ticks;
+    long fresh_data;
+    int bad_status;
+} run_state;
+
+static void* sim_thread(void* arg) {
+    run_state* r = (run_state*)arg;
+    while (!atomic_load(&r->haptic_done)) {
+        if (sh_world_step(r->world, 1.0 / 60.0, NULL) != SH_OK) r->bad_status = 1;
+        ++r->sim_steps;
+    }
+    return NULL;
+}
+
+static void* haptic_thread(void* arg) {
+    run_state* r = (run_state*)arg;
+    const double top = kBlock[2] + kRadius, dt = 1e-3;
+    sh_haptic_output out;
+    tl_watched = 1;
+    for (long i = 0; i < r->steps; ++i) {
+        /* Press 2 mm over 0.5 s, slide 6 mm and back over 2 s, in a loop (haptic time). */
+        const double t = fmod(i * dt, 3.0);
+        const double depth = 0.002 * fmin(1.0, t / 0.5);
+        const double slide = t < 0.5 ? 0.0 : 0.003 * sin(M_PI * (t - 0.5) / 1.25);
+        const double p[3] = {0.5 * kBlock[0] + slide, 0.5 * kBlock[1], top - depth};
+        if (sh_haptic_step(r->haptic, p, kIdentity, dt, &out) != SH_OK) r->bad_status = 2;
+        if (norm3(out.force) > r->largest_force) r->largest_force = norm3(out.force);
+        r->contact_ticks += out.contact;
+        r->fresh_data += out.data_age <= dt * 1.000001;
+    }
+    tl_watched = 0;
+    atomic_store(&r->haptic_done, 1);
+    return NULL;
+}
+
+static void test_haptic_thread_never_allocates_nor_locks(void** state) {
+    (void)state;
+    const sh_allocator allocator = {counting_alloc, counting_free, NULL};
+    assert_ok(sh_set_allocator(&allocator));
+    const double top = kBlock[2] + kRadius;
+    scene s = make_scene(40.0, top);
+    sh_haptic_def def = haptic_def(&s);
+    def.radius = 0.008;
+    sh_haptic* haptic = NULL;
+    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    run_state r;
+    memset(&r, 0, sizeof r);
+    r.world = s.world;
+    r.haptic = haptic;
+    r.steps = 100000;
+#if COUNTING_INTERPOSED
+    /* The counters see what they must: a malloc and free, a mutex, and the allocation of an
+     * error message inside the library (through operator new). */
+    tl_watched = 1;
+    void* volatile block = malloc(16);
+    free(block);
+    pthread_mutex_t mutex = PTHREAD_MUTEX_INITIALIZER;
+    pthread_mutex_lock(&mutex);
+    pthread_mutex_unlock(&mutex);
+    const long direct = atomic_load(&g_watched_allocations);
+    sh_haptic_def bad = def;
+    bad.radius = NAN;
+    size_t bytes = 0;
+    assert_int_equal(sh_haptic_memory_bytes(&bad, &bytes), SH_ERR_INVALID_ARGUMENT);
+    tl_watched = 0;
+    assert_int_equal(direct, 2);
+    assert_true(atomic_load(&g_watched_allocations) > direct);
+    assert_int_equal(atomic_load(&g_watched_locks), 1);
+#endif
+    atomic_store(&g_watched_allocations, 0);
+    atomic_store(&g_watched_locks, 0);
+    pthread_t sim, device;
+    assert_int_equal(pthread_create(&sim, NULL, sim_thread, &r), 0);
+    assert_int_equal(pthread_create(&device, NULL, haptic_thread, &r), 0);
+    pthread_join(device, NULL);
+    pthread_join(sim, NULL);
+    const long allocations = atomic_load(&g_watched_allocations), locks = atomic_load(&g_watched_locks);
+    printf("haptic thread: %ld steps beside %ld sim steps; %ld ticks in contact, %ld with fresh data, "
+           "largest force %.4g N; %ld allocations, %ld locks%s\n",
+           r.steps, r.sim_steps, r.contact_ticks, r.fresh_data, r.largest_force, allocations, locks,
+           COUNTING_INTERPOSED ? "" : " (not counted: sanitizer build)");
+    assert_int_equal(r.bad_status, 0);
+    assert_true(r.sim_steps > 10);
+    assert_true(r.fresh_data > 10);
+    assert_true(r.contact_ticks > r.steps / 2);
+    assert_true(r.largest_force > 0.01);
+    assert_int_equal(allocations, 0);
+    assert_int_equal(locks, 0);
+    assert_ok(sh_haptic_destroy(haptic));
+    sh_world_destroy(s.world);
+    assert_ok(sh_set_allocator(NULL));
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_whole_body_buffer_matches_static_solve),
+        cmocka_unit_test(test_force_is_clamped_rate_limited_and_ramped_in),
+        cmocka_unit_test(test_stale_data_and_bad_pose_ramp_the_force_out),
+        cmocka_unit_test(test_unstable_buffer_rolls_back),
+        cmocka_unit_test(test_first_force_one_tick_after_contact),
+        cmocka_unit_test(test_capacity_overflow_keeps_the_nearest),
+        cmocka_unit_test(test_haptic_thread_never_allocates_nor_locks),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -97,7 +97,7 @@ def _python_constants():
     """{C name: value} of every enum constant and macro the bindings mirror."""
     constants = {"SH_VERSION": _lib.SH_VERSION, "SH_WARN_COUNT": _lib.SH_WARN_COUNT,
                  "SH_STATIC_HISTORY": _lib.SH_STATIC_HISTORY}
-    for enum_class in (_lib.Status, _lib.WarningKind, _lib.FeatureKind):
+    for enum_class in (_lib.Status, _lib.WarningKind, _lib.FeatureKind, _lib.HapticFault):
         constants.update({member.name: int(member) for member in enum_class})
     for prefix, table in [
         ("SH_INTEGRATOR_", _lib.INTEGRATORS),

@@ -16,11 +16,12 @@ call raises softhap.Error with the status and sh_last_error_message().
 """
 
 from ._errors import Error, status_name
-from ._lib import SH_VERSION, FeatureKind, Status, WarningKind, version_string
+from ._lib import SH_VERSION, FeatureKind, HapticFault, Status, WarningKind, version_string
 from ._loaded import lib as _c_library
 from ._loaded import status_string
 from ._record import BodyInfo, MeshInfo, StaticReport, StepReport
 from .contact import ContactState, Obstacle, Tool
+from .haptic import Haptic, HapticResult
 from .mesh import Mesh
 from .world import Body, World
 
@@ -49,6 +50,9 @@ __all__ = [
     "ContactState",
     "Error",
     "FeatureKind",
+    "Haptic",
+    "HapticFault",
+    "HapticResult",
     "Mesh",
     "MeshInfo",
     "Obstacle",

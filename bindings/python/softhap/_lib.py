@@ -17,6 +17,7 @@ from ctypes import (
     c_int,
     c_int32,
     c_int64,
+    c_size_t,
     c_uint32,
     c_uint64,
     c_void_p,
@@ -359,6 +360,51 @@ class sh_contact_state(Structure):
     ]
 
 
+class sh_haptic_def(Structure):
+    """Mirror of struct sh_haptic_def."""
+
+    _fields_ = [
+        ("internal_init", c_uint32),
+        ("tool", sh_tool_id),
+        ("capacity_tets", c_int32),
+        ("capacity_nodes", c_int32),
+        ("radius", c_double),
+        ("rings", c_int32),
+        ("dt", c_double),
+        ("max_force", c_double),
+        ("max_force_rate", c_double),
+        ("ramp_time", c_double),
+        ("stale_after", c_double),
+    ]
+
+
+class sh_haptic_output(Structure):
+    """Mirror of struct sh_haptic_output."""
+
+    _fields_ = [
+        ("force", c_double * 3),
+        ("torque", c_double * 3),
+        ("contact", c_int32),
+        ("buffer_tets", c_int32),
+        ("buffer_nodes", c_int32),
+        ("substeps", c_int32),
+        ("data_age", c_double),
+        ("faults", c_uint32),
+        ("warnings", c_uint32),
+        ("raw_force", c_double * 3),
+    ]
+
+
+class HapticFault(enum.IntFlag):
+    """sh_haptic_fault: bits of a haptic step's faults (why the force is held or ramping out)."""
+
+    SH_HAPTIC_FAULT_POSE = 1
+    SH_HAPTIC_FAULT_DT = 2
+    SH_HAPTIC_FAULT_UNSTABLE = 4
+    SH_HAPTIC_FAULT_STALE = 8
+    SH_HAPTIC_FAULT_NO_TOOL = 16
+
+
 # Every struct the header declares that the bindings use, by C name (for the layout test).
 STRUCTS = {
     "sh_mesh_info": sh_mesh_info,
@@ -376,6 +422,8 @@ STRUCTS = {
     "sh_contact_params": sh_contact_params,
     "sh_collider_def": sh_collider_def,
     "sh_contact_state": sh_contact_state,
+    "sh_haptic_def": sh_haptic_def,
+    "sh_haptic_output": sh_haptic_output,
 }
 
 # ------------------------------------------------------------------------------------------------
@@ -449,6 +497,12 @@ PROTOTYPES = {
     "sh_tool_set_velocity": (_status, [_handle, sh_tool_id, _pd, _pd]),
     "sh_tool_get_contact": (_status, [_handle, sh_tool_id, POINTER(sh_contact_state)]),
     "sh_tool_get_wrench": (_status, [_handle, sh_tool_id, _pd, _pd]),
+    "sh_haptic_def_default": (None, [POINTER(sh_haptic_def)]),
+    "sh_haptic_memory_bytes": (_status, [POINTER(sh_haptic_def), POINTER(c_size_t)]),
+    "sh_haptic_create": (_status, [_handle, POINTER(sh_haptic_def), POINTER(_handle)]),
+    "sh_haptic_destroy": (_status, [_handle]),
+    "sh_haptic_step": (_status, [_handle, _pd, _pd, c_double, POINTER(sh_haptic_output)]),
+    "sh_haptic_get_warnings": (_status, [_handle, POINTER(c_uint64)]),
     "sh_obstacle_create": (
         _status,
         [_handle, POINTER(sh_collider_def), POINTER(sh_obstacle_id)],

@@ -609,6 +609,44 @@ class World(OwnedHandle):
         del arrays  # the C library has copied the points
         return collider.value
 
+    def add_haptic(
+        self,
+        tool,
+        capacity_tets=None,
+        capacity_nodes=None,
+        radius=None,
+        rings=None,
+        dt=None,
+        max_force=None,
+        max_force_rate=None,
+        ramp_time=None,
+        stale_after=None,
+    ):
+        """Create a haptic context (sh_haptic_create) for tool and return its Haptic.
+
+        The buffer holds at most capacity_tets tets (default 2000) and capacity_nodes nodes
+        (2000): those whose centroid lies within radius (m, default 0.02) of the tool's nearest
+        surface point, or, with rings > 0, the tets within that many rings of the contact. dt
+        is the nominal haptic step (s, 1e-3). The rendered force is at most max_force (N, 10),
+        moves at most max_force_rate (N/s, 2000) times dt per step, ramps in over ramp_time
+        (s, 0.05) and ramps out once the full-model data is older than stale_after (s of
+        haptic time, 0.1). None keeps the C default. Each World.step then moves the tool to the
+        latest device pose first and re-extracts the buffer last."""
+        from .haptic import Haptic
+
+        options = dict(
+            capacity_tets=capacity_tets,
+            capacity_nodes=capacity_nodes,
+            radius=radius,
+            rings=rings,
+            dt=dt,
+            max_force=max_force,
+            max_force_rate=max_force_rate,
+            ramp_time=ramp_time,
+            stale_after=stale_after,
+        )
+        return Haptic(self, tool, **options)
+
     def set_body_contact(
         self,
         body_a,

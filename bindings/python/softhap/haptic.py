@@ -1,0 +1,125 @@
+"""softhap.Haptic (an sh_haptic: a Volumetric Buffer Model context of one tool) and its
+HapticResult.
+
+World.add_haptic makes one. Haptic.step is the device-rate call (sh_haptic_step): it reuses
+its ctypes buffers, so a Python haptic loop allocates only the small result it returns.
+"""
+
+import ctypes
+
+import numpy as np
+
+from ._handle import OwnedHandle
+from ._lib import SH_WARN_COUNT, HapticFault, Status, WarningKind, sh_haptic_def, sh_haptic_output
+from ._loaded import check, lib
+from ._record import Record, record_of
+
+
+class HapticResult(Record):
+    """What one Haptic.step rendered (sh_haptic_output): force (N) and torque (N m) to render,
+    (3,) arrays in the world frame, clamped and ramped; raw_force, the buffer's force before
+    that; contact (bool); buffer_tets and buffer_nodes in use; substeps; data_age (s of haptic
+    time since the newest full-model data); faults (set of sh_haptic_fault names) and
+    fault_bits; warnings (set of sh_warning names) and warning_bits."""
+
+
+def _names(bits, kinds):
+    return frozenset(kind.name for kind in kinds if bits & int(kind))
+
+
+def _haptic_def(tool, options):
+    definition = sh_haptic_def()
+    lib.sh_haptic_def_default(ctypes.byref(definition))
+    definition.tool = tool.id
+    for name, value in options.items():
+        if value is None:
+            continue
+        if name not in dict(sh_haptic_def._fields_) or name in ("internal_init", "tool"):
+            raise TypeError("unknown haptic option %r" % name)
+        setattr(definition, name, value)
+    return definition
+
+
+class Haptic(OwnedHandle):
+    """A haptic context: a small explicit FEM buffer around a tool's contact, stepped by step()
+    at the device rate while World.step re-extracts it from the full model. It keeps its World
+    and Tool alive; close() (or the end of a ``with`` block) destroys it. Once the world is
+    closed, step() reports the fault SH_HAPTIC_FAULT_NO_TOOL and ramps the force out."""
+
+    _kind = "haptic context"
+    _destroy = "sh_haptic_destroy"
+
+    def __init__(self, world, tool, **options):
+        """Use World.add_haptic."""
+        self._handle = None
+        definition = _haptic_def(tool, options)
+        handle = ctypes.c_void_p()
+        check(
+            lib.sh_haptic_create(world._require_handle("sh_haptic_create"), ctypes.byref(definition), ctypes.byref(handle)),
+            "sh_haptic_create",
+        )
+        self._handle = handle.value
+        self._world = world
+        self._tool = tool
+        self._dt = float(definition.dt)
+        out = ctypes.c_size_t()
+        check(lib.sh_haptic_memory_bytes(ctypes.byref(definition), ctypes.byref(out)), "sh_haptic_memory_bytes")
+        self._memory_bytes = int(out.value)
+        self._position = (ctypes.c_double * 3)()
+        self._orientation = (ctypes.c_double * 4)()
+        self._output = sh_haptic_output()
+
+    def __repr__(self):
+        return "<softhap.Haptic %s>" % ("closed" if self._handle is None else "tool=%#x" % self._tool.id)
+
+    @property
+    def tool(self):
+        """The Tool the device moves."""
+        return self._tool
+
+    @property
+    def memory_bytes(self):
+        """Bytes of memory the context holds, fixed at creation."""
+        return self._memory_bytes
+
+    @property
+    def dt(self):
+        """The nominal haptic step (s) that step() uses when no dt is given."""
+        return self._dt
+
+    def step(self, position, orientation=(1.0, 0.0, 0.0, 0.0), dt=None):
+        """Step the buffer to the device pose (position m, orientation unit quaternion
+        (w, x, y, z)) over dt seconds (default: the context's dt) and return the HapticResult.
+        A non-finite pose or dt is not raised: the result carries the fault (force held and
+        ramping out), as the C call reports it."""
+        handle = self._require_handle("sh_haptic_step")
+        for k in range(3):
+            self._position[k] = position[k]
+        for k in range(4):
+            self._orientation[k] = orientation[k]
+        status = lib.sh_haptic_step(
+            handle, self._position, self._orientation, self._dt if dt is None else float(dt), ctypes.byref(self._output)
+        )
+        raw = self._output
+        if status != Status.SH_OK and not (raw.faults & (HapticFault.SH_HAPTIC_FAULT_POSE | HapticFault.SH_HAPTIC_FAULT_DT)):
+            check(status, "sh_haptic_step")
+        return record_of(
+            HapticResult,
+            raw,
+            force=np.array(raw.force[:]),
+            torque=np.array(raw.torque[:]),
+            raw_force=np.array(raw.raw_force[:]),
+            contact=bool(raw.contact),
+            faults=_names(raw.faults, HapticFault),
+            fault_bits=int(raw.faults),
+            warnings=frozenset(kind.name for kind in WarningKind if raw.warnings & (1 << int(kind))),
+            warning_bits=int(raw.warnings),
+        )
+
+    @property
+    def warnings(self):
+        """The context's warning counters as a dict {"SH_WARN_FORCE_CLAMPED": count, ...}."""
+        handle = self._require_handle("sh_haptic_get_warnings")
+        counters = (ctypes.c_uint64 * SH_WARN_COUNT)()
+        check(lib.sh_haptic_get_warnings(handle, counters), "sh_haptic_get_warnings")
+        return {kind.name: int(counters[int(kind)]) for kind in WarningKind}

@@ -1,0 +1,104 @@
+"""Haptic contexts through the bindings: the proxy force against the Hunt-Crossley law by hand,
+the buffer force against the full model's static solve, the force contract's clamp and faults,
+and the context's options, memory and lifetime."""
+
+import math
+
+import numpy as np
+import pytest
+
+import softhap
+from test_contact import box_mesh
+
+TOP = 0.01  # the block's top face (m)
+RADIUS = 0.005
+
+
+def pressed_block(damping_mass=40.0, tool_z=TOP + RADIUS + 0.05):
+    """A 20 x 20 x 10 mm soft block on a fixed base and a linear sphere tool above its centre."""
+    world = softhap.World(gravity=(0.0, 0.0, 0.0))
+    body = world.add_fem_body(
+        box_mesh((0.02, 0.02, TOP), (6, 6, 3)), model="neohookean", young=5e3, poisson=0.3,
+        density=1000.0, damping_mass=damping_mass,
+    )
+    body.fix_nodes(np.flatnonzero(np.abs(body.positions[:, 2]) < 1e-12))
+    tool = world.add_tool(
+        "sphere", radius=RADIUS, position=(0.01, 0.01, tool_z), stiffness=100.0, exponent=1.0, damping=0.0
+    )
+    return world, body, tool
+
+
+def test_proxy_force_is_the_law_at_the_sphere_depth():
+    # The tool is far from the block at creation: no buffer, only the proxy plane of the
+    # nearest surface point. One Hunt-Crossley point, n = 1, no damping: F = lambda d.
+    world, _, tool = pressed_block()
+    haptic = world.add_haptic(tool, radius=0.005, ramp_time=0.0, stale_after=100.0)
+    result = haptic.step((0.01, 0.01, TOP + RADIUS + 1e-3))
+    assert not result.contact and np.all(result.force == 0.0)
+    depth = 7e-4
+    result = haptic.step((0.01, 0.01, TOP + RADIUS - depth))
+    assert result.contact and result.buffer_tets == 0
+    assert result.raw_force == pytest.approx([0.0, 0.0, 100.0 * depth], abs=1e-12)
+    # The rate limit (2000 N/s default) lets 2 N per 1 ms step through: the whole force.
+    assert result.force == pytest.approx(result.raw_force, abs=1e-12)
+    assert result.faults == frozenset() and result.fault_bits == 0
+
+
+def test_whole_block_buffer_settles_on_the_static_solve():
+    depth = 0.0015
+    pose = (0.01, 0.01, TOP + RADIUS - depth)
+    reference, _, reference_tool = pressed_block(damping_mass=0.0)
+    reference_tool.set_pose(pose)
+    reference.solve_static(tolerance=1e-9)
+    expected = reference_tool.force
+
+    world, _, tool = pressed_block(tool_z=TOP + RADIUS)
+    haptic = world.add_haptic(tool, radius=1.0, max_force_rate=1e6, ramp_time=0.0, stale_after=100.0)
+    for i in range(2500):
+        s = min(1.0, (i + 1) / 300.0)
+        result = haptic.step((0.01, 0.01, TOP + RADIUS - s * depth))
+    assert result.buffer_tets == 6 * 6 * 3 * 6
+    assert expected[2] > 0.02
+    assert result.raw_force == pytest.approx(expected, abs=2e-3 * expected[2])
+
+
+def test_force_is_clamped_and_faults_are_reported_not_raised():
+    world, _, tool = pressed_block(tool_z=TOP + RADIUS)
+    haptic = world.add_haptic(tool, radius=0.008, max_force=0.02, ramp_time=0.0, stale_after=100.0)
+    for i in range(100):
+        result = haptic.step((0.01, 0.01, TOP + RADIUS - 0.003 * min(1.0, (i + 1) / 20.0)))
+        assert np.linalg.norm(result.force) <= 0.02 * (1 + 1e-12)
+    assert np.linalg.norm(result.raw_force) > 0.02
+    assert "SH_WARN_FORCE_CLAMPED" in result.warnings
+    assert haptic.warnings["SH_WARN_FORCE_CLAMPED"] > 0
+    bad = haptic.step((math.nan, 0.0, 0.0))
+    assert bad.faults == {"SH_HAPTIC_FAULT_POSE"}
+    assert np.all(np.isfinite(bad.force))
+    assert "SH_HAPTIC_FAULT_DT" in haptic.step((0.01, 0.01, TOP), dt=-1.0).faults
+    world.close()
+    gone = haptic.step((0.01, 0.01, TOP))
+    assert "SH_HAPTIC_FAULT_NO_TOOL" in gone.faults
+    haptic.close()
+    with pytest.raises(softhap.Error) as error:
+        haptic.step((0.01, 0.01, TOP))
+    assert error.value.status == softhap.Status.SH_ERR_INVALID_HANDLE
+
+
+def test_options_memory_and_validation():
+    world, _, tool = pressed_block()
+    small = world.add_haptic(tool, capacity_tets=100, capacity_nodes=100)
+    large = world.add_haptic(tool, capacity_tets=1000, capacity_nodes=1000)
+    assert 0 < small.memory_bytes < large.memory_bytes
+    # Three exchanged buffers of about 104 bytes per tet in force-kernel blocks, at least.
+    assert large.memory_bytes > 3 * 104 * 1000
+    assert small.dt == 1e-3 and small.tool is tool
+    with pytest.raises(softhap.Error) as error:
+        world.add_haptic(tool, radius=-1.0)
+    assert error.value.status == softhap.Status.SH_ERR_INVALID_ARGUMENT
+    assert "def->radius" in str(error.value)
+    with pytest.raises(TypeError):
+        world.add_haptic(tool, unknown=1.0)
+    tool.destroy()
+    with pytest.raises(softhap.Error) as error:
+        world.add_haptic(tool)
+    assert error.value.status == softhap.Status.SH_ERR_INVALID_HANDLE

@@ -573,6 +573,64 @@ static void test_haptic_thread_never_allocates_nor_locks(void** state) {
     assert_ok(sh_set_allocator(NULL));
 }
 
+/* A convex tool (a cube hull) in the haptic step: MPR only, so no allocation either, and a
+ * push matching the box tool of the same size to 1 % (both flat faces on the block's top). */
+static void test_convex_tool_steps_without_allocating(void** state) {
+    (void)state;
+#if defined(SOFTHAP_TEST_WITH_CCD)
+    const double top = kBlock[2], h = 0.003, dt = 1e-3;
+    double force[2] = {0.0, 0.0};
+    for (int c = 0; c < 2; ++c) {
+        scene s = make_scene(40.0, top + 0.01);
+        assert_ok(sh_tool_destroy(s.world, s.tool));
+        sh_collider_def tool;
+        sh_collider_def_default(&tool);
+        static const double cube[8][3] = {{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {1, 1, -1},
+                                          {-1, -1, 1},  {1, -1, 1},  {-1, 1, 1},  {1, 1, 1}};
+        double points[8][3];
+        for (int i = 0; i < 8; ++i)
+            for (int k = 0; k < 3; ++k) points[i][k] = h * cube[i][k];
+        if (c == 0) {
+            tool.shape.kind = SH_SHAPE_CONVEX;
+            tool.shape.points = &points[0][0];
+            tool.shape.point_count = 8;
+        } else {
+            tool.shape.kind = SH_SHAPE_BOX;
+            for (int k = 0; k < 3; ++k) tool.shape.half_extents[k] = h;
+        }
+        tool.contact.stiffness = 100.0;
+        tool.contact.exponent = 1.0;
+        tool.position[0] = 0.5 * kBlock[0] + 1e-4; /* off the node under the centre */
+        tool.position[1] = 0.5 * kBlock[1] + 1e-4;
+        tool.position[2] = top + h;
+        assert_ok(sh_tool_create(s.world, &tool, &s.tool));
+        sh_haptic_def def = haptic_def(&s);
+        def.radius = 0.008;
+        def.ramp_time = 0.0;
+        def.stale_after = 1e3;
+        sh_haptic* haptic = NULL;
+        assert_ok(sh_haptic_create(s.world, &def, &haptic));
+        sh_haptic_output out;
+        atomic_store(&g_watched_allocations, 0);
+        tl_watched = 1;
+        for (int i = 0; i < 1500; ++i) {
+            const double p[3] = {tool.position[0], tool.position[1], top + h - 0.001 * fmin(1.0, (i + 1) / 200.0)};
+            assert_ok(sh_haptic_step(haptic, p, kIdentity, dt, &out));
+        }
+        tl_watched = 0;
+        assert_int_equal(atomic_load(&g_watched_allocations), 0);
+        force[c] = out.raw_force[2];
+        assert_ok(sh_haptic_destroy(haptic));
+        sh_world_destroy(s.world);
+    }
+    printf("1 mm press of a 6 mm cube: convex hull %.6g N, box %.6g N\n", force[0], force[1]);
+    assert_true(force[1] > 0.01);
+    assert_close(force[0], force[1], 0.01 * force[1]);
+#else
+    skip();
+#endif
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_whole_body_buffer_matches_static_solve),
@@ -581,6 +639,7 @@ int main(void) {
         cmocka_unit_test(test_unstable_buffer_rolls_back),
         cmocka_unit_test(test_first_force_one_tick_after_contact),
         cmocka_unit_test(test_capacity_overflow_keeps_the_nearest),
+        cmocka_unit_test(test_convex_tool_steps_without_allocating),
         cmocka_unit_test(test_haptic_thread_never_allocates_nor_locks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

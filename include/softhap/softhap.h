@@ -704,8 +704,9 @@ typedef struct sh_haptic sh_haptic;
 /** Definition of a haptic context. Initialise with sh_haptic_def_default. */
 typedef struct sh_haptic_def {
     uint32_t internal_init;   /**< set by sh_haptic_def_default; do not touch */
-    sh_tool_id tool;          /**< the tool the device moves (a sphere, capsule or box; a
-                                   convex tool is SH_ERR_UNSUPPORTED); required */
+    sh_tool_id tool;          /**< the tool the device moves; required. A convex tool's
+                                   depth comes from libccd's MPR only in the haptic step
+                                   (allocation-free; an upper bound on the depth) */
     int32_t capacity_tets;    /**< most tets in the buffer, >= 1; default 2000 */
     int32_t capacity_nodes;   /**< most nodes in the buffer, >= 4; default 2000 */
     double radius;            /**< buffer radius (m): tets whose centroid lies within it of the

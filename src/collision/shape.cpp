@@ -543,7 +543,7 @@ bool Shape::penetrate_convex(const double xl[3], double& depth, double nl[3]) co
     // over the nearest face (normalised frame); MPR when it gains less than mpr_tolerance.
     ccd.epa_tolerance = 1e-10;
     ccd.mpr_tolerance = 1e-12;
-    {
+    if (!allocation_free_) {
         // GJK/EPA: exact (the nearest face) when it converges. Its loop has no iteration limit
         // and can cycle, mostly for points within ~1e-6 of a vertex; the budget ends a cycle.
         const CcdHull hull{ccd_points_.data(), count, ccd_centroid_, &point, budget};

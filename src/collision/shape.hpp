@@ -55,6 +55,11 @@ public:
     bool penetrate_triangle(const Pose& pose, const double a[3], const double b[3], const double c[3],
                             Penetration& out, double bary[3]) const;
 
+    /// From now on, point queries on a convex hull skip libccd's GJK/EPA, which allocates:
+    /// MPR and the sampled directions give the depth (an upper bound, exact along the hull
+    /// face MPR finds). For the haptic step's own copy of a tool.
+    void use_allocation_free_queries() { allocation_free_ = true; }
+
 private:
     static constexpr int kMaxDirections = 17;  ///< convex: sampled directions (see shape.cpp)
 
@@ -70,6 +75,7 @@ private:
     double half_extents_[3] = {};
     vec<double> points_;  ///< convex: 3 per point, local frame
     double inner_radius_ = 0.0;
+    bool allocation_free_ = false;  ///< convex: no GJK/EPA (see use_allocation_free_queries)
     // convex only:
     double local_lo_[3] = {}, local_hi_[3] = {};  ///< bounding box in the local frame
     double dirs_[kMaxDirections][3] = {};         ///< sampled unit directions, local frame

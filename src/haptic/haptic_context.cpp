@@ -75,9 +75,7 @@ size_t HapticContext::memory_bytes(const sh_haptic_def& def) {
 HapticContext::HapticContext(World& world, const sh_haptic_def& def)
     : def_(def), world_(&world), tool_(world.collider(def.tool, true)), filter_(limits_of(def)) {
     validate_haptic_def(def);
-    require(tool_.shape.kind() != SH_SHAPE_CONVEX, SH_ERR_UNSUPPORTED,
-            "def->tool is a convex tool: the haptic step supports sphere, capsule and box tools (libccd's "
-            "penetration query allocates)");
+    tool_.shape.use_allocation_free_queries();
     arena_bytes_ = memory_bytes(def);
     arena_ = allocate(arena_bytes_, 64);
     Arena arena(arena_, arena_bytes_);

@@ -4,7 +4,7 @@ PYTHON ?= python3
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-c test-python test-reduced demo palpation bench report clean
+.PHONY: all deps build test test-c test-python test-reduced demo palpation bench report report-deps haptic-report clean
 
 all: build
 
@@ -44,12 +44,25 @@ bench: build
 # Error against run time (bench/accuracy.c, a few minutes on 2 cores): JSON lines, then tables and
 # PNG plots in report/. matplotlib is needed only here and installed on demand. One OpenMP thread
 # per worker process: the accuracy bench runs two of them.
-report: build
-	@$(PYTHON) -c "import matplotlib" 2>/dev/null || $(PYTHON) -m pip install -q matplotlib </dev/null || \
-	  $(PYTHON) -m pip install -q --break-system-packages matplotlib </dev/null
+report: build report-deps
 	@mkdir -p report
 	OMP_NUM_THREADS=1 $(BUILD)/bench/softhap_bench accuracy > report/accuracy.jsonl
 	$(PYTHON) scripts/report.py report/accuracy.jsonl report/
+
+# matplotlib for the reports, installed on demand.
+report-deps:
+	@$(PYTHON) -c "import matplotlib" 2>/dev/null || $(PYTHON) -m pip install -q matplotlib </dev/null || \
+	  $(PYTHON) -m pip install -q --break-system-packages matplotlib </dev/null
+
+# Haptic step cost against buffer size, force error against buffer radius and force smoothness
+# (bench/haptic.c, about 2 minutes on 2 cores): JSON lines, then report/haptic.md and PNG plots.
+# --rt runs the haptic thread SCHED_FIFO where allowed, so that its tails are the step's own.
+haptic-report: build report-deps
+	@mkdir -p report
+	OMP_NUM_THREADS=1 $(BUILD)/bench/softhap_bench haptic --rt > report/haptic_cost.jsonl
+	OMP_NUM_THREADS=1 $(BUILD)/bench/softhap_bench haptic-error > report/haptic_error.jsonl
+	OMP_NUM_THREADS=1 $(BUILD)/bench/softhap_bench haptic-force --csv report/haptic_force.csv > report/haptic_force.jsonl
+	$(PYTHON) scripts/haptic_report.py report/
 
 clean:
 	rm -rf build build-no-cholmod build-no-ccd

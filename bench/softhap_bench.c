@@ -6,6 +6,9 @@
  *   softhap_bench implicit [FILTER] [--steps N]             implicit Euler step, direct vs CG
  *   softhap_bench contact [FILTER] [--steps N]              collision and contact time per step
  *   softhap_bench accuracy [--quick] [--jobs N]             error against run time (accuracy.c)
+ *   softhap_bench haptic [FILTER] [--steps N]               haptic step cost vs buffer size (haptic.c)
+ *   softhap_bench haptic-error [FILTER]                     haptic force error vs buffer radius
+ *   softhap_bench haptic-force [--csv PATH]                 haptic force smoothness, VBM vs ZOH
  *
  * Each case builds a world with one body from a mesh in ../shared/meshes (scaled so its largest
  * extent is kMeshSize), gravity on, the highest 1% of the nodes fixed, dt = kDtFraction * dt_crit
@@ -23,6 +26,8 @@
 #include <softhap/softhap.h>
 
 #include "accuracy.h"
+#include "bench_util.h"
+#include "haptic.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -52,48 +57,6 @@ static const char* g_mesh_dir = NULL;
 static int g_steps = 0; /* --steps N; 0 = adaptive */
 static double g_factor_reuse = -1.0; /* implicit: --factor-reuse X; < 0 = the default */
 
-#define CHECK(expr)                                                                                 \
-    do {                                                                                            \
-        sh_status s_ = (expr);                                                                      \
-        if (s_ != SH_OK) {                                                                          \
-            fprintf(stderr, "softhap_bench: %s failed: %s (%s)\n", #expr, sh_status_string(s_),     \
-                    sh_last_error_message());                                                       \
-            exit(1);                                                                                \
-        }                                                                                           \
-    } while (0)
-
-static double now_ns(void) {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
-}
-
-static void* xmalloc(size_t size) {
-    void* p = malloc(size ? size : 1);
-    if (!p) {
-        fprintf(stderr, "softhap_bench: out of memory\n");
-        exit(1);
-    }
-    return p;
-}
-
-static int cmp_double(const void* a, const void* b) {
-    const double x = *(const double*)a, y = *(const double*)b;
-    return x < y ? -1 : x > y;
-}
-
-/* Value at quantile q of sorted[0..n): the smallest value with at least q*n values at or below. */
-static double quantile(const double* sorted, int n, double q) {
-    int k = (int)ceil(q * n) - 1;
-    if (k < 0) k = 0;
-    if (k > n - 1) k = n - 1;
-    return sorted[k];
-}
-
-static double median(const double* sorted, int n) {
-    return n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
-}
-
 /* ------------------------------------------------------------------------------------------ */
 /* Scenes                                                                                       */
 
@@ -117,32 +80,10 @@ static int cmp_node_height(const void* a, const void* b) {
 
 /* Loads g_mesh_dir/file as m, named name. */
 static int load_mesh_file(const char* file, const char* name, bench_mesh* m) {
-    char path[4096];
-    snprintf(path, sizeof path, "%s/%s", g_mesh_dir, file);
-    sh_mesh* raw = NULL;
-    if (sh_mesh_load(path, &raw) != SH_OK) {
-        fprintf(stderr, "softhap_bench: cannot load %s: %s\n", path, sh_last_error_message());
-        return 0;
-    }
-    sh_mesh_info info;
-    CHECK(sh_mesh_get_info(raw, &info));
-    const int32_t n = info.node_count, t = info.tet_count;
-    double* nodes = (double*)xmalloc(sizeof(double) * 3 * (size_t)n);
-    int32_t* tets = (int32_t*)xmalloc(sizeof(int32_t) * 4 * (size_t)t);
-    CHECK(sh_mesh_get_nodes(raw, nodes, 3 * (int64_t)n));
-    CHECK(sh_mesh_get_tets(raw, tets, 4 * (int64_t)t));
-    double extent = 0.0;
-    for (int k = 0; k < 3; ++k) {
-        const double e = info.bounds_max[k] - info.bounds_min[k];
-        if (e > extent) extent = e;
-    }
-    const double scale = kMeshSize / extent;
-    for (int32_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) nodes[3 * i + k] = (nodes[3 * i + k] - info.bounds_min[k]) * scale;
-    CHECK(sh_mesh_destroy(raw));
-    CHECK(sh_mesh_create(nodes, n, tets, t, &m->mesh));
-    free(tets);
+    double* nodes = NULL;
+    if (!bench_load_scaled_mesh(g_mesh_dir, file, NULL, kMeshSize, &m->mesh, &nodes)) return 0;
     CHECK(sh_mesh_get_info(m->mesh, &m->info));
+    const int32_t n = m->info.node_count;
     m->name = name;
     m->rest = nodes;
 
@@ -627,6 +568,7 @@ static void run_contact(const char* filter) {
 static void usage(void) {
     fprintf(stderr,
             "usage: softhap_bench [integrators|implicit|contact] [FILTER] [--steps N] [--meshes DIR]\n"
+            "       softhap_bench accuracy|haptic|haptic-error|haptic-force ... (see their --help)\n"
             "  FILTER  keep the cases whose name contains it (e.g. stvk/raptorTetra_19409)\n"
             "  --steps N  timed steps per case (default: adaptive, %d..%d; implicit 100, contact 200)\n"
             "  --meshes DIR  mesh folder (default $SOFTHAP_MESHES, " SOFTHAP_BENCH_MESH_DIR
@@ -634,16 +576,9 @@ static void usage(void) {
             kMinSteps, kMaxSteps);
 }
 
-static int file_exists(const char* dir, const char* name) {
-    char path[4096];
-    snprintf(path, sizeof path, "%s/%s.vtu", dir, name);
-    FILE* f = fopen(path, "r");
-    if (f) fclose(f);
-    return f != NULL;
-}
-
 int main(int argc, char** argv) {
     if (argc > 1 && strcmp(argv[1], "accuracy") == 0) return run_accuracy(argc - 1, argv + 1);
+    if (argc > 1 && is_haptic_command(argv[1])) return run_haptic(argc - 1, argv + 1);
     const char* filter = NULL;
     int integrators = 0, implicit = 0, contact = 0;
     for (int i = 1; i < argc; ++i) {
@@ -673,11 +608,10 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    if (!g_mesh_dir) {
-        const char* candidates[] = {getenv("SOFTHAP_MESHES"), SOFTHAP_BENCH_MESH_DIR, "../shared/meshes",
-                                    "../../shared/meshes"};
-        for (size_t k = 0; k < sizeof candidates / sizeof candidates[0] && !g_mesh_dir; ++k)
-            if (candidates[k] && file_exists(candidates[k], kMeshes[0])) g_mesh_dir = candidates[k];
+    {
+        char probe[256];
+        snprintf(probe, sizeof probe, "%s.vtu", kMeshes[0]);
+        g_mesh_dir = bench_find_mesh_dir(g_mesh_dir, probe);
         if (!g_mesh_dir) {
             fprintf(stderr, "softhap_bench: meshes not found; pass --meshes DIR\n");
             return 1;

@@ -230,7 +230,7 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
     for (int k = 0; k < 3; ++k) out.gravity[k] = gravity[k];
     out.damping_mass = body.settings.damping_mass;
     out.damping_stiffness = body.damping_stiffness();
-    out.dt_stable = body.stable_step(body.x.data());
+    out.dt_stable = body.stable_step_of(chosen_.data(), chosen_.size());
     out.runaway_speed = body.settings.runaway_speed;
 
     for (const int32_t node : ring_) local_of_[static_cast<size_t>(node)] = -1;

@@ -121,12 +121,14 @@ void FemBody::rebuild(vec<sh_material> materials) {
         }
     }
 
-    double omega2 = 0.0;
-    for (size_t t = 0; t < tet_count; ++t) omega2 = std::max(omega2, element_max_frequency_squared(t, materials[t]));
-    const double omega = std::sqrt(omega2);
-    // Central-difference limit with stiffness damping ratio xi = beta omega / 2.
-    const double xi = 0.5 * damping_stiffness_ * omega;
-    stable_step_ = omega > 0.0 ? 2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi) : INFINITY;
+    vec<double> omega2(tet_count);
+    double largest = 0.0;
+    for (size_t t = 0; t < tet_count; ++t) {
+        omega2[t] = element_max_frequency_squared(t, materials[t]);
+        largest = std::max(largest, omega2[t]);
+    }
+    stable_step_ = stable_step_at(largest);
+    element_omega2_.swap(omega2);
 
     materials_.swap(materials);
     mass.swap(new_mass);
@@ -181,6 +183,19 @@ double FemBody::elastic_energy(const double* xs) const {
 }
 
 double FemBody::stable_step(const double*) const { return stable_step_; }
+
+double FemBody::stable_step_at(double omega2) const {
+    const double omega = std::sqrt(omega2);
+    // Central-difference limit with stiffness damping ratio xi = beta omega / 2.
+    const double xi = 0.5 * damping_stiffness_ * omega;
+    return omega > 0.0 ? 2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi) : INFINITY;
+}
+
+double FemBody::stable_step_of(const int32_t* tets, size_t count) const {
+    double largest = 0.0;
+    for (size_t k = 0; k < count; ++k) largest = std::max(largest, element_omega2_[static_cast<size_t>(tets[k])]);
+    return stable_step_at(largest);
+}
 
 
 }  // namespace sh

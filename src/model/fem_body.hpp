@@ -36,6 +36,9 @@ public:
     /// Rayleigh beta (s).
     double damping_stiffness() const { return damping_stiffness_; }
 
+    /// Largest stable step (as stable_step) of the tets listed in tets[count] alone.
+    double stable_step_of(const int32_t* tets, size_t count) const;
+
     /// Writes tet t with material m into lane `lane` of block b, over node numbers nodes[4]
     /// (the body's, or a copy's own); an unused lane (used false) gets zero weights.
     void fill_lane(size_t t, const sh_material& m, const int32_t nodes[4], bool used, TetBlock& b, int lane) const;
@@ -44,6 +47,8 @@ private:
     /// Adopts materials (one per tet): masses, blocks and the stable step, all or nothing.
     void rebuild(vec<sh_material> materials);
     double element_max_frequency_squared(size_t element, const sh_material& material) const;
+    /// 2/omega with the stiffness damping, for omega^2 = omega2 (1/s^2).
+    double stable_step_at(double omega2) const;
 
     vec<int32_t> tets_;          ///< 4 per tet
     vec<double> inverse_rest_;   ///< Bm = Dm^-1, 9 per tet, row-major
@@ -52,6 +57,7 @@ private:
     vec<TetBlock> blocks_[4];    ///< per sh_material_model
     double damping_stiffness_;
     double stable_step_ = 0.0;   ///< 2/omega_max at rest, with stiffness damping
+    vec<double> element_omega2_; ///< per tet: its largest squared frequency (Irons-Treharne)
     mutable int32_t inverted_elements_ = 0;  ///< most elements with det F <= 0 at one evaluation
 };
 

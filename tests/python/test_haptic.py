@@ -102,3 +102,20 @@ def test_options_memory_and_validation():
     with pytest.raises(softhap.Error) as error:
         world.add_haptic(tool)
     assert error.value.status == softhap.Status.SH_ERR_INVALID_HANDLE
+
+
+def test_sub_steps_follow_the_buffers_own_tets(meshes):
+    # The liver's thinnest tet (0.4 mm altitude) sits near its top: a small buffer at its bottom
+    # needs fewer explicit sub-steps than the whole organ, whose critical step that tet sets.
+    mesh = softhap.Mesh.load(str(meshes / "liver.msh")).transform(0.01)
+    world = softhap.World(gravity=(0.0, 0.0, 0.0))
+    world.add_fem_body(mesh, model="linear", young=15e3, poisson=0.45, density=1000.0)
+    device = mesh.nodes[np.argmin(mesh.nodes[:, 2])] - (0.0, 0.0, 0.0098)
+    tool = world.add_tool("sphere", radius=0.01, position=device, stiffness=10.0, exponent=1.0)
+    substeps = {}
+    for radius in (0.01, 1.0):
+        haptic = world.add_haptic(tool, radius=radius, ramp_time=0.0, stale_after=100.0)
+        result = haptic.step(device)
+        substeps[radius] = (result.buffer_tets, result.substeps)
+    assert substeps[1.0][0] == mesh.info.tet_count > substeps[0.01][0]
+    assert substeps[0.01][1] < substeps[1.0][1]

@@ -168,29 +168,19 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
         out.inverse_mass[i] = interior ? 1.0 / out.mass[i] : 0.0;
     }
 
-    // Blocks per material model, lanes over local numbers.
+    // Blocks per material model, lanes over local numbers, spread like the full model's.
     int32_t block = 0;
     for (int model = 0; model < 4; ++model) {
         out.block_begin[model] = block;
-        int32_t lane = 0;
-        size_t first = 0;  // the block's first tet, repeated weightless in unused lanes
-        for (const int32_t t : chosen_) {
-            if (body.material(static_cast<size_t>(t)).model != model) continue;
+        members_.clear();
+        for (const int32_t t : chosen_)
+            if (body.material(static_cast<size_t>(t)).model == model) members_.push_back(t);
+        spread_over_lanes(members_.data(), members_.size(), [&](int32_t t, bool used, size_t k, int l) {
             int32_t local[4];
             for (int a = 0; a < 4; ++a) local[a] = local_of_[static_cast<size_t>(elements[4 * static_cast<size_t>(t) + a])];
-            if (lane == 0) first = static_cast<size_t>(t);
-            body.fill_lane(static_cast<size_t>(t), body.material(static_cast<size_t>(t)), local, true, out.blocks[block], lane);
-            if (++lane == kLanes) {
-                lane = 0;
-                ++block;
-            }
-        }
-        if (lane > 0) {
-            int32_t local[4];
-            for (int a = 0; a < 4; ++a) local[a] = local_of_[static_cast<size_t>(elements[4 * first + a])];
-            for (; lane < kLanes; ++lane) body.fill_lane(first, body.material(first), local, false, out.blocks[block], lane);
-            ++block;
-        }
+            body.fill_lane(static_cast<size_t>(t), body.material(static_cast<size_t>(t)), local, used, out.blocks[block + static_cast<int32_t>(k)], l);
+        });
+        block += static_cast<int32_t>(block_count(members_.size()));
     }
     out.block_begin[4] = block;
 

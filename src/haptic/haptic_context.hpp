@@ -124,7 +124,8 @@ private:
     vec<int32_t> local_of_;                    ///< body node -> local node, -1 outside
     vec<uint8_t> in_buffer_;                   ///< per body tet
     vec<int32_t> chosen_;                      ///< the buffer's tets (body numbers)
-    vec<int32_t> ring_;                        ///< ring expansion scratch
+    vec<int32_t> ring_;                        ///< the buffer's body nodes, ascending
+    vec<int32_t> members_;                     ///< the buffer's tets of one material model
 };
 
 }  // namespace sh

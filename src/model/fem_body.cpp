@@ -103,22 +103,11 @@ void FemBody::rebuild(vec<sh_material> materials) {
         vec<uint32_t> members;
         for (const uint32_t t : order)
             if (materials[t].model == model) members.push_back(t);
-        // Lane l of block k takes the (l * nb + k)-th tet along the curve: each lane walks its
-        // own stretch of the curve, so consecutive blocks reuse the nodes of the previous one
-        // lane by lane, while the kLanes tets of a block lie far apart and rarely share a node
-        // (the scatter's node updates within a block are then independent).
-        const size_t m = members.size(), nb = (m + kLanes - 1) / kLanes;
         vec<TetBlock>& blocks = new_blocks[model];
-        blocks.assign(nb, TetBlock{});
-        for (size_t k = 0; k < nb; ++k) {
-            TetBlock& b = blocks[k];
-            for (int l = 0; l < kLanes; ++l) {
-                const size_t slot = static_cast<size_t>(l) * nb + k;
-                const bool used = slot < m;
-                const size_t t = members[used ? slot : k];  // unused lanes repeat lane 0's tet, weightless
-                fill_lane(t, materials[t], &tets_[4 * t], used, b, l);
-            }
-        }
+        blocks.assign(block_count(members.size()), TetBlock{});
+        spread_over_lanes(members.data(), members.size(), [&](uint32_t t, bool used, size_t k, int l) {
+            fill_lane(t, materials[t], &tets_[4 * static_cast<size_t>(t)], used, blocks[k], l);
+        });
     }
 
     vec<double> omega2(tet_count);

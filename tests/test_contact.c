@@ -185,7 +185,12 @@ static void test_implicit_body_rests_on_stiff_plane(void** state) {
 
 /* The same cube pressed by a sphere tool while resting on the plane, explicit: in equilibrium
  * (heavy mass damping) the plane carries the weight plus the tool's push, and the tool feels
- * the opposite of its push. */
+ * the opposite of its push. The sphere (radius 8 mm, 2 mm in) is wide enough to bear on the
+ * nodes around the top's middle one (5 mm off): a sphere that presses on the middle node alone
+ * is an unstable balance on the frictionless plane (its push on a node off its apex has a
+ * sideways part that nothing holds: round-off grows into the cube squirting out from under
+ * it), which the test with a 5 mm sphere had passed only through where that drift happened to
+ * end. */
 static void test_tool_reaction_balances_the_plane(void** state) {
     (void)state;
     sh_world* world = sh_test_world(-9.81);
@@ -197,15 +202,15 @@ static void test_tool_reaction_balances_the_plane(void** state) {
     const double weight = body_mass(world, cube) * 9.81;
     sh_collider_def def;
     sh_collider_def_default(&def);
-    def.shape.radius = 0.005;
-    def.position[2] = 0.02 + 0.005 + 1e-3;
+    def.shape.radius = 0.008;
+    def.position[2] = 0.02 + 0.008 + 1e-3;
     def.contact = law;
     sh_tool_id tool = 0;
     assert_ok(sh_tool_create(world, &def, &tool));
     const double q[4] = {1, 0, 0, 0};
     for (int i = 0; i < 400; ++i) {
         const double depth = fmin(1.0, i / 100.0) * 0.003; /* press 2 mm into the top */
-        const double p[3] = {0.0, 0.0, 0.02 + 0.005 + 1e-3 - depth};
+        const double p[3] = {0.0, 0.0, 0.02 + 0.008 + 1e-3 - depth};
         assert_ok(sh_tool_set_pose(world, tool, p, q));
         assert_ok(sh_world_step(world, 0.005, NULL));
     }
@@ -296,6 +301,352 @@ static void test_fast_tool_does_not_pass_through_membrane(void** state) {
     free(rim);
     assert_ok(sh_mesh_destroy(unit));
     assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* ---- Coulomb friction on an inclined plane ---------------------------------------------------- */
+
+/* A cube of side a (2 cells per side) resting with its bottom face on the plane through the
+ * origin whose outward normal is n = (-sin t, 0, cos t): the box [-a/2, a/2]^2 x [0, a] turned
+ * by t about y, so that its local x runs up the slope along d = (cos t, 0, sin t). Gravity is
+ * -z, so the slope pulls the cube down along -d with g sin t and presses it with g cos t. */
+typedef struct incline {
+    sh_world* world;
+    sh_body_id body;
+    int32_t node_count;
+    double* masses;
+    double total_mass;
+    double theta, up[3];
+} incline;
+
+static incline incline_create(double theta, const sh_contact_params* law, sh_integrator integrator) {
+    incline s;
+    s.theta = theta;
+    s.up[0] = cos(theta);
+    s.up[1] = 0.0;
+    s.up[2] = sin(theta);
+    s.world = sh_test_world(-9.81);
+    const double a = 0.02;
+    double* nodes = NULL;
+    int32_t* tets = NULL;
+    int32_t tet_count = 0;
+    sh_test_box_arrays(a, a, a, 2, 2, 2, &nodes, &s.node_count, &tets, &tet_count);
+    assert_non_null(nodes);
+    assert_non_null(tets);
+    for (int32_t i = 0; i < s.node_count; ++i) {
+        const double x = nodes[3 * i] - 0.5 * a, y = nodes[3 * i + 1] - 0.5 * a, z = nodes[3 * i + 2];
+        nodes[3 * i] = cos(theta) * x - sin(theta) * z; /* x along d, z along n */
+        nodes[3 * i + 1] = y;
+        nodes[3 * i + 2] = sin(theta) * x + cos(theta) * z;
+    }
+    sh_mesh* mesh = NULL;
+    assert_ok(sh_mesh_create(nodes, s.node_count, tets, tet_count, &mesh));
+    free(nodes);
+    free(tets);
+    sh_collider_def plane;
+    sh_collider_def_default(&plane);
+    plane.shape.kind = SH_SHAPE_PLANE;
+    plane.shape.normal[0] = -sin(theta);
+    plane.shape.normal[1] = 0.0;
+    plane.shape.normal[2] = cos(theta);
+    plane.contact = *law;
+    sh_obstacle_id obstacle = 0;
+    assert_ok(sh_obstacle_create(s.world, &plane, &obstacle));
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.material.model = SH_MATERIAL_COROTATIONAL;
+    def.material.young = 3e4;
+    def.material.poisson = 0.3;
+    def.integrator = integrator;
+    /* Explicit: a little stiffness damping, which leaves rigid motion alone, keeps the cube's
+     * own vibration from making its corners chatter on the plane. */
+    if (integrator != SH_INTEGRATOR_IMPLICIT_EULER) def.damping_stiffness = 1e-3;
+    assert_ok(sh_world_add_fem_body(s.world, &def, &s.body));
+    assert_ok(sh_mesh_destroy(mesh));
+    s.masses = malloc(sizeof(double) * (size_t)s.node_count);
+    assert_ok(sh_body_get_masses(s.world, s.body, s.masses, s.node_count));
+    s.total_mass = 0.0;
+    for (int32_t i = 0; i < s.node_count; ++i) s.total_mass += s.masses[i];
+    return s;
+}
+
+/* Centre of mass position and velocity along the slope's up direction d. */
+static void incline_centre(const incline* s, double* position, double* velocity) {
+    double* x = malloc(3 * sizeof(double) * (size_t)s->node_count);
+    double* v = malloc(3 * sizeof(double) * (size_t)s->node_count);
+    assert_ok(sh_body_get_positions(s->world, s->body, x, 3 * (int64_t)s->node_count));
+    assert_ok(sh_body_get_velocities(s->world, s->body, v, 3 * (int64_t)s->node_count));
+    *position = *velocity = 0.0;
+    for (int32_t i = 0; i < s->node_count; ++i)
+        for (int k = 0; k < 3; ++k) {
+            *position += s->masses[i] * x[3 * i + k] * s->up[k] / s->total_mass;
+            *velocity += s->masses[i] * v[3 * i + k] * s->up[k] / s->total_mass;
+        }
+    free(x);
+    free(v);
+}
+
+/* Steps the cube for `seconds` at dt, every step asserted to succeed (an implicit body's
+ * Newton iteration converged); returns the most Newton iterations any step took. */
+static int32_t incline_run(incline* s, double dt, double seconds) {
+    int32_t most = 0;
+    const int steps = (int)lround(seconds / dt);
+    for (int i = 0; i < steps; ++i) {
+        sh_step_report report;
+        assert_ok(sh_world_step(s->world, dt, &report));
+        if (report.newton_iterations > most) most = report.newton_iterations;
+    }
+    return most;
+}
+
+static void incline_destroy(incline* s) {
+    free(s->masses);
+    assert_ok(sh_world_destroy(s->world));
+}
+
+static sh_contact_params incline_law(double mu_s, double mu_d) {
+    sh_contact_params law;
+    sh_contact_params_default(&law);
+    law.stiffness = 1e5;
+    law.static_friction = mu_s;
+    law.dynamic_friction = mu_d;
+    return law;
+}
+
+/* With mu_s > tan t the cube sticks. The regularised law makes sticking viscous, F =
+ * mu_s fn v / s0 on each contact, so the cube creeps at the speed where the friction carries
+ * the slope's pull: sum mu_s fn v / s0 = M g sin t with sum fn = M g cos t gives
+ * v_creep = s0 tan t / mu_s (0.728 mm/s here), whatever the time step, for implicit Euler and
+ * for symplectic Euler (whose friction is taken implicitly on the new velocities, so that no
+ * node creeps at its load times the step over its own mass, as with a capped explicit
+ * friction). Checked: the creep speed after 1 s and the distance crept over the last 0.5 s,
+ * both to 2 %; and that the whole first second, landing included (the cube starts touching
+ * the plane at zero depth: its first step has no friction, and its normal force rings for a
+ * while), moves it less than 2 s0 x 1 s, where sliding would take it about 1 m. Every
+ * implicit step converges (assert_ok). */
+static void check_sticking(sh_integrator integrator, double dt) {
+    const double theta = 20.0 * 3.14159265358979323846 / 180.0, mu = 0.5, seconds = 1.0;
+    const sh_contact_params law = incline_law(mu, mu);
+    incline s = incline_create(theta, &law, integrator);
+    double x0, v0, x_half, v_half, x1, v1;
+    incline_centre(&s, &x0, &v0);
+    const int32_t most = incline_run(&s, dt, 0.5 * seconds);
+    incline_centre(&s, &x_half, &v_half);
+    const int32_t later = incline_run(&s, dt, 0.5 * seconds);
+    incline_centre(&s, &x1, &v1);
+    const double creep = law.slip_velocity * tan(theta) / mu;
+    printf("%s, dt %g s: sticks, creep %.4f mm/s (s0 tan t / mu_s = %.4f), %.4f mm in the last 0.5 s (%.4f), %.4f mm "
+           "in 1 s (bound 2 s0 x 1 s = %.4f); most Newton iterations %d\n",
+           integrator == SH_INTEGRATOR_IMPLICIT_EULER ? "implicit Euler" : "symplectic Euler", dt, -1e3 * v1, 1e3 * creep,
+           -1e3 * (x1 - x_half), 1e3 * 0.5 * seconds * creep, -1e3 * (x1 - x0), 2e3 * law.slip_velocity * seconds,
+           most > later ? most : later);
+    assert_true(fabs(-v1 - creep) <= 0.02 * creep);
+    assert_true(fabs(-(x1 - x_half) - 0.5 * seconds * creep) <= 0.02 * 0.5 * seconds * creep);
+    assert_true(-(x1 - x0) >= 0.0 && -(x1 - x0) <= 2.0 * law.slip_velocity * seconds);
+    incline_destroy(&s);
+}
+
+/* With mu_d < tan t (and mu_s only a little above mu_d) the cube slides down with
+ * a = g (sin t - mu_d cos t): Coulomb's law, once the regularisation's extra
+ * (mu_s - mu_d) fn s0 / |v| has faded (below 1e-4 of the friction at the speeds measured).
+ * The centre of mass moves only under gravity and the plane, so its velocity change over
+ * [0.5 s, 1 s] is the acceleration's, free of the cube's own vibration. */
+static void check_sliding(sh_integrator integrator, double dt) {
+    const double theta = 20.0 * 3.14159265358979323846 / 180.0, mu_s = 0.2, mu_d = 0.15, g = 9.81;
+    const sh_contact_params law = incline_law(mu_s, mu_d);
+    incline s = incline_create(theta, &law, integrator);
+    double x_half, v_half, x1, v1;
+    const int32_t most = incline_run(&s, dt, 0.5);
+    incline_centre(&s, &x_half, &v_half);
+    const int32_t later = incline_run(&s, dt, 0.5);
+    incline_centre(&s, &x1, &v1);
+    const double expected = g * (sin(theta) - mu_d * cos(theta));
+    const double measured = -(v1 - v_half) / 0.5;
+    printf("%s, dt %g s: slides, a %.4f m/s^2 (g (sin t - mu_d cos t) = %.4f); most Newton iterations %d\n",
+           integrator == SH_INTEGRATOR_IMPLICIT_EULER ? "implicit Euler" : "symplectic Euler", dt, measured, expected,
+           most > later ? most : later);
+    assert_true(fabs(measured - expected) <= 0.02 * expected);
+    incline_destroy(&s);
+}
+
+static void test_implicit_block_sticks_on_a_slope(void** state) {
+    (void)state;
+    check_sticking(SH_INTEGRATOR_IMPLICIT_EULER, 1e-3);
+    check_sticking(SH_INTEGRATOR_IMPLICIT_EULER, 1e-2);
+}
+
+static void test_implicit_block_slides_down_a_slope(void** state) {
+    (void)state;
+    check_sliding(SH_INTEGRATOR_IMPLICIT_EULER, 1e-3);
+    check_sliding(SH_INTEGRATOR_IMPLICIT_EULER, 1e-2);
+}
+
+static void test_explicit_block_sticks_on_a_slope(void** state) {
+    (void)state;
+    check_sticking(SH_INTEGRATOR_SYMPLECTIC_EULER, 1e-3);
+}
+
+static void test_explicit_block_slides_down_a_slope(void** state) {
+    (void)state;
+    check_sliding(SH_INTEGRATOR_SYMPLECTIC_EULER, 1e-3);
+}
+
+/* ---- A sphere on a convex edge of a coarse mesh ---------------------------------------------- */
+
+/* A box 20 x 20 x 10 mm of 4 x 2 x 2 cells (5 x 10 x 5 mm) on fixed bottom nodes, and a sphere
+ * of radius 6 mm (more than the cells) against its top edge x = 20 mm, z = 10 mm, centred over
+ * y = 5 mm, halfway between the edge's nodes: no node under it, so only the triangles (faces
+ * and the edge between them) can hold it. */
+#define EDGE_BOX_X 0.02
+#define EDGE_BOX_Z 0.01
+#define EDGE_RADIUS 0.006
+
+static sh_body_id edge_box(sh_world* world, double young, sh_integrator integrator, int32_t* node_count) {
+    double* nodes = NULL;
+    int32_t* tets = NULL;
+    int32_t tet_count = 0;
+    sh_test_box_arrays(EDGE_BOX_X, 0.02, EDGE_BOX_Z, 4, 2, 2, &nodes, node_count, &tets, &tet_count);
+    assert_non_null(nodes);
+    sh_mesh* mesh = NULL;
+    assert_ok(sh_mesh_create(nodes, *node_count, tets, tet_count, &mesh));
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.material.model = SH_MATERIAL_COROTATIONAL;
+    def.material.young = young;
+    def.material.poisson = 0.3;
+    def.integrator = integrator;
+    def.damping_mass = 50.0;
+    sh_body_id body = 0;
+    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    int32_t* bottom = malloc(sizeof(int32_t) * (size_t)*node_count);
+    const int count = sh_test_nodes_at(nodes, *node_count, 2, 0.0, bottom);
+    assert_ok(sh_body_fix_nodes(world, body, bottom, count));
+    free(bottom);
+    free(nodes);
+    free(tets);
+    assert_ok(sh_mesh_destroy(mesh));
+    return body;
+}
+
+/* The sphere's centre at distance EDGE_RADIUS - depth from the point p along the unit u. */
+static void edge_tool_centre(const double p[3], const double u[3], double depth, double out[3]) {
+    for (int k = 0; k < 3; ++k) out[k] = p[k] + (EDGE_RADIUS - depth) * u[k];
+}
+
+/* A stiff box (1 GPa) and a sphere held d = 0.5 mm into it, solved to static equilibrium,
+ * once on the edge along its bisector u = (1, 0, 1) / sqrt 2 and once on the top face's middle
+ * along z. Either way one contact (no node is inside the sphere) must carry the tool with the
+ * Hunt-Crossley force lambda d^n along u: the body's give under ~1 N is below 1 um (its
+ * stiffness under a point load is at least E times the 5 mm cell, 5e6 N/m), which changes
+ * the depth, so the force, by under 0.1 % and turns the direction by under 1e-4 rad. Before
+ * edges were contacts, the sphere on the edge reached through neither face over the face and
+ * got no support at all. */
+static void test_sphere_on_a_convex_edge_is_supported(void** state) {
+    (void)state;
+    const double depth = 5e-4, s = sqrt(0.5);
+    sh_contact_params law;
+    sh_contact_params_default(&law);
+    law.stiffness = 1e5;
+    law.exponent = 1.5;
+    law.damping = 0.0;
+    const double expected = law.stiffness * pow(depth, law.exponent);
+    const double edge_point[3] = {EDGE_BOX_X, 0.005, EDGE_BOX_Z}, bisector[3] = {s, 0.0, s};
+    const double face_point[3] = {0.0125, 0.0025, EDGE_BOX_Z}, up[3] = {0.0, 0.0, 1.0};
+    const double* points[2] = {edge_point, face_point};
+    const double* directions[2] = {bisector, up};
+    double magnitude[2];
+    for (int run = 0; run < 2; ++run) {
+        sh_world* world = sh_test_world(0.0);
+        int32_t node_count = 0;
+        edge_box(world, 1e9, SH_INTEGRATOR_IMPLICIT_EULER, &node_count);
+        sh_collider_def def;
+        sh_collider_def_default(&def);
+        def.shape.radius = EDGE_RADIUS;
+        def.contact = law;
+        edge_tool_centre(points[run], directions[run], depth, def.position);
+        sh_tool_id tool = 0;
+        assert_ok(sh_tool_create(world, &def, &tool));
+        sh_static_def statics;
+        sh_static_def_default(&statics);
+        assert_ok(sh_world_solve_static(world, &statics, NULL));
+        sh_contact_state contact;
+        assert_ok(sh_tool_get_contact(world, tool, &contact));
+        const double* f = contact.force;
+        magnitude[run] = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+        const double along = (f[0] * directions[run][0] + f[1] * directions[run][1] + f[2] * directions[run][2]);
+        const double angle = acos(fmin(1.0, along / magnitude[run]));
+        printf("sphere %.1f mm into the %s: reaction (%.5f, %.5f, %.5f) N, |F| %.5f N (lambda d^n = %.5f), %.2e rad off "
+               "its normal, %d contact(s), depth %.4f mm\n",
+               1e3 * depth, run == 0 ? "edge" : "face", f[0], f[1], f[2], magnitude[run], expected, angle,
+               contact.contact_count, 1e3 * contact.max_depth);
+        assert_int_equal(contact.contact_count, 1);
+        assert_true(fabs(magnitude[run] - expected) <= 1e-3 * expected);
+        assert_true(angle <= 1e-4);
+        assert_ok(sh_world_destroy(world));
+    }
+    assert_true(fabs(magnitude[0] - magnitude[1]) <= 1e-3 * magnitude[1]);
+}
+
+/* A soft box (30 kPa) and the sphere driven half its radius into the edge along the bisector
+ * in 0.2 s, symplectic Euler at 2 ms: the edge gives way and holds it. Nothing passes through: every
+ * node stays outside the sphere but for the edge region's give (none deeper than the half
+ * radius it was pushed), the edge's middle stays in front of the sphere's centre along the
+ * bisector, and the tool is pushed back out along it (its reaction's component along the
+ * bisector is most of it, and half as large again at r / 2 in as at r / 4 in). */
+static void test_sphere_pushed_into_an_edge_does_not_pass_through(void** state) {
+    (void)state;
+    const double s = sqrt(0.5), bisector[3] = {s, 0.0, s}, edge_point[3] = {EDGE_BOX_X, 0.005, EDGE_BOX_Z};
+    sh_world* world = sh_test_world(0.0);
+    int32_t node_count = 0;
+    const sh_body_id box = edge_box(world, 3e4, SH_INTEGRATOR_SYMPLECTIC_EULER, &node_count);
+    sh_collider_def def;
+    sh_collider_def_default(&def);
+    def.shape.radius = EDGE_RADIUS;
+    def.contact.stiffness = 1e5;
+    edge_tool_centre(edge_point, bisector, -1e-3, def.position); /* 1 mm clear of the edge */
+    sh_tool_id tool = 0;
+    assert_ok(sh_tool_create(world, &def, &tool));
+    const double q[4] = {1, 0, 0, 0};
+    double* x = malloc(3 * sizeof(double) * (size_t)node_count);
+    double quarter = 0.0, last = 0.0;  /* the push along the bisector at r / 4 in and at the end */
+    const int steps = 100;
+    for (int i = 1; i <= steps; ++i) {
+        const double depth = -1e-3 + (1e-3 + 0.5 * EDGE_RADIUS) * i / steps;
+        double centre[3];
+        edge_tool_centre(edge_point, bisector, depth, centre);
+        assert_ok(sh_tool_set_pose(world, tool, centre, q));
+        assert_ok(sh_world_step(world, 2e-3, NULL));
+        sh_contact_state contact;
+        assert_ok(sh_tool_get_contact(world, tool, &contact));
+        const double* f = contact.force;
+        const double along = f[0] * bisector[0] + f[1] * bisector[1] + f[2] * bisector[2];
+        const double magnitude = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+        assert_ok(sh_body_get_positions(world, box, x, 3 * (int64_t)node_count));
+        double edge_mid[3] = {0.0, 0.0, 0.0}, deepest = 0.0;
+        for (int32_t k = 0; k < node_count; ++k) {
+            const double d[3] = {x[3 * k] - centre[0], x[3 * k + 1] - centre[1], x[3 * k + 2] - centre[2]};
+            deepest = fmax(deepest, EDGE_RADIUS - sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+        }
+        /* The edge's nodes at y = 0 and 10 mm (grid nodes (4, 0, 2) and (4, 1, 2)). */
+        const int32_t e0 = (2 * 3 + 0) * 5 + 4, e1 = (2 * 3 + 1) * 5 + 4;
+        for (int k = 0; k < 3; ++k) edge_mid[k] = 0.5 * (x[3 * e0 + k] + x[3 * e1 + k]) - centre[k];
+        const double ahead = -(edge_mid[0] * bisector[0] + edge_mid[1] * bisector[1] + edge_mid[2] * bisector[2]);
+        if (i % 20 == 0)
+            printf("sphere %.2f mm into the edge: reaction %.4f N, %.4f N of it along the bisector, edge middle %.3f mm "
+                   "in front of the centre, deepest node %.3f mm in\n",
+                   1e3 * depth, magnitude, along, 1e3 * ahead, 1e3 * deepest);
+        assert_true(ahead > 0.0);
+        assert_true(deepest < 0.5 * EDGE_RADIUS);
+        if (depth > 0.25 * EDGE_RADIUS) {
+            assert_true(along > 0.9 * magnitude);
+            if (quarter == 0.0) quarter = along;
+            last = along;
+        }
+    }
+    assert_true(quarter > 0.0 && last > 1.5 * quarter); /* deeper, pushed back harder */
+    free(x);
     assert_ok(sh_world_destroy(world));
 }
 
@@ -462,6 +813,12 @@ int main(void) {
         cmocka_unit_test(test_implicit_body_rests_on_stiff_plane),
         cmocka_unit_test(test_tool_reaction_balances_the_plane),
         cmocka_unit_test(test_fast_tool_does_not_pass_through_membrane),
+        cmocka_unit_test(test_implicit_block_sticks_on_a_slope),
+        cmocka_unit_test(test_implicit_block_slides_down_a_slope),
+        cmocka_unit_test(test_explicit_block_sticks_on_a_slope),
+        cmocka_unit_test(test_explicit_block_slides_down_a_slope),
+        cmocka_unit_test(test_sphere_on_a_convex_edge_is_supported),
+        cmocka_unit_test(test_sphere_pushed_into_an_edge_does_not_pass_through),
         cmocka_unit_test(test_invalid_shapes_are_rejected),
         cmocka_unit_test(test_degenerate_contacts_stay_finite),
         cmocka_unit_test(test_contact_capacity_keeps_the_deepest),

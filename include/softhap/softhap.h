@@ -258,7 +258,8 @@ typedef struct sh_step_report {
  *  runaway is restored to its state before the call; the call then returns SH_ERR_UNSTABLE,
  *  the other bodies still advance, and SH_WARN_UNSTABLE is counted. report may be NULL.
  *  Thread: sim. Alloc: none once the scene is built, for explicit bodies. An implicit body
- *  builds its solver state on its first step (and after fixed nodes change), and sparse
+ *  builds its solver state on its first step (and after fixed nodes change), implicit bodies
+ *  that touch each other build their joint system when they first touch, and sparse
  *  factorisations and CG solves allocate inside CHOLMOD and Eigen, outside sh_set_allocator. */
 SH_API sh_status sh_world_step(sh_world* world, double dt, sh_step_report* report);
 
@@ -544,7 +545,11 @@ typedef struct sh_shape {
  *  F = max(0, lambda x^n + mu x' x^n) with mu = 3/2 alpha lambda: never attractive and exactly 0
  *  at x = 0; for small alpha v the restitution of an impact at speed v is about 1 - alpha v.
  *  Friction opposes tangential sliding with at most mu_s F while sticking and mu_d F while
- *  sliding, regularised below slip_velocity. */
+ *  sliding, regularised below slip_velocity: a sticking contact creeps at slip_velocity times
+ *  its tangential load over mu_s F (below slip_velocity), whatever the time step. Explicit
+ *  bodies take friction implicitly on each (sub)step's new velocities (stable at any step);
+ *  implicit bodies take it proportional to the normal force at the step's start (so a contact
+ *  that begins within a step has no friction until the next). */
 typedef struct sh_contact_params {
     double stiffness;        /**< lambda (N/m^n) per contact point, > 0; default 1e4 */
     double exponent;         /**< n, >= 1; default 1.5 (Hertz-like) */
@@ -642,12 +647,21 @@ SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id o
                                          sh_contact_state* out);
 
 /** Enable contact between two deformable bodies with params (NULL disables it): each step,
- *  the surface nodes of each body that lie inside the other's tets are pushed out through the
- *  other's nearest surface triangle, the reaction spread over that triangle's nodes. Both
- *  bodies must be FEM bodies of world, and different. The bodies are stepped one after the
- *  other, each against the other's latest state (staggered): stiff contact between two
- *  implicit bodies can creep instead of settling, and sh_world_solve_static solves them in
- *  turn rather than for a joint equilibrium. Thread: sim. Alloc: may. */
+ *  the surface nodes of each body that lie inside the other's tets, or in front of its
+ *  surface within the distance the two may close in the step, are contact candidates; one
+ *  inside is pushed out through the other's nearest surface triangle, the reaction spread over
+ *  that triangle's nodes. Both bodies must be FEM bodies of world, and different.
+ *  Implicit bodies with candidates between them (directly or through other bodies) are
+ *  stepped together: one Newton loop on their joint residual over one sparse system of all
+ *  their free nodes, each contact's blocks between the two bodies included, its updates
+ *  backtracking until the step's incremental potential or the residual falls; if it fails,
+ *  each of them is restored. sh_world_solve_static solves bodies in contact for their joint
+ *  equilibrium the same way: one of them needs fixed or prescribed nodes, the others may be
+ *  held by their contacts alone, but frictionless contact gives no sideways stiffness, so a
+ *  body resting on another needs a sideways hold (or it has no equilibrium to converge to).
+ *  A body with an explicit integrator is stepped against the other's latest state
+ *  (staggered). Thread: sim. Alloc: may; the joint system of bodies in contact is built when
+ *  they first touch and rebuilt when the nodes in contact outgrow it. */
 SH_API sh_status sh_world_set_body_contact(sh_world* world, sh_body_id a, sh_body_id b,
                                            const sh_contact_params* params);
 
@@ -684,13 +698,16 @@ typedef struct sh_static_report {
 /** Move every body to static equilibrium under gravity (lumped, rho g V / 4 per node per tet
  *  for FEM bodies) and its external forces, with fixed and prescribed nodes held: Newton-Raphson
  *  K(x_i) dx = f_ext + f(x_i) with backtracking line search on the potential energy, one sparse
- *  solve for linear materials. Positions are updated in place and velocities zeroed. A body
- *  with no fixed node (singular K) is SH_ERR_SOLVER; SH_ERR_NOT_CONVERGED if the tolerance is
+ *  solve for linear materials. Bodies in contact with each other (sh_world_set_body_contact)
+ *  are solved together, for their joint equilibrium. Positions are updated in place and
+ *  velocities zeroed. A body with no fixed node that no contact holds (singular K) is
+ *  SH_ERR_SOLVER; SH_ERR_NOT_CONVERGED if the tolerance is
  *  not reached; on any error every body keeps its previous state and report (if not NULL)
  *  still tells what was tried (converged = 0).
  *  Thread: sim. Alloc: may. */
 SH_API sh_status sh_world_solve_static(sh_world* world, const sh_static_def* def,
                                        sh_static_report* report);
+
 
 /* ------------------------------------------------------------------------------------------ */
 /* Haptic rendering: the Volumetric Buffer Model                                               */

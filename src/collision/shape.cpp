@@ -700,8 +700,19 @@ bool Shape::penetrate_triangle(const Pose& pose, const double a[3], const double
     w[1] = dot3(n, t) / area2;
     cross3(qa, qb, t);
     w[2] = dot3(n, t) / area2;
-    const double tolerance = -1e-12;
-    if (!(w[0] >= tolerance && w[1] >= tolerance && w[2] >= tolerance)) return false;
+    // On an edge (to round-off) the point belongs to one of the two triangles that share it:
+    // to the one that runs along the edge from its lexicographically smaller end (the other
+    // runs along it the other way), so that a tool on the edge between two faces is held once.
+    const double tolerance = 1e-12;
+    const double* corner[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) {
+        if (w[k] > tolerance) continue;
+        if (w[k] < -tolerance) return false;
+        const double* from = corner[(k + 1) % 3];
+        const double* to = corner[(k + 2) % 3];
+        const bool forward = from[0] != to[0] ? from[0] < to[0] : from[1] != to[1] ? from[1] < to[1] : from[2] < to[2];
+        if (!forward) return false;
+    }
     double sum = 0.0;
     for (int k = 0; k < 3; ++k) {
         w[k] = std::max(w[k], 0.0);
@@ -714,6 +725,83 @@ bool Shape::penetrate_triangle(const Pose& pose, const double a[3], const double
         out.normal[k] = -n[k];
         out.point[k] = q[k];
         bary[k] = w[k] / sum;
+    }
+    return true;
+}
+
+bool Shape::penetrate_edge(const Pose& pose, const double a[3], const double b[3], const double n1[3],
+                           const double n2[3], Penetration& out, double& t) const {
+    if (kind_ == SH_SHAPE_PLANE) return false;
+    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double length = norm3(e);
+    if (!(length > 0.0) || !std::isfinite(length)) return false;
+    for (int k = 0; k < 3; ++k) e[k] /= length;
+    // The directions between n1 and n2: m(angle) = cos(angle) n1 + sin(angle) u, 0..range.
+    const double c12 = dot3(n1, n2);
+    double u[3] = {n2[0] - c12 * n1[0], n2[1] - c12 * n1[1], n2[2] - c12 * n1[2]};
+    const double s12 = norm3(u);
+    if (!(s12 > 1e-9)) return false;  // flat (or folded back on itself)
+    for (int k = 0; k < 3; ++k) u[k] /= s12;
+    const double range = std::atan2(s12, c12);
+    auto direction = [&](double angle, double m[3]) {
+        const double ca = std::cos(angle), sa = std::sin(angle);
+        for (int k = 0; k < 3; ++k) m[k] = ca * n1[k] + sa * u[k];
+    };
+    double angle;
+    if (kind_ == SH_SHAPE_SPHERE) {
+        // Overlap r - m.(centre - a): least where m points at the centre, across the edge.
+        double q[3] = {pose.p[0] - a[0], pose.p[1] - a[1], pose.p[2] - a[2]};
+        const double along = dot3(q, e);
+        for (int k = 0; k < 3; ++k) q[k] -= along * e[k];
+        if (!(norm3(q) > 0.0)) return false;
+        angle = std::atan2(dot3(q, u), dot3(q, n1));
+        if (!(angle > 0.0 && angle < range)) return false;
+    } else {
+        // Golden-section search of the overlap over the range; an end is a face's region.
+        auto overlap = [&](double x) {
+            double m[3], minus_m[3], s[3];
+            direction(x, m);
+            for (int k = 0; k < 3; ++k) minus_m[k] = -m[k];
+            support(pose, minus_m, s);
+            return dot3(m, a) - dot3(m, s);
+        };
+        const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+        double lo = 0.0, hi = range;
+        double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo);
+        double f1 = overlap(x1), f2 = overlap(x2);
+        for (int i = 0; i < 60 && hi - lo > 1e-12 * range; ++i) {
+            if (f1 <= f2) {
+                hi = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = hi - ratio * (hi - lo);
+                f1 = overlap(x1);
+            } else {
+                lo = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = lo + ratio * (hi - lo);
+                f2 = overlap(x2);
+            }
+        }
+        angle = 0.5 * (lo + hi);
+        if (!(angle > 1e-9 * range && angle < (1.0 - 1e-9) * range)) return false;
+    }
+    double m[3], minus_m[3], s[3];
+    direction(angle, m);
+    for (int k = 0; k < 3; ++k) minus_m[k] = -m[k];
+    support(pose, minus_m, s);
+    const double depth = dot3(m, a) - dot3(m, s);
+    if (!(depth > 0.0)) return false;
+    const double centre[3] = {pose.p[0] - a[0], pose.p[1] - a[1], pose.p[2] - a[2]};
+    if (!(dot3(m, centre) > 0.0)) return false;  // the shape's centre must be on the outer side
+    const double sa[3] = {s[0] - a[0], s[1] - a[1], s[2] - a[2]};
+    t = dot3(sa, e) / length;
+    if (!(t >= 0.0 && t <= 1.0)) return false;  // beyond an end: the node's contact
+    out.depth = depth;
+    for (int k = 0; k < 3; ++k) {
+        out.normal[k] = -m[k];
+        out.point[k] = a[k] + t * length * e[k];
     }
     return true;
 }

@@ -55,6 +55,19 @@ public:
     bool penetrate_triangle(const Pose& pose, const double a[3], const double b[3], const double c[3],
                             Penetration& out, double bary[3]) const;
 
+    /// True if the shape at pose reaches through the edge (a, b) where two surface triangles
+    /// with unit outward normals n1 and n2 meet in a convex dihedral, in the edge's own region:
+    /// over the directions m between n1 and n2 (perpendicular to the edge) the overlap
+    /// m.a - min over the shape of m.s is least strictly between them (at n1 or n2 it is a
+    /// face's, see penetrate_triangle), and positive there, the shape's deepest point along -m
+    /// projects onto the segment and its centre is on the outer side. Then out.depth is that
+    /// overlap, out.normal = -m (the push that moves the edge out of the shape), out.point the
+    /// projected point and t its parameter from a (0) to b (1). Exact for spheres (m points
+    /// from the edge to the centre); a one-dimensional search over m for the other shapes.
+    /// Planes, zero-length edges and parallel normals give false.
+    bool penetrate_edge(const Pose& pose, const double a[3], const double b[3], const double n1[3],
+                        const double n2[3], Penetration& out, double& t) const;
+
     /// From now on, point queries on a convex hull skip libccd's GJK/EPA, which allocates:
     /// MPR and the sampled directions give the depth (an upper bound, exact along the hull
     /// face MPR finds). For the haptic step's own copy of a tool.

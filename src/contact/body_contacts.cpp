@@ -21,29 +21,88 @@ inline void cross(const double* a, const double* b, double* out) {
     out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-// A node p behind triangle (a, b, c) of another body: depth below its plane along the outward
-// unit normal n, and the barycentric weights of the nearest point of the triangle to p's
-// projection. False if p is in front, the triangle is degenerate, or p has slid off it.
-bool node_behind_face(const double* p, const double* a, const double* b, const double* c, double& depth, double n[3],
-                      double w[3]) {
+// Where p lies against the plane of triangle (a, b, c): its height above it along the outward
+// unit normal n, and the barycentric weights w of the point of the triangle nearest to p's
+// projection, at distance lateral from it. False if the triangle is degenerate. Sets edge2 to
+// its longer edge from a, squared.
+bool over_face(const double* p, const double* a, const double* b, const double* c, double& height, double n[3],
+               double w[3], double& lateral, double& edge2) {
     double ab[3], ac[3], ap[3];
     sub(b, a, ab);
     sub(c, a, ac);
     cross(ab, ac, n);
     const double area2 = std::sqrt(dot(n, n));
-    const double edge2 = std::max(dot(ab, ab), dot(ac, ac));
+    edge2 = std::max(dot(ab, ab), dot(ac, ac));
     if (!(area2 > 1e-14 * edge2)) return false;
     for (int k = 0; k < 3; ++k) n[k] /= area2;
     sub(p, a, ap);
-    depth = -dot(n, ap);
-    if (!(depth > 0.0)) return false;
+    height = dot(n, ap);
     double q[3];
-    for (int k = 0; k < 3; ++k) q[k] = p[k] + depth * n[k];
-    const double lateral = closest_on_triangle(q, a, b, c, w);
-    return lateral * lateral <= edge2;
+    for (int k = 0; k < 3; ++k) q[k] = p[k] - height * n[k];
+    lateral = closest_on_triangle(q, a, b, c, w);
+    return true;
+}
+
+// A node p behind triangle (a, b, c) of another body: depth below its plane along the outward
+// unit normal n, and the barycentric weights of the nearest point of the triangle to p's
+// projection. False if p is in front, the triangle is degenerate, or p has slid off it.
+bool node_behind_face(const double* p, const double* a, const double* b, const double* c, double& depth, double n[3],
+                      double w[3]) {
+    double height, lateral, edge2;
+    if (!over_face(p, a, b, c, height, n, w, lateral, edge2)) return false;
+    depth = -height;
+    return depth > 0.0 && lateral * lateral <= edge2;
+}
+
+// A node p in front of triangle (a, b, c) of another body, over the triangle itself (its
+// projection inside it, to round-off): the face it would enter.
+bool node_before_face(const double* p, const double* a, const double* b, const double* c) {
+    double height, n[3], w[3], lateral, edge2;
+    return over_face(p, a, b, c, height, n, w, lateral, edge2) && height >= 0.0 && lateral * lateral <= 1e-18 * edge2;
 }
 
 inline const double* at(const double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
+
+// Dihedral angle (between the outward normals) from which a convex edge has the whole contact
+// law (rad): 15 degrees.
+constexpr double kFullEdgeAngle = 0.2617993877991494;
+
+// The tangent of one contact point, stiffness_scale K + damping_scale D, as 3x3 blocks between
+// two of the nodes it acts on (its own, or for a body pair one of the other body's): for
+// depth gradients g_a, g_b and shares w_a, w_b, K_ab = k g_a g_b^T, D_ab = c g_a g_b^T +
+// w_a w_b D_t, D_t friction's -dF/dvt on the tangent plane: across (I - n n^T - t t^T) + along
+// t t^T (friction_tangent), exact for the velocity-only friction of contact() but for the part
+// dropped to stay positive semi-definite.
+class PointTangent {
+public:
+    PointTangent(const ContactPoint& p, const sh_contact_params& params, double stiffness_scale, double damping_scale,
+                 double chord = -1.0)
+        : p_(p), normal_scale_(stiffness_scale * p.stiffness + damping_scale * p.damping), damping_scale_(damping_scale) {
+        if (p.friction_normal > 0.0) {
+            const double vn = dot(p.relative_velocity, p.normal);
+            for (int k = 0; k < 3; ++k) t_[k] = p.relative_velocity[k] - vn * p.normal[k];
+            const double speed = std::sqrt(dot(t_, t_));
+            ft_ = friction_tangent(params, p.friction_normal, speed, chord);
+            for (int k = 0; k < 3; ++k) t_[k] = speed > 0.0 ? t_[k] / speed : 0.0;
+        }
+    }
+
+    void block(const double* ga, double wa, const double* gb, double wb, double out[9]) const {
+        const double shares = damping_scale_ * wa * wb;
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s) {
+                const double tangent_plane = (r == s ? 1.0 : 0.0) - p_.normal[r] * p_.normal[s];
+                out[3 * r + s] = normal_scale_ * ga[r] * gb[s] +
+                                 shares * (ft_.across * (tangent_plane - t_[r] * t_[s]) + ft_.along * t_[r] * t_[s]);
+            }
+    }
+
+private:
+    const ContactPoint& p_;
+    double normal_scale_, damping_scale_;
+    double t_[3] = {0.0, 0.0, 0.0};
+    FrictionTangent ft_;
+};
 
 
 }  // namespace
@@ -72,6 +131,27 @@ BodyContacts::BodyContacts(const Body& body) : body_(body) {
     for (size_t i = 0; i < n; ++i)
         if (on_surface[i]) surface_nodes_.push_back(static_cast<int32_t>(i));
     if (tris.empty()) boxes_.resize(surface_nodes_.size());
+    // Each surface edge's two triangles, by sorting the edges by their node pair.
+    edge_neighbor_.assign(tris.size(), -1);
+    struct Side {
+        int32_t lo, hi, index;  ///< node pair, and 3 triangle + k
+    };
+    vec<Side> sides(tris.size());
+    for (size_t i = 0; i < tris.size(); ++i) {
+        const int32_t a = tris[i], b = tris[i - i % 3 + (i % 3 + 1) % 3];
+        sides[i] = {std::min(a, b), std::max(a, b), static_cast<int32_t>(i)};
+    }
+    std::sort(sides.begin(), sides.end(),
+              [](const Side& p, const Side& q) { return p.lo != q.lo ? p.lo < q.lo : p.hi != q.hi ? p.hi < q.hi : p.index < q.index; });
+    for (size_t i = 0; i < sides.size();) {
+        size_t j = i;
+        while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
+        if (j - i == 2) {  // a manifold edge
+            edge_neighbor_[static_cast<size_t>(sides[i].index)] = sides[i + 1].index / 3;
+            edge_neighbor_[static_cast<size_t>(sides[i + 1].index)] = sides[i].index / 3;
+        }
+        i = j;
+    }
     stamp_.assign(n, 0);
     node_depth_.assign(n, 0.0);
 }
@@ -82,6 +162,7 @@ void BodyContacts::clear() {
 }
 
 void BodyContacts::refit(double margin) {
+    margin_ = margin;
     const double* x = body_.x.data();
     const vec<int32_t>& tris = body_.surface_triangles;
     for (size_t b = 0; b < boxes_.size(); ++b) {
@@ -135,6 +216,17 @@ bool BodyContacts::detect(Collider& collider, double reach) {
         tree_.query(query, [&](int32_t prim) {
             const int32_t* t = &tris[3 * static_cast<size_t>(prim)];
             candidates_.push_back({ContactCandidate::kFaceShape, -1, {t[0], t[1], t[2]}, target, nullptr, &collider.params});
+            // Its edges it shares with a triangle of higher index (so each edge once): a tool
+            // straddling a convex edge reaches through neither face's plane over the face.
+            for (int k = 0; k < 3; ++k) {
+                const int32_t across = edge_neighbor_[3 * static_cast<size_t>(prim) + static_cast<size_t>(k)];
+                if (across <= prim) continue;
+                const int32_t a = t[k], b = t[(k + 1) % 3];
+                const int32_t* u = &tris[3 * static_cast<size_t>(across)];
+                const int32_t opposite = u[0] != a && u[0] != b ? u[0] : u[1] != a && u[1] != b ? u[1] : u[2];
+                candidates_.push_back({ContactCandidate::kEdgeShape, opposite, {a, b, t[(k + 2) % 3]}, target, nullptr,
+                                       &collider.params});
+            }
         });
     group.end = static_cast<int32_t>(candidates_.size());
     if (group.end == group.begin) return false;
@@ -186,15 +278,20 @@ bool BodyContacts::detect_pair(BodyContacts& a, BodyContacts& b, const sh_contac
             const double l1 = dot(r, c12) / det, l2 = dot(r, c20) / det, l3 = dot(r, c01) / det;
             inside = l1 >= 0.0 && l2 >= 0.0 && l3 >= 0.0 && l1 + l2 + l3 <= 1.0;
         });
-        if (!inside) continue;
+        // Outside b, the node is a candidate while the bodies may close the gap in the step
+        // (without it, a node resting at the surface would fall a whole step into b each time
+        // it is found outside, and chatter).
+        const double reach = inside ? INFINITY : a.margin_ + b.margin_;
+        if (!(reach > 0.0)) continue;
         double distance = 0.0;
-        const int32_t tri = b.tree_.nearest(p, INFINITY, [&](int32_t t) {
+        const int32_t tri = b.tree_.nearest(p, reach, [&](int32_t t) {
             double w[3];
             const int32_t* f = &tris[3 * static_cast<size_t>(t)];
             return closest_on_triangle(p, at(xb, f[0]), at(xb, f[1]), at(xb, f[2]), w);
         }, distance);
         if (tri < 0) continue;
         const int32_t* f = &tris[3 * static_cast<size_t>(tri)];
+        if (!inside && !node_before_face(p, at(xb, f[0]), at(xb, f[1]), at(xb, f[2]))) continue;
         a.candidates_.push_back({ContactCandidate::kNodeFace, node, {f[0], f[1], f[2]}, nullptr, &b.body_, &params});
         b.candidates_.push_back({ContactCandidate::kFaceNode, node, {f[0], f[1], f[2]}, nullptr, &a.body_, &params});
     }
@@ -239,18 +336,118 @@ bool BodyContacts::keep_deepest(Group& group, int32_t capacity) {
     return true;
 }
 
+BodyContacts* BodyContacts::finish_detection() {
+    iterates_.clear();
+    if (candidates_.empty()) return nullptr;
+    if (body_.settings.integrator != SH_INTEGRATOR_IMPLICIT_EULER) return this;
+    bool friction = false;
+    for (const ContactCandidate& c : candidates_) friction |= c.params->static_friction > 0.0;
+    if (!friction) return this;
+    // At the step's start state: each candidate's normal force and where it acts.
+    for (ContactCandidate& c : candidates_) c.friction_normal = 0.0;
+    vec<FrictionIterate> iterates(candidates_.size(), FrictionIterate{});
+    evaluate_candidates(body_.x.data(), body_.v.data(), [&](const ContactCandidate& c, const ContactPoint* point) {
+        if (!point) return;
+        const size_t index = static_cast<size_t>(&c - candidates_.data());
+        candidates_[index].friction_normal = point->normal_force;
+        FrictionIterate& r = iterates[index];
+        for (int k = 0; k < 3; ++k) {
+            r.lag_normal[k] = point->normal[k];
+            r.lag_point[k] = point->point[k];
+            // The face's barycentric weights, for the kinds with one.
+            r.lag_face[k] = c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kEdgeShape
+                                ? (k < point->count ? point->weights[k] : 0.0)
+                            : c.kind == ContactCandidate::kFaceNode ? -point->weights[k]
+                            : c.kind == ContactCandidate::kNodeFace ? -point->other_weights[k]
+                                                                    : 0.0;
+        }
+    });
+    iterates_.swap(iterates);
+    return this;
+}
+
 bool BodyContacts::contact(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const {
+    if (touching(c, x, v, out)) return true;
+    return v && lagged_friction(c, v, out);
+}
+
+bool BodyContacts::lagged_friction(const ContactCandidate& c, const double* v, ContactPoint& out) const {
+    // An implicit body's candidate that touched at the step's start keeps its friction through
+    // the step even at iterates where it has come off (its normal force is lagged, so is
+    // whether it acts): else the friction would vanish as a node leaves the surface, a jump in
+    // the force that Newton cannot converge across. It acts where it did at the start.
+    if (!(c.friction_normal > 0.0) || iterates_.size() != candidates_.size() || !(c.params->static_friction > 0.0))
+        return false;
+    const FrictionIterate& r = iterates_[static_cast<size_t>(&c - candidates_.data())];
+    double vrel[3] = {0.0, 0.0, 0.0};
+    int count = 1;
+    const int32_t* nodes = &c.node;
+    double weights[3] = {1.0, 0.0, 0.0};
+    switch (c.kind) {
+        case ContactCandidate::kNodeShape:
+        case ContactCandidate::kFaceShape:
+        case ContactCandidate::kEdgeShape: {
+            double vc[3];
+            c.collider->point_velocity(r.lag_point, vc);
+            if (c.kind != ContactCandidate::kNodeShape) {
+                count = c.kind == ContactCandidate::kFaceShape ? 3 : 2;
+                nodes = c.face;
+                for (int k = 0; k < 3; ++k) weights[k] = r.lag_face[k];
+            }
+            for (int k = 0; k < 3; ++k) vrel[k] = -vc[k];
+            break;
+        }
+        case ContactCandidate::kNodeFace:
+            for (int a = 0; a < 3; ++a)
+                for (int k = 0; k < 3; ++k) vrel[k] -= r.lag_face[a] * at(c.other->v.data(), c.face[a])[k];
+            for (int k = 0; k < 3; ++k) out.other_weights[k] = -r.lag_face[k];
+            break;
+        case ContactCandidate::kFaceNode:
+            count = 3;
+            nodes = c.face;
+            for (int k = 0; k < 3; ++k) {
+                weights[k] = -r.lag_face[k];
+                vrel[k] = at(c.other->v.data(), c.node)[k];
+            }
+            break;
+    }
+    out.depth = 0.0;
+    out.count = count;
+    for (int k = 0; k < 3; ++k) {
+        out.normal[k] = r.lag_normal[k];
+        out.point[k] = r.lag_point[k];
+    }
+    for (int a = 0; a < count; ++a) {
+        out.nodes[a] = nodes[a];
+        out.weights[a] = weights[a];
+        for (int k = 0; k < 3; ++k) {
+            out.gradient[a][k] = weights[a] * out.normal[k];
+            vrel[k] += weights[a] * at(v, nodes[a])[k];
+        }
+    }
+    out.stiffness = out.damping = out.normal_force = 0.0;
+    out.law_scale = 1.0;
+    out.friction_normal = c.friction_normal;
+    for (int k = 0; k < 3; ++k) out.relative_velocity[k] = vrel[k];
+    const double vn = dot(vrel, out.normal);
+    double vt[3], ft[3];
+    for (int k = 0; k < 3; ++k) vt[k] = vrel[k] - vn * out.normal[k];
+    out.friction = coulomb_friction(*c.params, out.friction_normal, vt, ft);
+    for (int a = 0; a < count; ++a)
+        for (int k = 0; k < 3; ++k) out.node_force[a][k] = weights[a] * ft[k];
+    return true;
+}
+
+bool BodyContacts::touching(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const {
     const sh_contact_params& p = *c.params;
     double vrel[3] = {0.0, 0.0, 0.0};  // velocity of the node side relative to the other side
-    double touched_mass = INFINITY;    // smallest own mass the friction acts on
-    const double* mass = body_.mass.data();
+    out.law_scale = 1.0;
     auto set_nodes = [&](int count, const int32_t* nodes, const double* weights) {
         out.count = count;
         for (int a = 0; a < count; ++a) {
             out.nodes[a] = nodes[a];
             out.weights[a] = weights[a];
             for (int k = 0; k < 3; ++k) out.gradient[a][k] = weights[a] * out.normal[k];
-            touched_mass = std::min(touched_mass, mass[nodes[a]]);
         }
     };
     const double one = 1.0;
@@ -295,6 +492,52 @@ bool BodyContacts::contact(const ContactCandidate& c, const double* x, const dou
             }
             break;
         }
+        case ContactCandidate::kEdgeShape: {
+            const double *a = at(x, c.face[0]), *b = at(x, c.face[1]);
+            double ab[3], ac[3], ad[3], n1[3], n2[3];
+            sub(b, a, ab);
+            sub(at(x, c.face[2]), a, ac);
+            sub(at(x, c.node), a, ad);
+            cross(ab, ac, n1);  // own triangle (a, b, c), outward
+            cross(ad, ab, n2);  // the one across, (b, a, d), outward
+            const double l1 = std::sqrt(dot(n1, n1)), l2 = std::sqrt(dot(n2, n2));
+            if (!(l1 > 0.0 && l2 > 0.0)) return false;
+            for (int k = 0; k < 3; ++k) {
+                n1[k] /= l1;
+                n2[k] /= l2;
+            }
+            // Convex there: the node across lies behind own triangle's plane.
+            if (!(dot(n1, ad) < -1e-9 * std::sqrt(dot(ab, ab) * dot(ad, ad)))) return false;
+            // The edge's region (the directions between n1 and n2) closes as the edge
+            // flattens, and past flat the two faces' regions overlap instead (each takes the
+            // tool, see penetrate_triangle): its law ramps in with the dihedral angle up to
+            // kFullEdgeAngle, so that an edge that folds through flat under load (the faces
+            // of a dent) changes the force continuously. A sharp edge has the whole law.
+            double fold[3];
+            cross(n1, n2, fold);
+            out.law_scale = std::min(1.0, std::atan2(std::sqrt(dot(fold, fold)), dot(n1, n2)) / kFullEdgeAngle);
+            Penetration pen;
+            double t = 0.0;
+            if (!c.collider->shape.penetrate_edge(c.collider->pose, a, b, n1, n2, pen, t)) return false;
+            // As for a face: once a node of it or of the two triangles that meet there (whose
+            // contacts take over from the edge's at either side) touches the collider, the node
+            // contacts carry it.
+            for (const int32_t node : {c.face[0], c.face[1], c.face[2], c.node})
+                if (node_depth_[static_cast<size_t>(node)] > 0.0) return false;
+            out.depth = pen.depth;
+            for (int k = 0; k < 3; ++k) {
+                out.normal[k] = pen.normal[k];
+                out.point[k] = pen.point[k];
+            }
+            const double w[2] = {1.0 - t, t};
+            set_nodes(2, c.face, w);
+            if (v) {
+                double vc[3];
+                c.collider->point_velocity(out.point, vc);
+                for (int k = 0; k < 3; ++k) vrel[k] = w[0] * at(v, c.face[0])[k] + w[1] * at(v, c.face[1])[k] - vc[k];
+            }
+            break;
+        }
         case ContactCandidate::kNodeFace:
         case ContactCandidate::kFaceNode: {
             const bool own_node = c.kind == ContactCandidate::kNodeFace;
@@ -307,6 +550,7 @@ bool BodyContacts::contact(const ContactCandidate& c, const double* x, const dou
             for (int k = 0; k < 3; ++k) out.point[k] = at(xn, c.node)[k];
             if (own_node) {
                 set_nodes(1, &c.node, &one);
+                for (int k = 0; k < 3; ++k) out.other_weights[k] = -w[k];
             } else {
                 const double far_side[3] = {-w[0], -w[1], -w[2]};
                 set_nodes(3, c.face, far_side);
@@ -322,20 +566,32 @@ bool BodyContacts::contact(const ContactCandidate& c, const double* x, const dou
         }
     }
     const double normal_speed = dot(out.normal, vrel);
-    const NormalForce fn = hunt_crossley(p, out.depth, -normal_speed);
+    NormalForce fn = hunt_crossley(p, out.depth, -normal_speed);
+    fn.force *= out.law_scale;
+    fn.stiffness *= out.law_scale;
+    fn.damping *= out.law_scale;
     out.stiffness = fn.stiffness;
     out.damping = fn.damping;
+    out.normal_force = fn.force;
     out.friction = 0.0;
+    out.friction_normal = 0.0;
+    for (int k = 0; k < 3; ++k) out.relative_velocity[k] = vrel[k];
     double ft[3] = {0.0, 0.0, 0.0};
-    if (v && fn.force > 0.0 && p.static_friction > 0.0) {
+    // Friction of an implicit body is proportional to the normal force at the step's start
+    // (lagged, as IPC does), not at the state being tried: then it depends on the velocity alone
+    // and its tangent (add_tangent) is its exact derivative. With the current normal force the
+    // friction would also change with every node's depth, a coupling (mu times the contact
+    // stiffness, far above the viscous friction's own) that a symmetric tangent cannot hold, and
+    // Newton cycles. The lag is one step: a contact new in the step has no friction until the
+    // next (and one that comes off keeps it, see lagged_friction). Explicit bodies evaluate
+    // forces at the (sub)step's start, so their current normal force is that one.
+    const bool implicit = body_.settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER;
+    const double friction_normal = implicit ? c.friction_normal : fn.force;
+    if (v && friction_normal > 0.0 && p.static_friction > 0.0) {
+        out.friction_normal = friction_normal;
         double vt[3];
         for (int k = 0; k < 3; ++k) vt[k] = vrel[k] - normal_speed * out.normal[k];
-        out.friction = coulomb_friction(p, fn.force, vt, ft);
-        if (friction_rate_limit > 0.0 && out.friction > touched_mass * friction_rate_limit) {
-            const double scale = touched_mass * friction_rate_limit / out.friction;
-            out.friction *= scale;
-            for (double& f : ft) f *= scale;
-        }
+        out.friction = coulomb_friction(p, out.friction_normal, vt, ft);
     }
     for (int a = 0; a < out.count; ++a)
         for (int k = 0; k < 3; ++k) out.node_force[a][k] = fn.force * out.gradient[a][k] + out.weights[a] * ft[k];
@@ -371,39 +627,275 @@ void BodyContacts::evaluate(const double* x, const double* v, Emit&& emit) const
 
 void BodyContacts::add_forces(const double* x, const double* v, double* f) const {
     const ScopedTimer timer(evaluation_seconds_);
-    evaluate(x, v, [&](const ContactCandidate&, const ContactPoint& p) {
+    // Explicit bodies feel their friction in end_explicit_step, not here.
+    const bool explicit_friction = body_.settings.integrator != SH_INTEGRATOR_IMPLICIT_EULER;
+    const bool record = recording_ && v;
+    if (record) friction_records_.clear();
+    recording_ = false;
+    const bool iterate = v && !explicit_friction && iterates_.size() == candidates_.size();
+    evaluate_candidates(x, v, [&](const ContactCandidate& c, const ContactPoint* point) {
+        if (iterate) record_friction_iterate(c, point);
+        if (!point) return;
+        const ContactPoint& p = *point;
+        const bool friction = p.friction_normal > 0.0;
         for (int a = 0; a < p.count; ++a)
-            for (int k = 0; k < 3; ++k) f[3 * static_cast<size_t>(p.nodes[a]) + k] += p.node_force[a][k];
+            for (int k = 0; k < 3; ++k)
+                f[3 * static_cast<size_t>(p.nodes[a]) + k] +=
+                    explicit_friction && friction ? p.normal_force * p.gradient[a][k] : p.node_force[a][k];
+        if (!(explicit_friction && friction && record)) return;
+        FrictionRecord r;
+        r.count = p.count;
+        r.normal_force = p.friction_normal;
+        r.params = c.params;
+        for (int k = 0; k < 3; ++k) {
+            r.normal[k] = p.normal[k];
+            r.offset[k] = -p.relative_velocity[k];
+        }
+        for (int a = 0; a < p.count; ++a) {
+            r.nodes[a] = p.nodes[a];
+            r.weights[a] = p.weights[a];
+            for (int k = 0; k < 3; ++k) r.offset[k] += p.weights[a] * v[3 * static_cast<size_t>(p.nodes[a]) + k];
+        }
+        friction_records_.push_back(r);
     });
+}
+
+void BodyContacts::begin_explicit_step() const {
+    recording_ = true;
+    friction_records_.clear();
+}
+
+void BodyContacts::end_explicit_step(double h, bool move_positions, double* x, double* v) const {
+    // Friction taken implicitly (backward Euler) on the velocities the step reached without it,
+    // contact by contact (Gauss-Seidel over contacts sharing nodes), with the normal force and
+    // normal of the step's start: the tangential velocity each contact ends the step with is
+    // implicit_slip_speed's. An explicit viscous friction mu_s fn / s0 would need a step below
+    // the node's mass over it (or a cap there, which lets a node that carries more weight than
+    // its own creep at its load times h over its mass); this one holds a sticking contact at
+    // the regularised law's creep, at most slip_velocity, at any step.
+    recording_ = false;
+    const double* inverse_mass = body_.inverse_mass.data();
+    for (const FrictionRecord& r : friction_records_) {
+        double w = 0.0;  // effective inverse mass of the contact (1/kg)
+        double vt[3];
+        for (int k = 0; k < 3; ++k) vt[k] = -r.offset[k];
+        for (int a = 0; a < r.count; ++a) {
+            const size_t node = static_cast<size_t>(r.nodes[a]);
+            w += r.weights[a] * r.weights[a] * inverse_mass[node];
+            for (int k = 0; k < 3; ++k) vt[k] += r.weights[a] * v[3 * node + k];
+        }
+        if (!(w > 0.0)) continue;
+        const double vn = dot(vt, r.normal);
+        for (int k = 0; k < 3; ++k) vt[k] -= vn * r.normal[k];
+        const double speed = std::sqrt(dot(vt, vt));
+        if (!(speed > 0.0)) continue;
+        const double slowed = implicit_slip_speed(*r.params, r.normal_force, speed, w * h);
+        // The impulse J = -(speed - slowed) / w along vt changes node a's velocity by
+        // weights[a] J / m_a, and the contact's relative velocity by w J.
+        const double scale = -(speed - slowed) / (w * speed);
+        for (int a = 0; a < r.count; ++a) {
+            const size_t node = static_cast<size_t>(r.nodes[a]);
+            const double share = scale * r.weights[a] * inverse_mass[node];
+            for (int k = 0; k < 3; ++k) {
+                v[3 * node + k] += share * vt[k];
+                if (move_positions) x[3 * node + k] += h * share * vt[k];
+            }
+        }
+    }
+    friction_records_.clear();
 }
 
 void BodyContacts::add_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
                                const int32_t* free_index, SparseSystem& system) const {
     const ScopedTimer timer(evaluation_seconds_);
-    evaluate(x, v, [&](const ContactCandidate&, const ContactPoint& p) {
-        // K_ab = k g_a g_b^T, D_ab = c g_a g_b^T + friction w_a w_b (I - n n^T).
+    evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
+        const PointTangent tangent(p, *c.params, stiffness_scale, damping_scale, friction_chord(c, p));
         for (int a = 0; a < p.count; ++a) {
             const int32_t fa = free_index[p.nodes[a]];
             if (fa < 0) continue;
             for (int b = a; b < p.count; ++b) {
                 const int32_t fb = free_index[p.nodes[b]];
                 if (fb < 0) continue;
-                const double sliding = damping_scale * p.friction * p.weights[a] * p.weights[b];
                 double block[9];
-                for (int r = 0; r < 3; ++r)
-                    for (int s = 0; s < 3; ++s)
-                        block[3 * r + s] =
-                            (stiffness_scale * p.stiffness + damping_scale * p.damping) * p.gradient[a][r] * p.gradient[b][s] +
-                            sliding * ((r == s ? 1.0 : 0.0) - p.normal[r] * p.normal[s]);
+                tangent.block(p.gradient[a], p.weights[a], p.gradient[b], p.weights[b], block);
                 system.add_block(fa, fb, block, 1.0);
             }
         }
     });
 }
 
+// Friction's tangent in an implicit step.
+//
+// With the normal force lagged, friction depends on the slip velocity alone, and its exact
+// (positive semi-definite) tangent makes Newton quadratic while the contacts stay in their
+// regime. But a step in which a sliding contact comes to stick (a block stopping on a slope, a
+// tool stopping) defeats it whenever h mu fn / m is well above slip_velocity s0: from a
+// sliding iterate the linearised friction is the saturated force, unchanging along the slip,
+// so the update lands far on the other side of the narrow sticking band, and from there back;
+// Newton cycles. The secant through zero slip (|F| / s along the slip, "lagged diffusivity")
+// cannot overshoot so, but it creeps towards the band at a linear rate.
+//
+// So the exact tangent until a contact's slip turns back between two tangents of the step
+// (the cycle's signature); from then on the contact's tangent along its slip comes from the
+// one-dimensional problem it is part of, which the iterates reveal. The update that took it
+// from one iterate to the next balanced its rows with the friction of the linear model it was
+// given, F_prev - D (vrel - vrel_prev): the residual left at the new iterate (over h) is that
+// model's error, F_model - F. The update also shows how stiffly the rest of the system
+// answered along it: (J_rest dv) / h = -(residual_prev + D dv). With that stiffness mu_eff
+// (N s/m) the contact's own problem near the iterate is mu_eff (v - w) = F(v), the implicit
+// friction of a step of a body of mass h mu_eff (implicit_slip_speed), whose solution v* it
+// computes exactly; the tangent along the slip is set so that the update (slope mu_eff +
+// along) lands on v*. While mu_eff is not known (not positive, or fewer than two updates
+// seen), the secant through zero slip. A heuristic for a non-smooth problem, not a proof:
+// it converges in the inclined-plane tests of test_contact.c within the default 20 Newton
+// iterations (contacts landing, stopping and sliding at dt up to 10 ms), where the exact
+// tangent alone fails; with mu_s > mu_d (friction that weakens with speed: the problem is not
+// convex) a stopping step can take more, so raise newton_max_iterations there. A line search
+// on the step's incremental potential (which with the normal force lagged includes friction's
+// dissipation potential, friction_potential) would make it robust.
+
+void BodyContacts::record_friction_iterate(const ContactCandidate& c, const ContactPoint* point) const {
+    FrictionIterate& r = iterates_[static_cast<size_t>(&c - candidates_.data())];
+    if (!point || !(point->friction_normal > 0.0)) {
+        r.has_cur = r.has_prev = false;  // no friction here: the chain of updates breaks
+        return;
+    }
+    const double* u = point->relative_velocity;
+    auto same = [](const double* a, const double* b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; };
+    if (!r.has_start) {
+        for (int k = 0; k < 3; ++k) r.start_vrel[k] = u[k];
+        r.has_start = true;
+    } else if (same(u, r.start_vrel)) {  // the step starts again (retried, or after half steps)
+        r.has_cur = r.has_prev = r.has_tangent = r.reversed = false;
+        r.tangents = 0;
+    }
+    if (r.has_cur && same(u, r.cur.vrel)) return;  // the same iterate again
+    if (r.has_prev && same(u, r.prev.vrel)) {      // back to the iterate before (an update taken back)
+        r.cur = r.prev;
+        r.has_prev = false;
+        return;
+    }
+    // A new iterate, reached from the latest one by an update with the last tangent.
+    r.has_prev = r.has_cur;
+    if (r.has_cur) r.prev = r.cur;
+    r.has_cur = true;
+    FrictionIterate::Point& q = r.cur;
+    double slip[3];
+    const double vn = dot(u, point->normal);
+    for (int k = 0; k < 3; ++k) {
+        q.vrel[k] = u[k];
+        slip[k] = u[k] - vn * point->normal[k];
+    }
+    coulomb_friction(*c.params, point->friction_normal, slip, q.force);
+    q.has_residual = q.has_response = false;
+    q.response = 0.0;
+    if (!(r.has_prev && r.has_tangent)) return;
+    double dv[3], d_dv[3];  // the update, and the last tangent times it
+    for (int k = 0; k < 3; ++k) dv[k] = u[k] - r.prev.vrel[k];
+    for (int k = 0; k < 3; ++k) d_dv[k] = r.tangent[3 * k] * dv[0] + r.tangent[3 * k + 1] * dv[1] + r.tangent[3 * k + 2] * dv[2];
+    for (int k = 0; k < 3; ++k) q.residual[k] = r.prev.force[k] - d_dv[k] - q.force[k];
+    q.has_residual = true;
+    const double dv2 = dot(dv, dv);
+    if (r.prev.has_residual && dv2 > 0.0) {
+        double answer[3];
+        for (int k = 0; k < 3; ++k) answer[k] = -(r.prev.residual[k] + d_dv[k]);
+        q.response = dot(answer, dv) / dv2;
+        q.has_response = q.response > 0.0 && std::isfinite(q.response);
+    }
+}
+
+double BodyContacts::friction_chord(const ContactCandidate& c, const ContactPoint& p) const {
+    if (!(p.friction_normal > 0.0) || iterates_.size() != candidates_.size()) return -1.0;
+    FrictionIterate& r = iterates_[static_cast<size_t>(&c - candidates_.data())];
+    const sh_contact_params& params = *c.params;
+    const double s0 = params.slip_velocity;
+    const double vn = dot(p.relative_velocity, p.normal);
+    double slip[3], t[3];
+    for (int k = 0; k < 3; ++k) slip[k] = p.relative_velocity[k] - vn * p.normal[k];
+    const double speed = std::sqrt(dot(slip, slip));
+    for (int k = 0; k < 3; ++k) t[k] = speed > 0.0 ? slip[k] / speed : 0.0;
+    if (r.tangents > 0 && dot(r.last_slip, slip) < 0.0) r.reversed = true;
+    for (int k = 0; k < 3; ++k) r.last_slip[k] = slip[k];
+    ++r.tangents;
+
+    double chord = -1.0;
+    if (r.reversed && speed > s0) {
+        const double secant = friction_magnitude(params, p.friction_normal, speed) / speed;
+        chord = secant;
+        const FrictionIterate::Point& q = r.cur;
+        const bool here = r.has_cur && q.vrel[0] == p.relative_velocity[0] && q.vrel[1] == p.relative_velocity[1] &&
+                          q.vrel[2] == p.relative_velocity[2];
+        if (here && q.has_residual && q.has_response) {
+            // The contact's own problem: response (v - w) = F(v), on the tangent plane.
+            double w[3];
+            for (int k = 0; k < 3; ++k) w[k] = slip[k] - (q.residual[k] + q.force[k]) / q.response;
+            const double wn = dot(w, p.normal);
+            for (int k = 0; k < 3; ++k) w[k] -= wn * p.normal[k];
+            const double free_speed = std::sqrt(dot(w, w));
+            const double end_speed = implicit_slip_speed(params, p.friction_normal, free_speed, 1.0 / q.response);
+            const double target = free_speed > 0.0 ? dot(w, t) * end_speed / free_speed : 0.0;  // along t
+            if (target != speed) {
+                // The update solves (response + along) (target - speed) = -residual . t.
+                const double along = -dot(q.residual, t) / (target - speed) - q.response;
+                if (std::isfinite(along)) chord = std::min(std::max(along, 0.0), params.static_friction * p.friction_normal / s0);
+            }
+        }
+    }
+    const FrictionTangent ft = friction_tangent(params, p.friction_normal, speed, chord);
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+            const double plane = (a == b ? 1.0 : 0.0) - p.normal[a] * p.normal[b];
+            r.tangent[3 * a + b] = ft.across * (plane - t[a] * t[b]) + ft.along * t[a] * t[b];
+        }
+    r.has_tangent = true;
+    return chord;
+}
+
+template <class Visit>
+void BodyContacts::for_each_pair_candidate(const Body& other, const int32_t* own_index, Visit&& visit) const {
+    for (const ContactCandidate& c : candidates_)
+        if (c.kind == ContactCandidate::kNodeFace && c.other == &other && own_index[c.node] >= 0) visit(c);
+}
+
+void BodyContacts::add_coupling_pattern(const Body& other, const int32_t* own_index, const int32_t* other_index,
+                                        vec<int32_t>& pairs) const {
+    for_each_pair_candidate(other, own_index, [&](const ContactCandidate& c) {
+        for (int k = 0; k < 3; ++k)
+            if (other_index[c.face[k]] >= 0) {
+                pairs.push_back(own_index[c.node]);
+                pairs.push_back(other_index[c.face[k]]);
+            }
+    });
+}
+
+void BodyContacts::add_coupling_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
+                                        const int32_t* own_index, const Body& other, const int32_t* other_index,
+                                        SparseSystem& system) const {
+    // A body-pair contact is one term over its node and the face behind it: this body's node
+    // with gradient n and share 1, the other's face nodes with -w_k n and -w_k. Each body's
+    // add_tangent has the blocks among its own nodes; these are the ones across.
+    const ScopedTimer timer(evaluation_seconds_);
+    for_each_pair_candidate(other, own_index, [&](const ContactCandidate& c) {
+        ContactPoint p;
+        if (!contact(c, x, v, p)) return;
+        const PointTangent tangent(p, *c.params, stiffness_scale, damping_scale);
+        for (int k = 0; k < 3; ++k) {
+            const int32_t j = other_index[c.face[k]];
+            if (j < 0) continue;
+            double gradient[3], block[9];
+            for (int r = 0; r < 3; ++r) gradient[r] = p.other_weights[k] * p.normal[r];
+            tangent.block(p.gradient[0], p.weights[0], gradient, p.other_weights[k], block);
+            system.add_block(own_index[c.node], j, block, 1.0);
+        }
+    });
+}
+
 double BodyContacts::energy(const double* x) const {
     double e = 0.0;
-    evaluate(x, nullptr, [&](const ContactCandidate& c, const ContactPoint& p) { e += hunt_crossley_energy(*c.params, p.depth); });
+    evaluate(x, nullptr, [&](const ContactCandidate& c, const ContactPoint& p) {
+        const bool pair = c.kind == ContactCandidate::kNodeFace || c.kind == ContactCandidate::kFaceNode;
+        e += (pair ? 0.5 : 1.0) * p.law_scale * hunt_crossley_energy(*c.params, p.depth);
+    });
     return e;
 }
 
@@ -413,8 +905,9 @@ double BodyContacts::stable_step(const double* x, const double* v, const double*
     // by a share of 1 (its weights sum to 1) on each node it may touch.
     double step = INFINITY;
     evaluate_candidates(x, v, [&](const ContactCandidate& c, const ContactPoint* point) {
-        const bool face = c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kFaceNode;
-        const int count = point ? point->count : face ? 3 : 1;
+        const bool face = c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kFaceNode ||
+                          c.kind == ContactCandidate::kEdgeShape;
+        const int count = point ? point->count : c.kind == ContactCandidate::kEdgeShape ? 2 : face ? 3 : 1;
         const NormalForce fn = hunt_crossley(*c.params, (point ? point->depth : 0.0) + anticipated_depth, 0.0);
         double row = 0.0;
         for (int b = 0; point && b < count; ++b) row += std::sqrt(dot(point->gradient[b], point->gradient[b]));
@@ -432,7 +925,7 @@ int32_t BodyContacts::accumulate_reactions() {
     int32_t count = 0;
     evaluate(body_.x.data(), body_.v.data(), [&](const ContactCandidate& c, const ContactPoint& p) {
         if (c.kind == ContactCandidate::kFaceNode) return;
-        ++count;
+        if (p.depth > 0.0) ++count;
         if (!c.collider) return;
         sh_contact_state& s = c.collider->state;
         for (int a = 0; a < p.count; ++a) {
@@ -445,6 +938,7 @@ int32_t BodyContacts::accumulate_reactions() {
                 s.torque[k] += torque[k];
             }
         }
+        if (!(p.depth > 0.0)) return;  // friction kept through a step on a contact that came off
         ++s.contact_count;
         s.max_depth = std::max(s.max_depth, p.depth);
         if (c.kind == ContactCandidate::kNodeShape) s.penetration_volume += p.depth * node_area_[static_cast<size_t>(c.node)];

@@ -20,14 +20,22 @@ struct ContactCandidate {
         kNodeShape,  ///< own node inside a collider
         kFaceShape,  ///< a collider through own surface triangle (smaller than it)
         kNodeFace,   ///< own surface node inside another body, behind its triangle `face`
-        kFaceNode    ///< another body's node behind own triangle `face`
+        kFaceNode,   ///< another body's node behind own triangle `face`
+        kEdgeShape   ///< a collider through own convex surface edge (face[0], face[1]), between
+                     ///< own triangle `face` and the triangle across it, whose third node is
+                     ///< `node`
     };
     Kind kind;
-    int32_t node;     ///< kNodeShape, kNodeFace: own node; kFaceNode: the other body's node
-    int32_t face[3];  ///< kFaceShape, kFaceNode: own nodes; kNodeFace: the other body's nodes
+    int32_t node;     ///< kNodeShape, kNodeFace: own node; kFaceNode: the other body's node;
+                      ///< kEdgeShape: the third node of the triangle across the edge
+    int32_t face[3];  ///< kFaceShape, kFaceNode, kEdgeShape: own nodes; kNodeFace: the other
+                      ///< body's nodes
     Collider* collider;                ///< shape kinds
     const Body* other;                 ///< body-pair kinds
     const sh_contact_params* params;   ///< the contact law
+    /// Implicit bodies: the candidate's normal force at the start of the step (N, 0 if it did
+    /// not touch then), which its friction uses throughout the step (see finish_detection).
+    double friction_normal = 0.0;
 };
 
 /// One acting contact, as evaluate() reports it.
@@ -36,7 +44,7 @@ struct ContactPoint {
     double normal[3];        ///< unit direction of the push on the node side (node or face)
     double point[3];         ///< touching point (world)
     int32_t nodes[3];        ///< own nodes the contact acts on
-    int count;               ///< 1 or 3
+    int count;               ///< 1, 2 (kEdgeShape) or 3
     double weights[3];       ///< own nodes' shares of the node side's motion and friction (sign
                              ///< included: kFaceNode's own face is the far side)
     double gradient[3][3];   ///< per own node: -d depth / d x, its weight times the normal (the
@@ -45,6 +53,13 @@ struct ContactPoint {
     double stiffness;        ///< dFn/dx (N/m)
     double damping;          ///< dFn/dx' (N s/m)
     double friction;         ///< viscous coefficient of the friction (N s/m)
+    double normal_force;     ///< Hunt-Crossley normal force (N)
+    double friction_normal;  ///< normal force the friction is proportional to (N); 0: no friction
+    double relative_velocity[3]; ///< node side's velocity relative to the other side (m/s)
+    double law_scale;        ///< share of the contact law it carries: 1 but for an edge flatter
+                             ///< than kFullEdgeAngle (body_contacts.cpp)
+    double other_weights[3]; ///< kNodeFace: the other body's face nodes' shares (-w, the far
+                             ///< side); their gradients are these times the normal
 };
 
 /// The contact state of one body: surface, broad phase and candidates.
@@ -67,7 +82,9 @@ public:
     bool detect(Collider& collider, double reach);
 
     /// Adds to both a and b the candidates of a's surface nodes inside b's tets, each behind b's
-    /// nearest surface triangle. Both must be FEM bodies.
+    /// nearest surface triangle, and of those outside b within the two bodies' refit margins of
+    /// a triangle of b they are in front of (they may reach it in the step). Both must be FEM
+    /// bodies.
     static bool detect_pair(BodyContacts& a, BodyContacts& b, const sh_contact_params& params);
 
 
@@ -88,22 +105,47 @@ public:
     /// Anticipated extra depth (m) used by stable_step for contacts that deepen in the step.
     double anticipated_depth = 0.0;
 
-    /// For explicit bodies: 1 / the coming (sub)step (1/s). Friction's viscous coefficient is
-    /// capped at the touched mass times this, so that it can stop a sliding node within a
-    /// step but never reverse it (0: no cap, for implicit bodies).
-    double friction_rate_limit = 0.0;
+    /// Ends a detection pass (after every detect and detect_pair): an implicit body's
+    /// candidates record their normal force at the body's current state, the step's start,
+    /// for their friction (lagged normal force, see contact()). Returns this if there are
+    /// candidates, else null: the field to attach to the body.
+    BodyContacts* finish_detection();
 
     void add_forces(const double* x, const double* v, double* f) const override;
     void add_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
                      const int32_t* free_index, SparseSystem& system) const override;
+    /// Each body-pair contact counts half here and half in the other body's contacts.
     double energy(const double* x) const override;
+    /// The blocks between this body's node and the other body's face of each kNodeFace
+    /// candidate against other.
+    void add_coupling_pattern(const Body& other, const int32_t* own_index, const int32_t* other_index,
+                              vec<int32_t>& pairs) const override;
+    void add_coupling_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
+                              const int32_t* own_index, const Body& other, const int32_t* other_index,
+                              SparseSystem& system) const override;
     double stable_step(const double* x, const double* v, const double* mass) const override;
+    void begin_explicit_step() const override;
+    void end_explicit_step(double h, bool move_positions, double* x, double* v) const override;
 
 private:
     struct Group {
         int32_t begin, end;  ///< candidates [begin, end): node kinds first, then faces
     };
+    /// Candidate c at (x, v) (v null: at rest): true if it acts, with out filled: touching,
+    /// or an implicit body's friction kept through the step (lagged_friction).
     bool contact(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const;
+    /// contact() where the candidate touches at x.
+    bool touching(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const;
+    /// Implicit bodies: the friction of a candidate that touched at the step's start but not at
+    /// this iterate, at its start geometry (depth 0, no normal force).
+    bool lagged_friction(const ContactCandidate& c, const double* v, ContactPoint& out) const;
+    /// Implicit bodies, from add_forces: records candidate c's friction at a Newton iterate
+    /// (point null: not touching there) for friction_chord.
+    void record_friction_iterate(const ContactCandidate& c, const ContactPoint* point) const;
+    /// Implicit bodies, from add_tangent: the slope along the slip that candidate c's friction
+    /// tangent takes at point p instead of the exact one (-1: the exact one), and records the
+    /// tangent it then has. See the comment in body_contacts.cpp.
+    double friction_chord(const ContactCandidate& c, const ContactPoint& p) const;
     /// Calls emit(candidate, point) for every candidate at (x, v) (v null: at rest, without
     /// damping or friction), point null for one not in contact. Group by group, node contacts
     /// before the faces they share depth with.
@@ -113,13 +155,20 @@ private:
     template <class Emit>
     void evaluate(const double* x, const double* v, Emit&& emit) const;
     bool keep_deepest(Group& group, int32_t capacity);
+    /// Calls visit(candidate) for each kNodeFace candidate against other whose node has
+    /// own_index >= 0.
+    template <class Visit>
+    void for_each_pair_candidate(const Body& other, const int32_t* own_index, Visit&& visit) const;
     void ensure_tet_tree();
 
     const Body& body_;
     vec<int32_t> surface_nodes_;   ///< nodes on the surface
     vec<double> node_area_;        ///< per node: a third of its surface triangles' rest area (m^2)
+    vec<int32_t> edge_neighbor_;   ///< per surface triangle and edge k (nodes k, k + 1): the
+                                   ///< triangle across it, -1 if not exactly one
     vec<Aabb> boxes_;              ///< per surface primitive (triangle, or node for springs)
     AabbTree tree_;
+    double margin_ = 0.0;          ///< the last refit's margin (m)
     vec<Aabb> tet_boxes_;          ///< per tet, for other bodies' nodes (built on first use)
     AabbTree tet_tree_;
     vec<uint32_t> stamp_;          ///< per node: last detection pass that took it
@@ -129,6 +178,41 @@ private:
     mutable vec<double> node_depth_; ///< per node: its depth in the current group's collider
     vec<double> keys_;               ///< scratch for keep_deepest
     mutable double evaluation_seconds_ = 0.0;
+    /// Explicit bodies: a friction contact as the (sub)step's first add_forces found it, for
+    /// end_explicit_step.
+    struct FrictionRecord {
+        int32_t nodes[3];
+        double weights[3];
+        int count;
+        double normal[3];
+        double offset[3];      ///< sum of weights[a] v[a] minus the relative velocity (m/s)
+        double normal_force;   ///< N
+        const sh_contact_params* params;
+    };
+    mutable vec<FrictionRecord> friction_records_;
+    mutable bool recording_ = false;  ///< the next add_forces records the friction contacts
+    /// Implicit bodies with friction: per candidate, its geometry at the step's start and its
+    /// friction over the step's Newton iterates (see friction_chord). Residual and response
+    /// are per unit step: the row of the Newton residual over h (N) and the rest of the
+    /// system's stiffness along the last update over h (N s/m).
+    struct FrictionIterate {
+        struct Point {
+            double vrel[3];      ///< relative velocity (m/s)
+            double force[3];     ///< friction (N)
+            double residual[3];  ///< the contact's residual row: its linear model's friction error
+            double response;     ///< the rest of the system's stiffness along the last update
+            bool has_residual, has_response;
+        };
+        double lag_normal[3], lag_point[3];  ///< at the step's start
+        double lag_face[3];    ///< the face's barycentric weights then (face kinds)
+        Point cur, prev;       ///< the latest iterate and the one before
+        double start_vrel[3];  ///< the step's first iterate (a retried step returns to it)
+        double tangent[9];     ///< -dF/dvrel the last add_tangent gave
+        double last_slip[3];   ///< slip at the last add_tangent
+        int tangents;          ///< add_tangent calls at this contact in the step
+        bool has_start, has_cur, has_prev, has_tangent, reversed;
+    };
+    mutable vec<FrictionIterate> iterates_;
 };
 
 }  // namespace sh

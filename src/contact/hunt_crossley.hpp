@@ -4,6 +4,7 @@
 
 #include <softhap/softhap.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace sh {
@@ -36,18 +37,78 @@ inline double hunt_crossley_energy(const sh_contact_params& p, double x) {
     return p.stiffness * std::pow(x, p.exponent + 1.0) / (p.exponent + 1.0);
 }
 
-/// Friction on a point sliding at tangential velocity vt (relative to the collider, m/s) under
-/// normal force fn (N): below slip_velocity s0 it is viscous, -mu_s fn vt / s0 (sticking, at
-/// most mu_s fn); above, its magnitude falls from mu_s fn at s0 towards mu_d fn as
-/// (mu_d + (mu_s - mu_d) s0 / |vt|) fn, against vt. Writes the force into out and returns the
-/// viscous coefficient |F| / max(|vt|, s0) (N s/m) that the implicit tangent uses.
+/// Magnitude (N) of the regularised Coulomb friction at tangential speed s >= 0 (m/s) under
+/// normal force fn (N): below the slip velocity s0 it is viscous, mu_s fn s / s0 (sticking, at
+/// most mu_s fn); above, it falls from mu_s fn at s0 towards mu_d fn as
+/// (mu_d + (mu_s - mu_d) s0 / s) fn. Continuous at s0.
+inline double friction_magnitude(const sh_contact_params& p, double fn, double s) {
+    const double s0 = p.slip_velocity;
+    if (s <= s0) return p.static_friction * fn * s / s0;
+    return (p.dynamic_friction + (p.static_friction - p.dynamic_friction) * s0 / s) * fn;
+}
+
+/// Friction on a point sliding at tangential velocity vt (relative to the other side, m/s)
+/// under normal force fn (N): friction_magnitude against vt. Writes the force into out and
+/// returns the viscous coefficient |F| / |vt| (N s/m; mu_s fn / s0 while sticking).
 inline double coulomb_friction(const sh_contact_params& p, double fn, const double vt[3], double out[3]) {
     const double speed = std::sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
-    const double s0 = p.slip_velocity;
-    const double mu = speed <= s0 ? p.static_friction : p.dynamic_friction + (p.static_friction - p.dynamic_friction) * s0 / speed;
-    const double coefficient = mu * fn / (speed <= s0 ? s0 : speed);
+    const double coefficient =
+        speed <= p.slip_velocity ? p.static_friction * fn / p.slip_velocity : friction_magnitude(p, fn, speed) / speed;
     for (int k = 0; k < 3; ++k) out[k] = -coefficient * vt[k];
     return coefficient;
+}
+
+/// D = -dF/dvt of coulomb_friction at tangential speed s (m/s) under a normal force fn (N)
+/// held fixed, on the tangent plane, as across (I - t t^T) + along t t^T with t = vt / s:
+/// sticking (s <= s0) it is mu_s fn / s0 in every tangent direction; sliding, the force turns
+/// with vt (across = |F| / s) and its magnitude changes along t by d|F|/ds =
+/// -(mu_s - mu_d) fn s0 / s^2 <= 0 (friction weakens as the slip speeds up), a negative part
+/// that is dropped (along = 0) to keep D positive semi-definite. chord >= 0 replaces along
+/// while sliding (see BodyContacts::friction_chord).
+struct FrictionTangent {
+    double across = 0.0;  ///< N s/m
+    double along = 0.0;   ///< N s/m
+};
+
+inline FrictionTangent friction_tangent(const sh_contact_params& p, double fn, double s, double chord = -1.0) {
+    FrictionTangent out;
+    if (!(fn > 0.0)) return out;
+    if (s <= p.slip_velocity) {
+        out.across = out.along = p.static_friction * fn / p.slip_velocity;
+    } else {
+        out.across = friction_magnitude(p, fn, s) / s;
+        out.along = chord >= 0.0 ? chord : 0.0;
+    }
+    return out;
+}
+
+/// Dissipation potential (W) of the friction at tangential speed s (m/s) under a normal force
+/// fn (N) held fixed: the integral of friction_magnitude from 0 to s, whose gradient in vt is
+/// -F. With the normal force lagged, an implicit step's friction is its gradient: a line
+/// search on the step's incremental potential would add h times it.
+inline double friction_potential(const sh_contact_params& p, double fn, double s) {
+    const double s0 = p.slip_velocity;
+    if (s <= s0) return 0.5 * p.static_friction * fn * s * s / s0;
+    return 0.5 * p.static_friction * fn * s0 + p.dynamic_friction * fn * (s - s0) +
+           (p.static_friction - p.dynamic_friction) * fn * s0 * std::log(s / s0);
+}
+
+/// Tangential speed (m/s) at the end of an explicit step of length h (s) in which the friction
+/// acts implicitly (backward Euler) on a contact whose tangential speed would be s_free without
+/// it: the s >= 0 with s + wh friction_magnitude(s) = s_free, wh = h times the contact's
+/// effective inverse mass (s/kg). Sticking, s = s_free / (1 + wh mu_s fn / s0) when that is at
+/// most s0; otherwise the sliding root, which is then unique (above s0) even where the slip
+/// branch weakens (mu_s > mu_d). Stable for any h: the speed never grows nor reverses.
+inline double implicit_slip_speed(const sh_contact_params& p, double fn, double s_free, double wh) {
+    const double s0 = p.slip_velocity;
+    const double stick = s_free / (1.0 + wh * p.static_friction * fn / s0);
+    if (stick <= s0) return stick;
+    // s^2 - b s + a0 = 0 with b = s_free - wh mu_d fn, a0 = wh (mu_s - mu_d) fn s0; it is
+    // negative at s0 here, so its larger root is the one above s0.
+    const double b = s_free - wh * p.dynamic_friction * fn;
+    const double a0 = wh * (p.static_friction - p.dynamic_friction) * fn * s0;
+    const double root = std::sqrt(std::max(0.0, b * b - 4.0 * a0));
+    return std::max(s0, 0.5 * (b + root));
 }
 
 /// Largest symplectic-Euler step stable for a mass m (kg) on a spring k (N/m) with a dashpot c

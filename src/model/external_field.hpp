@@ -2,10 +2,13 @@
 // solver see them: a force at any state, its tangent, its potential and its stability limit.
 #pragma once
 
+#include "core/memory.hpp"
+
 #include <cstdint>
 
 namespace sh {
 
+class Body;
 class SparseSystem;
 
 /// Forces a body feels from outside its own elements, evaluated at any state the integrators
@@ -23,12 +26,47 @@ public:
     virtual void add_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
                              const int32_t* free_index, SparseSystem& system) const = 0;
 
-    /// Potential energy of the field's conservative part at x (J).
+    /// Potential energy of the field's conservative part at x (J). An interaction with another
+    /// body counts half here and half in that body's field, so the fields of bodies solved
+    /// together sum to their joint potential.
     virtual double energy(const double* x) const = 0;
 
     /// Largest explicit step (s) that stays stable under the field at (x, v) for nodes of
     /// these masses (kg); INFINITY when the field adds no stiffness.
     virtual double stable_step(const double* x, const double* v, const double* mass) const = 0;
+
+    /// Explicit integrators: called before each (sub)step; its first add_forces is at the
+    /// (sub)step's start state. Nothing by default.
+    virtual void begin_explicit_step() const {}
+
+    /// Explicit integrators: called after a (sub)step of length h (s) took the body to x, v.
+    /// Applies what the field leaves out of add_forces for explicit bodies (contact friction,
+    /// taken implicitly on the new velocities); move_positions: each velocity change also
+    /// moves its node by h times it (the step's positions used its end velocities). Nothing
+    /// by default.
+    virtual void end_explicit_step(double h, bool move_positions, double* x, double* v) const {
+        (void)h, (void)move_positions, (void)x, (void)v;
+    }
+
+    /// For bodies solved together (CoupledSystem): appends to pairs, as (own_index[i],
+    /// other_index[j]), every pair of this body's node i and other's node j that an interaction
+    /// this field holds links, both indices >= 0 (each interaction is held by one of the two
+    /// bodies' fields). None by default.
+    virtual void add_coupling_pattern(const Body& other, const int32_t* own_index, const int32_t* other_index,
+                                      vec<int32_t>& pairs) const {
+        (void)other, (void)own_index, (void)other_index, (void)pairs;
+    }
+
+    /// For bodies solved together: adds the blocks stiffness_scale * K + damping_scale * D
+    /// between this body's nodes (rows own_index) and other's (columns other_index) of the
+    /// interactions add_coupling_pattern reports, at this body's (x, v) and other's current
+    /// state (v null: at rest). Their transposes come with them (the system is symmetric).
+    virtual void add_coupling_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
+                                      const int32_t* own_index, const Body& other, const int32_t* other_index,
+                                      SparseSystem& system) const {
+        (void)x, (void)v, (void)stiffness_scale, (void)damping_scale, (void)own_index, (void)other, (void)other_index,
+            (void)system;
+    }
 };
 
 }  // namespace sh

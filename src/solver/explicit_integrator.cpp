@@ -279,12 +279,16 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
         double* f = w.a[0].data();
         std::fill(f, f + body.x.size(), 0.0);
         body.add_internal_forces(body.x.data(), body.v.data(), f);
-        if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
+        if (body.field) {
+            body.field->begin_explicit_step();
+            body.field->add_forces(body.x.data(), body.v.data(), f);
+        }
         const bool per_node = !body.node_damping.empty();
         const bool symplectic = integrator == SH_INTEGRATOR_SYMPLECTIC_EULER;
         const size_t n = body.mass.size();
         const bool sane = symplectic ? (per_node ? EulerPass<true, true>(body, dt, g).run(n) : EulerPass<true, false>(body, dt, g).run(n))
                                      : (per_node ? EulerPass<false, true>(body, dt, g).run(n) : EulerPass<false, false>(body, dt, g).run(n));
+        if (sane && body.field) body.field->end_explicit_step(dt, symplectic, body.x.data(), body.v.data());
         for_each_kinematic(body.kinematic, [&](size_t i) {
             for (int k = 0; k < 3; ++k) {
                 const size_t j = 3 * i + k;
@@ -300,7 +304,15 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
     begin_kinematic_motion(body, dt);
 
     const double h = dt / substeps;
-    for (int32_t s = 0; s < result.substeps; ++s) integrate(body, h, g);
+    // Friction's velocity change also moves the nodes by h times it, as if it acted through the
+    // sub-step (symplectic Euler's positions take the end velocities; for RK methods it is a
+    // first-order splitting); forward Euler's positions take the start velocities.
+    const bool move_positions = integrator != SH_INTEGRATOR_FORWARD_EULER;
+    for (int32_t s = 0; s < result.substeps; ++s) {
+        if (body.field) body.field->begin_explicit_step();
+        integrate(body, h, g);
+        if (body.field) body.field->end_explicit_step(h, move_positions, body.x.data(), body.v.data());
+    }
 
     end_kinematic_motion(body);
 

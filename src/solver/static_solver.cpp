@@ -2,7 +2,7 @@
 
 #include "core/error.hpp"
 #include "model/external_field.hpp"
-#include "solver/implicit_integrator.hpp"
+#include "solver/newton_group.hpp"
 #include "solver/step_support.hpp"
 
 #include <algorithm>
@@ -11,89 +11,132 @@
 namespace sh {
 namespace {
 
-// Out-of-balance force f(x) + load_factor * (f_ext + m g) on the free DOFs, and its norm.
-double out_of_balance(const Body& body, const ImplicitState& state, const double g[3], double load_factor,
-                      vec<double>& force_scratch, vec<double>& out) {
-    std::fill(force_scratch.begin(), force_scratch.end(), 0.0);
-    body.add_internal_forces(body.x.data(), nullptr, force_scratch.data());
-    if (body.field) body.field->add_forces(body.x.data(), nullptr, force_scratch.data());
-    const vec<int32_t>& global = state.system.dof_to_global();
-    double s = 0.0;
-    for (size_t d = 0; d < out.size(); ++d) {
-        const size_t j = static_cast<size_t>(global[d]);
-        out[d] = force_scratch[j] + load_factor * body.applied_load(j, g);
-        s += out[d] * out[d];
+bool is_anchored(const Body& body) {
+    for (const uint8_t k : body.kinematic)
+        if (k) return true;
+    return false;
+}
+
+// A body without fixed nodes, held by its contacts with others, gets the diagonal of its
+// elastic tangent times this fraction times the relative residual (at most 1) added to its
+// tangent, a pseudo-transient continuation: the matrix stays positive definite along what
+// nothing holds (contacts not acting yet, sliding along frictionless contact); a step there is
+// at most the body's elastic deflection under the residual over the shift, which the line
+// search (30 halvings) can bring back even against contacts far stiffer than the body; and as
+// the residual falls the shift fades and Newton's convergence returns. On a cube resting on a
+// smaller block (as in tests/test_body_pairs.c), 1e-4 to 1e-2 took 8 to 10 iterations from a
+// gap, a touch or an overlap; 1e-6 could not leave a start touching at zero depth, 1e-1 took
+// 24 to 29.
+constexpr double kFloatingShift = 1e-3;
+
+// K of a body at rest into its own system, with the shift above if the body has no fixed node;
+// its force round-off.
+double assemble_static_tangent(Body& body, ImplicitState& state, double shift) {
+    const bool floating = !is_anchored(body);
+    if (floating) {  // the shift scales with the body's own stiffness, not its contacts'
+        const SparseSystem& k = state.system;
+        state.system.clear_values();
+        body.add_tangent(body.x.data(), 1.0, 0.0, state.system);
+        for (int32_t d = 0; d < k.dof_count(); ++d)
+            state.diagonal[static_cast<size_t>(d)] = shift * k.values()[static_cast<size_t>(k.diagonal_slot(d))];
     }
+    return assemble_body_tangent(body, state, 1.0, 0.0, nullptr, floating ? state.diagonal.data() : nullptr, 1.0);
+}
+
+// Out-of-balance force f(x) + load_factor * (f_ext + m g) on the free DOFs into out, and its
+// norm. Each body's workspace.a[0] is scratch.
+double out_of_balance(const NewtonGroup& group, const double g[3], double load_factor, vec<double>& out) {
+    group.each([&](Body& body, ImplicitState& state, size_t offset) {
+        vec<double>& force = body.workspace.a[0];
+        std::fill(force.begin(), force.end(), 0.0);
+        body.add_internal_forces(body.x.data(), nullptr, force.data());
+        if (body.field) body.field->add_forces(body.x.data(), nullptr, force.data());
+        const vec<int32_t>& global = state.system.dof_to_global();
+        for (size_t d = 0; d < global.size(); ++d) {
+            const size_t j = static_cast<size_t>(global[d]);
+            out[offset + d] = force[j] + load_factor * body.applied_load(j, g);
+        }
+    });
+    double s = 0.0;
+    for (const double f : out) s += f * f;
     return std::sqrt(s);
 }
 
-// Potential energy: elastic energy minus the work of the applied loads.
-double potential(const Body& body, const ImplicitState& state, const double g[3], double load_factor) {
-    double work = 0.0;
-    for (const int32_t j : state.system.dof_to_global()) {
-        const size_t k = static_cast<size_t>(j);
-        work += body.applied_load(k, g) * body.x[k];
-    }
-    const double field = body.field ? body.field->energy(body.x.data()) : 0.0;
-    return body.elastic_energy(body.x.data()) + field - load_factor * work;
+// Potential energy: elastic energy and the fields' potential minus the work of the applied
+// loads.
+double potential(const NewtonGroup& group, const double g[3], double load_factor) {
+    double total = 0.0;
+    group.each([&](const Body& body, const ImplicitState& state, size_t) {
+        double work = 0.0;
+        for (const int32_t j : state.system.dof_to_global()) {
+            const size_t k = static_cast<size_t>(j);
+            work += body.applied_load(k, g) * body.x[k];
+        }
+        const double field = body.field ? body.field->energy(body.x.data()) : 0.0;
+        total += body.elastic_energy(body.x.data()) + field - load_factor * work;
+    });
+    return total;
 }
 
-}  // namespace
+// Newton-Raphson with line search for the group's bodies, their states prepared.
+void solve_group(const NewtonGroup& group, const double g[3], const sh_static_def& def, sh_static_report& report) {
+    NewtonSystem& ns = group.newton;
+    group.each([](Body& body, ImplicitState&, size_t) {
+        end_kinematic_motion(body);  // fixed and prescribed nodes on their targets
+        std::fill(body.v.begin(), body.v.end(), 0.0);
+    });
+    if (ns.system.dof_count() == 0) return;
 
-void solve_static_body(Body& body, const double g[3], const sh_static_def& def, sh_static_report& report) {
-    bool anchored = false;
-    for (const uint8_t k : body.kinematic) anchored |= k != 0;
-    require(anchored, SH_ERR_SOLVER,
-            "a body has no fixed or prescribed node: it can float freely, so its stiffness is singular and it has "
-            "no static equilibrium (fix or prescribe nodes first)");
-    ImplicitState state;
-    sh_implicit_settings solver{};
-    solver.linear_solver = def.linear_solver;
-    solver.cg_tolerance = std::max(1e-3 * def.tolerance, 1e-15);  // well below the Newton tolerance
-    solver.cg_max_iterations = 20000;
-    const int32_t dofs = prepare_implicit_state(body, state, solver);
-    end_kinematic_motion(body);  // fixed and prescribed nodes on their targets
-    std::fill(body.v.begin(), body.v.end(), 0.0);
-    if (dofs == 0) return;
-
-    vec<double> scratch(body.x.size()), residual(static_cast<size_t>(dofs)), step(static_cast<size_t>(dofs), 0.0);
-    vec<double> saved(body.x.size());
-    const vec<int32_t>& global = state.system.dof_to_global();
+    vec<double>& residual = ns.residual;
+    vec<double>& step = ns.delta;
     // Scale of the residual: the full applied load, or 1 N if nothing is applied.
     double load_norm = 0.0;
-    for (const int32_t j : global) {
-        const size_t k = static_cast<size_t>(j);
-        const double load = body.applied_load(k, g);
-        load_norm += load * load;
-    }
+    group.each([&](const Body& body, const ImplicitState& state, size_t) {
+        for (const int32_t j : state.system.dof_to_global()) {
+            const double load = body.applied_load(static_cast<size_t>(j), g);
+            load_norm += load * load;
+        }
+    });
     load_norm = load_norm > 0.0 ? std::sqrt(load_norm) : 1.0;
 
     for (int32_t load_step = 1; load_step <= def.load_steps; ++load_step) {
         const double factor = static_cast<double>(load_step) / def.load_steps;
-        double r = out_of_balance(body, state, g, factor, scratch, residual) / load_norm;
+        double r = out_of_balance(group, g, factor, residual) / load_norm;
         bool converged = r <= def.tolerance;
         double floor = 0.0;
         for (int32_t iteration = 0; iteration < def.max_iterations && !converged; ++iteration) {
-            state.system.clear_values();
-            body.add_tangent(body.x.data(), 1.0, 0.0, state.system);
-            if (body.field) body.field->add_tangent(body.x.data(), nullptr, 1.0, 0.0, state.free_index.data(), state.system);
+            const auto assemble_member = [&](Body& body, ImplicitState& state) {
+                return assemble_static_tangent(body, state, kFloatingShift * std::min(r, 1.0));
+            };
             // Below the round-off of the internal forces the residual cannot fall further.
-            floor = std::max(floor, force_roundoff(state.system, body.x, 1.0) / load_norm);
-            state.solver->factorize(state.system);
-            state.solver->solve(state.system, residual.data(), step.data());
+            floor = std::max(floor, group.assemble(assemble_member, 1.0, 0.0, true) / load_norm);
+            ns.solver->factorize(ns.system);
+            ns.solver->solve(ns.system, residual.data(), step.data());
             double slope = 0.0;  // d potential / d alpha at alpha = 0
             for (size_t d = 0; d < residual.size(); ++d) slope -= residual[d] * step[d];
-            const double energy0 = potential(body, state, g, factor), r0 = r;
-            std::copy(body.x.begin(), body.x.end(), saved.begin());
+            const double energy0 = potential(group, g, factor), r0 = r;
+            group.each([](Body& body, ImplicitState&, size_t) {
+                std::copy(body.x.begin(), body.x.end(), body.workspace.xs.begin());
+            });
             double alpha = 1.0;
-            for (int trial = 0; trial < 30; ++trial, alpha *= 0.5) {
-                for (size_t d = 0; d < step.size(); ++d) {
-                    const size_t j = static_cast<size_t>(global[d]);
-                    body.x[j] = saved[j] + alpha * step[d];
-                }
-                r = out_of_balance(body, state, g, factor, scratch, residual) / load_norm;
-                const double energy = potential(body, state, g, factor);
-                if ((std::isfinite(energy) && energy <= energy0 + 1e-4 * alpha * slope) || r < r0) break;
+            bool accepted = false;
+            for (int trial = 0; trial < 30 && !accepted; ++trial, alpha *= 0.5) {
+                group.each([&](Body& body, ImplicitState& state, size_t offset) {
+                    const vec<int32_t>& global = state.system.dof_to_global();
+                    for (size_t d = 0; d < global.size(); ++d) {
+                        const size_t j = static_cast<size_t>(global[d]);
+                        body.x[j] = body.workspace.xs[j] + alpha * step[offset + d];
+                    }
+                });
+                r = out_of_balance(group, g, factor, residual) / load_norm;
+                const double energy = potential(group, g, factor);
+                accepted = (std::isfinite(energy) && energy <= energy0 + 1e-4 * alpha * slope) || r < r0;
+            }
+            if (!accepted) {  // no step helped: stay where the iteration was
+                group.each([](Body& body, ImplicitState&, size_t) {
+                    std::copy(body.workspace.xs.begin(), body.workspace.xs.end(), body.x.begin());
+                });
+                r = out_of_balance(group, g, factor, residual) / load_norm;
             }
             ++report.iterations;
             if (report.history_count < SH_STATIC_HISTORY) report.residual_history[report.history_count++] = r;
@@ -107,6 +150,38 @@ void solve_static_body(Body& body, const double g[3], const sh_static_def& def, 
                                r, def.max_iterations, load_step, def.load_steps, def.tolerance));
     }
     report.load_steps = std::max(report.load_steps, def.load_steps);
+}
+
+// The linear solver of a static solve.
+sh_implicit_settings static_solver_settings(const sh_static_def& def) {
+    sh_implicit_settings solver{};
+    solver.linear_solver = def.linear_solver;
+    solver.cg_tolerance = std::max(1e-3 * def.tolerance, 1e-15);  // well below the Newton tolerance
+    solver.cg_max_iterations = 20000;
+    return solver;
+}
+
+}  // namespace
+
+void solve_static_body(Body& body, const double g[3], const sh_static_def& def, sh_static_report& report) {
+    require(is_anchored(body), SH_ERR_SOLVER,
+            "a body has no fixed or prescribed node: it can float freely, so its stiffness is singular and it has "
+            "no static equilibrium (fix or prescribe nodes first)");
+    ImplicitState state;
+    prepare_implicit_state(body, state, static_solver_settings(def));
+    solve_group(NewtonGroup::alone(body, state), g, def, report);
+}
+
+void solve_static_coupled(CoupledSystem& system, Body* const* bodies, ImplicitState* const* states, int32_t count,
+                          const double g[3], const sh_static_def& def, sh_static_report& report) {
+    bool anchored = false;
+    for (int32_t m = 0; m < count; ++m) anchored |= is_anchored(*bodies[m]);
+    require(anchored, SH_ERR_SOLVER,
+            "bodies in contact with each other have no fixed or prescribed node among them: they can float "
+            "freely, so their stiffness is singular and they have no static equilibrium (fix or prescribe nodes "
+            "of one of them first)");
+    system.prepare(bodies, states, count, static_solver_settings(def));
+    solve_group(NewtonGroup::together(system), g, def, report);
 }
 
 }  // namespace sh

@@ -1,5 +1,6 @@
-// Static equilibrium of a body: Newton-Raphson K(x) dx = f_ext + f(x) with backtracking line
-// search on the potential energy and optional load stepping.
+// Static equilibrium of a body, or of bodies coupled by contact: Newton-Raphson
+// K(x) dx = f_ext + f(x) with backtracking line search on the potential energy and optional load
+// stepping.
 #pragma once
 
 #include "model/body.hpp"
@@ -8,10 +9,21 @@
 
 namespace sh {
 
+class CoupledSystem;
+struct ImplicitState;
+
 /// Moves body to equilibrium under gravity and its external forces, its fixed and prescribed
 /// nodes on their targets, velocities zeroed. Appends to report (iterations, history, residual).
 /// Throws SH_ERR_SOLVER (singular or indefinite K) or SH_ERR_NOT_CONVERGED; the caller restores
 /// the body (its start state is saved in the workspace).
 void solve_static_body(Body& body, const double gravity[3], const sh_static_def& def, sh_static_report& report);
+
+/// solve_static_body for bodies[0..count) (with fresh implicit states) coupled through system:
+/// one Newton loop on their joint out-of-balance force and potential. At least one of them must
+/// have a fixed or prescribed node; one without any is held by its contacts with the others,
+/// and the directions they leave free (sliding along frictionless contact) are held by a tiny
+/// shift of its tangent's diagonal, so that the solve ends at the equilibrium nearest its start.
+void solve_static_coupled(CoupledSystem& system, Body* const* bodies, ImplicitState* const* states, int32_t count,
+                          const double gravity[3], const sh_static_def& def, sh_static_report& report);
 
 }  // namespace sh

@@ -1,5 +1,5 @@
 // One body's step with its own integrator: the dispatch World::step and the step-doubling
-// estimate share.
+// estimate share, and how a step's figures go into the step report.
 #pragma once
 
 #include "model/body.hpp"
@@ -12,5 +12,9 @@ struct ImplicitState;
 /// Advances body by dt with its integrator. implicit is the body's implicit solver state,
 /// created here on the first implicit step (and kept by the caller).
 BodyStepResult step_body(Body& body, ImplicitState*& implicit, double dt, const double gravity[3]);
+
+/// Adds the figures of one solve (a body's step, or an island's) to r: critical step,
+/// sub-steps, Newton and linear-solver counts and times, the sub-stepping warning.
+void add_step_figures(sh_step_report& r, const BodyStepResult& result);
 
 }  // namespace sh

@@ -12,30 +12,31 @@ StepDoubling::StepDoubling(size_t values) : start_x(values), start_v(values), st
 
 StepDoubling::~StepDoubling() { sh::destroy(implicit); }
 
-bool take_half_steps(Body& body, StepDoubling& scratch, double dt, const double gravity[3]) {
+void begin_half_steps(Body& body, StepDoubling& scratch) {
     std::copy(body.x.begin(), body.x.end(), scratch.start_x.begin());
     std::copy(body.v.begin(), body.v.end(), scratch.start_v.begin());
     std::copy(body.target.begin(), body.target.end(), scratch.start_target.begin());
     for (size_t i = 0; i < body.kinematic.size(); ++i)
         if (body.kinematic[i])
             for (size_t k = 3 * i; k < 3 * i + 3; ++k) body.target[k] = 0.5 * (body.x[k] + body.target[k]);
-    auto put_back = [&] {
-        std::copy(scratch.start_target.begin(), scratch.start_target.end(), body.target.begin());
-        std::copy(scratch.start_x.begin(), scratch.start_x.end(), body.x.begin());
-        std::copy(scratch.start_v.begin(), scratch.start_v.end(), body.v.begin());
-    };
-    bool stable;
-    try {
-        stable = step_body(body, scratch.implicit, 0.5 * dt, gravity).stable;
-        std::copy(scratch.start_target.begin(), scratch.start_target.end(), body.target.begin());
-        if (stable) stable = step_body(body, scratch.implicit, 0.5 * dt, gravity).stable;
-    } catch (...) {  // e.g. out of memory building the half steps' solver: the body as it was
-        put_back();
-        throw;
-    }
-    std::copy(body.x.begin(), body.x.end(), scratch.half_x.begin());
-    put_back();
-    return stable;
+}
+
+void restore_targets(Body& body, const StepDoubling& scratch) {
+    std::copy(scratch.start_target.begin(), scratch.start_target.end(), body.target.begin());
+}
+
+void end_half_steps(Body& body, StepDoubling& scratch, bool keep_positions) {
+    if (keep_positions) std::copy(body.x.begin(), body.x.end(), scratch.half_x.begin());
+    restore_targets(body, scratch);
+    std::copy(scratch.start_x.begin(), scratch.start_x.end(), body.x.begin());
+    std::copy(scratch.start_v.begin(), scratch.start_v.end(), body.v.begin());
+}
+
+bool take_half_steps(Body& body, StepDoubling& scratch, double dt, const double gravity[3]) {
+    Body* bodies[1] = {&body};
+    StepDoubling* scratches[1] = {&scratch};
+    return take_half_steps_together(bodies, scratches, 1, dt,
+                                    [&](double h) { return step_body(body, scratch.implicit, h, gravity).stable; });
 }
 
 double largest_half_step_difference(const Body& body, const StepDoubling& scratch) {

@@ -5,6 +5,8 @@
 #include "core/memory.hpp"
 #include "model/body.hpp"
 
+#include <cstdint>
+
 namespace sh {
 
 struct ImplicitState;
@@ -21,9 +23,37 @@ struct StepDoubling {
     StepDoubling& operator=(const StepDoubling&) = delete;
 };
 
-/// Takes body over dt in two half steps (kinematic nodes reach the midpoint of their motion
-/// after the first), keeps the positions in scratch.half_x and puts body back as it was.
-/// Returns false if a half step was not stable.
+/// Saves body's start state in scratch and moves its kinematic nodes' targets to the midpoint
+/// of their motion (where the first half step takes them).
+void begin_half_steps(Body& body, StepDoubling& scratch);
+
+/// Gives body its own kinematic targets back, for the second half step.
+void restore_targets(Body& body, const StepDoubling& scratch);
+
+/// Keeps body's positions in scratch.half_x (keep_positions) and puts it back as
+/// begin_half_steps found it.
+void end_half_steps(Body& body, StepDoubling& scratch, bool keep_positions);
+
+/// Takes bodies[0..count) over dt in two half steps of step(h), which advances all of them by h
+/// and returns whether that was stable; keeps their positions in their scratch.half_x and puts
+/// them back as they were. Returns false if a half step was not stable.
+template <class Step>
+bool take_half_steps_together(Body* const* bodies, StepDoubling* const* scratch, int32_t count, double dt, Step&& step) {
+    for (int32_t m = 0; m < count; ++m) begin_half_steps(*bodies[m], *scratch[m]);
+    bool stable;
+    try {
+        stable = step(0.5 * dt);
+        for (int32_t m = 0; m < count; ++m) restore_targets(*bodies[m], *scratch[m]);
+        if (stable) stable = step(0.5 * dt);
+    } catch (...) {  // e.g. out of memory building the half steps' solver: the bodies as they were
+        for (int32_t m = 0; m < count; ++m) end_half_steps(*bodies[m], *scratch[m], false);
+        throw;
+    }
+    for (int32_t m = 0; m < count; ++m) end_half_steps(*bodies[m], *scratch[m], true);
+    return stable;
+}
+
+/// take_half_steps_together for one body with its own integrator (and scratch.implicit).
 bool take_half_steps(Body& body, StepDoubling& scratch, double dt, const double gravity[3]);
 
 /// Largest distance between a node of body and its position in scratch.half_x (m).

@@ -11,6 +11,7 @@
 #include "solver/static_solver.hpp"
 #include "solver/step_support.hpp"
 #include "world/body_step.hpp"
+#include "world/contact_islands.hpp"
 #include "world/step_doubling.hpp"
 
 #include <algorithm>
@@ -47,6 +48,7 @@ World::~World() {
     for (HapticContext* haptic : haptics_) haptic->detach();
     for (Slot& slot : slots_) destroy_slot(slot);
     for (ColliderSlot& c : colliders_) sh::destroy(c.collider);
+    sh::destroy(islands_);
 }
 
 void World::destroy_slot(Slot& slot) {
@@ -188,9 +190,12 @@ void World::remove_haptic(HapticContext* haptic) {
 }
 
 void World::step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed) {
+    // Implicit bodies pressing on each other are stepped together, island by island.
+    const bool coupled = group_islands(true, failed);
     for (size_t index = 0; index < slots_.size(); ++index) {
         Slot& slot = slots_[index];
         if (!slot.body || (failed && (*failed)[index])) continue;
+        if (coupled && islands_->island_of(index) >= 0) continue;
         bool half_steps_stable = false;
         if (slot.doubling) {
             const ScopedTimer timer(r.error_estimate_seconds);
@@ -204,26 +209,39 @@ void World::step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8
             else
                 r.error_estimate = -1.0;
         }
-        r.dt_critical = std::min(r.dt_critical, result.dt_critical);
-        r.substeps = std::max(r.substeps, result.substeps);
-        r.newton_iterations = std::max(r.newton_iterations, result.newton_iterations);
-        r.linear_iterations += result.linear_iterations;
-        r.newton_residual = std::max(r.newton_residual, result.newton_residual);
-        r.factorize_seconds += result.factorize_seconds;
-        r.solve_seconds += result.solve_seconds;
-        r.factorizations += result.factorizations;
-        if (result.substeps > 1) r.warnings |= 1u << SH_WARN_SUBSTEPPED;
-        if (slot.body->inverted_elements() > 0) r.warnings |= 1u << SH_WARN_INVERTED;
-        if (!result.stable) {
-            r.warnings |= 1u << SH_WARN_UNSTABLE;
-            ++r.unstable_body_count;
-            if (failed) (*failed)[index] = 1;
-            if (failure.body == SH_NULL_BODY) {
-                failure.body = id_of(index);
-                failure.result = result;
-            }
-        }
+        add_step_figures(r, result);
+        note_result(index, result, r, failure, failed);
     }
+    if (coupled) step_islands(h, r, failure, failed);
+    else if (islands_) islands_->drop_unused();
+}
+
+void World::note_result(size_t index, const BodyStepResult& result, sh_step_report& r, Failure& failure,
+                        vec<uint8_t>* failed) {
+    if (slots_[index].body->inverted_elements() > 0) r.warnings |= 1u << SH_WARN_INVERTED;
+    if (result.stable) return;
+    r.warnings |= 1u << SH_WARN_UNSTABLE;
+    ++r.unstable_body_count;
+    if (failed) (*failed)[index] = 1;
+    if (failure.body == SH_NULL_BODY) {
+        failure.body = id_of(index);
+        failure.result = result;
+    }
+}
+
+bool World::group_islands(bool implicit_only, const vec<uint8_t>* failed) {
+    if (pairs_.empty()) return false;
+    if (!islands_) islands_ = sh::create<ContactIslands>();
+    islands_->links.clear();
+    for (const BodyPair& pair : pairs_) {
+        const uint32_t a = slot_of(pair.a), b = slot_of(pair.b);
+        const auto eligible = [&](uint32_t index) {
+            return !(failed && (*failed)[index]) &&
+                   (!implicit_only || slots_[index].body->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER);
+        };
+        if (pair.has_candidates && eligible(a) && eligible(b)) islands_->links.push_back({a, b});
+    }
+    return islands_->group(slots_.size()) > 0;
 }
 
 uint32_t World::detect_contacts(double h, double travel_fraction, double extra_reach) {
@@ -248,16 +266,17 @@ uint32_t World::detect_contacts(double h, double travel_fraction, double extra_r
             if (contacts.detect(*c.collider, reach)) warning_bits |= 1u << SH_WARN_CAPACITY;
         }
         contacts.anticipated_depth = anticipated;
-        contacts.friction_rate_limit = body.settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER ? 0.0 : 1.0 / h;
     }
-    for (const BodyPair& pair : pairs_) {
+    for (BodyPair& pair : pairs_) {
         Slot& a = slots_[slot_of(pair.a)];
         Slot& b = slots_[slot_of(pair.b)];
+        const int32_t before = a.contacts->candidate_count() + b.contacts->candidate_count();
         if (BodyContacts::detect_pair(*a.contacts, *b.contacts, pair.params)) warning_bits |= 1u << SH_WARN_CAPACITY;
         if (BodyContacts::detect_pair(*b.contacts, *a.contacts, pair.params)) warning_bits |= 1u << SH_WARN_CAPACITY;
+        pair.has_candidates = a.contacts->candidate_count() + b.contacts->candidate_count() > before;
     }
     for (Slot& slot : slots_)
-        if (slot.body) slot.body->field = slot.contacts->candidate_count() > 0 ? slot.contacts : nullptr;
+        if (slot.body) slot.body->field = slot.contacts->finish_detection();
     return warning_bits;
 }
 
@@ -404,11 +423,13 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
             for (int k = 0; k < 3; ++k) extent = std::max(extent, box.hi[k] - box.lo[k]);
         }
         reach = std::max(reach, 0.05 * extent);
-        // Bodies pressing on each other are solved one after the other, each against the
-        // others' current shape: not a joint equilibrium (see sh_world_set_body_contact).
+        // Bodies pressing on each other are solved together, for their joint equilibrium.
         if (has_contact()) detect_contacts(1.0, 0.0, reach);
-        for (Slot& slot : slots_)
-            if (slot.body) solve_static_body(*slot.body, gravity, def, r);
+        const bool coupled = group_islands(false, nullptr);
+        for (size_t index = 0; index < slots_.size(); ++index)
+            if (slots_[index].body && !(coupled && islands_->island_of(index) >= 0))
+                solve_static_body(*slots_[index].body, gravity, def, r);
+        if (coupled) solve_static_islands(def, r);
         if (has_contact()) finish_contacts();
     } catch (...) {
         for (Slot& slot : slots_)

@@ -12,6 +12,7 @@
 namespace sh {
 
 class BodyContacts;
+class ContactIslands;
 class HapticContext;
 struct Collider;
 struct ImplicitState;
@@ -94,6 +95,7 @@ private:
     struct BodyPair {
         sh_body_id a, b;
         sh_contact_params params;
+        bool has_candidates = false;  ///< the last detection found candidates between them
     };
     /// The first body that failed in a step and why.
     struct Failure {
@@ -104,6 +106,17 @@ private:
     bool has_contact() const { return collider_count_ > 0 || !pairs_.empty(); }
     /// Steps every body (not in skip) by h, adding to r and recording the first failure.
     void step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed);
+    /// Adds body index's step result to r: warnings, and the failure (also in failed) if it
+    /// was not stable.
+    void note_result(size_t index, const BodyStepResult& result, sh_step_report& r, Failure& failure,
+                     vec<uint8_t>* failed);
+    /// Groups the bodies of pairs with candidates into islands (only implicit bodies with
+    /// implicit_only, none in failed); false if no island has two bodies. Nothing without pairs.
+    bool group_islands(bool implicit_only, const vec<uint8_t>* failed);
+    /// Steps each island of more than one body as one implicit system (contact_islands.cpp).
+    void step_islands(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed);
+    /// Solves each island of more than one body for its joint equilibrium (contact_islands.cpp).
+    void solve_static_islands(const sh_static_def& def, sh_static_report& r);
     /// Finds the contact candidates of every body for a (sub)step of h with colliders at their
     /// current poses, each tool moving by travel_fraction of its step, every box grown by
     /// extra_reach (m); attaches the fields; returns SH_WARN bits.
@@ -115,6 +128,7 @@ private:
     vec<uint32_t> free_colliders_;
     vec<BodyPair> pairs_;
     vec<uint8_t> failed_;  ///< per slot, during a sub-stepped step
+    ContactIslands* islands_ = nullptr;  ///< built on the first step with body pairs
     vec<HapticContext*> haptics_;
     bool error_estimate_ = false;
     sh_body_id id_of(size_t index) const;

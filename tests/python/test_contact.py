@@ -176,6 +176,33 @@ def test_particle_sliding_on_a_plane_stops_after_v0_squared_over_2_mu_g():
         np.testing.assert_allclose(plane.force, [0.0, 0.0, -m * G], rtol=1e-6, atol=1e-9)
 
 
+@pytest.mark.parametrize("dt", [1e-2, 1e-3])
+def test_implicit_particle_stops_at_the_backward_euler_distance(dt):
+    # Implicit Euler with Coulomb friction at constant normal force: while sliding each step
+    # takes mu g dt off the speed and then moves by dt times the new speed, v_k = v0 - k mu g dt,
+    # so after the N = floor(v0 / (mu g dt)) sliding steps it has gone
+    # dt (N v0 - mu g dt N (N + 1) / 2) (v0^2 / (2 mu g) - dt v0 / 2 when N is whole), and the
+    # next step sticks. That stopping step is where exact Newton on the regularised law cycles
+    # (mu g dt is 0.05 m/s here, fifty times slip_velocity): every step must converge.
+    m, stiffness, exponent, mu, v0 = 1e-3, 1e6, 1.5, 0.5, 1.0
+    depth = (m * G / stiffness) ** (1.0 / exponent)
+    with softhap.World(gravity=(0, 0, -G)) as world:
+        plane = world.add_obstacle("plane", stiffness=stiffness, exponent=exponent, damping=0.0,
+                                   static_friction=mu, dynamic_friction=mu)
+        particle = world.add_spring_body([[0.0, 0.0, -depth]], mass=m, integrator="implicit_euler")
+        particle.velocities = [[v0, 0.0, 0.0]]
+        most = 0
+        for _ in range(int(round(0.3 / dt))):
+            most = max(most, world.step(dt).newton_iterations)
+        steps = math.floor(v0 / (mu * G * dt))
+        distance = dt * (steps * v0 - mu * G * dt * steps * (steps + 1) / 2)
+        assert particle.positions[0, 0] == pytest.approx(distance, rel=1e-3)
+        assert abs(particle.velocities[0, 0]) < 1e-6
+        assert most <= 5
+        # at rest the plane carries the weight and no friction
+        np.testing.assert_allclose(plane.force, [0.0, 0.0, -m * G], rtol=1e-6, atol=1e-9)
+
+
 # ------------------------------------------------------------------------------------------
 # tools: pose, velocity, wrench
 
@@ -345,9 +372,8 @@ def test_body_contact_is_action_and_reaction_at_rest():
         world.clear_body_contact(upper, lower)  # clearing twice is fine
 
 
-@pytest.mark.xfail(strict=True, reason="sh_world_solve_static solves each body against the "
-                   "other's frozen positions, once: body-pair contact is not balanced")
 def test_static_solve_balances_body_contact():
+    # Bodies in contact are solved for their joint equilibrium (sh_world_set_body_contact).
     with softhap.World(gravity=(0, 0, 0)) as world:
         lower, upper, lower_fixed, upper_fixed = overlapping_blocks(world)
         world.set_body_contact(lower, upper, stiffness=1e4)

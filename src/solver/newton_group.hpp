@@ -1,0 +1,49 @@
+// NewtonGroup: the bodies one Newton loop (an implicit step or a static solve) solves for, seen
+// the same way whether a body is alone or several are coupled.
+#pragma once
+
+#include "solver/coupled_system.hpp"
+#include "solver/implicit_integrator.hpp"
+
+#include <cstddef>
+
+namespace sh {
+
+/// A body alone, whose own system is the one solved, or the members of a CoupledSystem.
+struct NewtonGroup {
+    Body* body;              ///< alone (null when coupled)
+    ImplicitState* state;    ///< alone (null when coupled)
+    CoupledSystem* coupled;  ///< together (null when alone)
+    NewtonSystem& newton;    ///< the system solved
+
+    static NewtonGroup alone(Body& body, ImplicitState& state) { return NewtonGroup{&body, &state, nullptr, state}; }
+    static NewtonGroup together(CoupledSystem& system) { return NewtonGroup{nullptr, nullptr, &system, system}; }
+
+    /// Calls visit(body, state, offset) for each body, offset its first DOF in newton.
+    template <class Visit>
+    void each(Visit&& visit) const {
+        if (!coupled) {
+            visit(*body, *state, size_t{0});
+            return;
+        }
+        for (int32_t m = 0; m < coupled->member_count(); ++m) {
+            const CoupledMember& member = coupled->member(m);
+            visit(*member.body, *member.state, static_cast<size_t>(member.offset));
+        }
+    }
+
+    /// Assembles the system solved: assemble_member(body, state) fills each body's own system
+    /// and returns its force round-off; coupled, the members' systems are added into the joint
+    /// one with their coupling blocks (stiffness_scale K + damping_scale D, at rest or not).
+    /// Returns the round-off of the forces.
+    template <class AssembleMember>
+    double assemble(AssembleMember&& assemble_member, double stiffness_scale, double damping_scale, bool at_rest) const {
+        if (!coupled) return assemble_member(*body, *state);
+        return coupled->assemble([&](CoupledMember& m) { return assemble_member(*m.body, *m.state); }, stiffness_scale,
+                                 damping_scale, at_rest);
+    }
+
+    uint64_t matrix_version() const { return coupled ? coupled->matrix_version() : body->matrix_version; }
+};
+
+}  // namespace sh

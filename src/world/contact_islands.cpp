@@ -1,0 +1,133 @@
+#include "world/contact_islands.hpp"
+
+#include "core/clock.hpp"
+#include "solver/coupled_system.hpp"
+#include "solver/static_solver.hpp"
+#include "world/body_step.hpp"
+#include "world/step_doubling.hpp"
+#include "world/world.hpp"
+
+#include <algorithm>
+
+namespace sh {
+
+ContactIslands::~ContactIslands() {
+    for (Kept& k : kept_) sh::destroy(k.system);
+}
+
+uint32_t ContactIslands::root(uint32_t slot) {
+    while (parent_[slot] != slot) {
+        parent_[slot] = parent_[parent_[slot]];
+        slot = parent_[slot];
+    }
+    return slot;
+}
+
+int32_t ContactIslands::group(size_t slot_count) {
+    parent_.resize(slot_count);
+    for (size_t s = 0; s < slot_count; ++s) parent_[s] = static_cast<uint32_t>(s);
+    for (const Link& link : links) {
+        const uint32_t a = root(link.a), b = root(link.b);
+        if (a != b) parent_[std::max(a, b)] = std::min(a, b);  // a set's root is its smallest slot
+    }
+    // island_ first counts each root's slots, then becomes the island index of every slot.
+    island_.assign(slot_count, 0);
+    for (size_t s = 0; s < slot_count; ++s) ++island_[root(static_cast<uint32_t>(s))];
+    island_start_.assign(1, 0);
+    for (size_t s = 0; s < slot_count; ++s) {
+        if (parent_[s] != s) continue;  // roots come before the rest of their set
+        const int32_t size = island_[s];
+        island_[s] = size > 1 ? static_cast<int32_t>(island_start_.size()) - 1 : -1;
+        if (size > 1) island_start_.push_back(island_start_.back() + size);
+    }
+    member_slots_.resize(static_cast<size_t>(island_start_.back()));
+    vec<int32_t>& fill = island_start_;  // advanced while filling, then moved back
+    for (size_t s = 0; s < slot_count; ++s) {
+        const int32_t i = island_[root(static_cast<uint32_t>(s))];
+        island_[s] = i;
+        if (i >= 0) member_slots_[static_cast<size_t>(fill[static_cast<size_t>(i)]++)] = static_cast<uint32_t>(s);
+    }
+    for (size_t i = fill.size() - 1; i > 0; --i) fill[i] = fill[i - 1];
+    fill[0] = 0;
+    return island_count();
+}
+
+CoupledSystem& ContactIslands::system(const sh_body_id* ids_, int32_t count) {
+    for (Kept& k : kept_)
+        if (k.ids.size() == static_cast<size_t>(count) && std::equal(k.ids.begin(), k.ids.end(), ids_)) {
+            k.used = true;
+            return *k.system;
+        }
+    Kept k;
+    k.ids.assign(ids_, ids_ + count);
+    kept_.push_back(std::move(k));
+    kept_.back().system = sh::create<CoupledSystem>();
+    kept_.back().used = true;
+    return *kept_.back().system;
+}
+
+void ContactIslands::drop_unused() {
+    for (Kept& k : kept_)
+        if (!k.used) sh::destroy(k.system);
+    kept_.erase(std::remove_if(kept_.begin(), kept_.end(), [](const Kept& k) { return !k.used; }), kept_.end());
+    for (Kept& k : kept_) k.used = false;
+}
+
+void World::step_islands(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed) {
+    ContactIslands& islands = *islands_;
+    for (int32_t i = 0; i < islands.island_count(); ++i) {
+        const uint32_t* members = islands.members(i);
+        const int32_t count = islands.member_count(i);
+        islands.bodies.clear();
+        islands.states.clear();
+        islands.doublings.clear();
+        islands.ids.clear();
+        for (int32_t m = 0; m < count; ++m) {
+            Slot& slot = slots_[members[m]];
+            if (!slot.implicit) slot.implicit = sh::create<ImplicitState>();
+            islands.bodies.push_back(slot.body);
+            islands.states.push_back(slot.implicit);
+            islands.doublings.push_back(slot.doubling);
+            islands.ids.push_back(id_of(members[m]));
+        }
+        CoupledSystem& system = islands.system(islands.ids.data(), count);
+        system.prepare(islands.bodies.data(), islands.states.data(), count, islands.bodies[0]->settings.implicit);
+        bool half_steps_stable = false;
+        if (error_estimate_) {
+            const ScopedTimer timer(r.error_estimate_seconds);
+            half_steps_stable = take_half_steps_together(islands.bodies.data(), islands.doublings.data(), count, h,
+                                                         [&](double half) { return step_implicit_coupled(system, half, gravity).stable; });
+        }
+        for (Body* body : islands.bodies) body->clear_inverted_elements();
+        const BodyStepResult result = step_implicit_coupled(system, h, gravity);
+        for (int32_t m = 0; m < count && error_estimate_; ++m) {
+            if (half_steps_stable && result.stable && r.error_estimate >= 0.0)
+                r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*islands.bodies[static_cast<size_t>(m)],
+                                                                                           *islands.doublings[static_cast<size_t>(m)]));
+            else
+                r.error_estimate = -1.0;
+        }
+        add_step_figures(r, result);
+        for (int32_t m = 0; m < count; ++m) note_result(members[m], result, r, failure, failed);
+    }
+    islands.drop_unused();
+}
+
+void World::solve_static_islands(const sh_static_def& def, sh_static_report& r) {
+    ContactIslands& islands = *islands_;
+    for (int32_t i = 0; i < islands.island_count(); ++i) {
+        const uint32_t* members = islands.members(i);
+        const int32_t count = islands.member_count(i);
+        vec<ImplicitState> states(static_cast<size_t>(count));  // fresh, as for a body alone
+        islands.bodies.clear();
+        islands.states.clear();
+        for (int32_t m = 0; m < count; ++m) {
+            islands.bodies.push_back(slots_[members[m]].body);
+            islands.states.push_back(&states[static_cast<size_t>(m)]);
+        }
+        CoupledSystem system;
+        solve_static_coupled(system, islands.bodies.data(), islands.states.data(), count, gravity, def, r);
+    }
+}
+
+}  // namespace sh

@@ -63,10 +63,6 @@ bool node_before_face(const double* p, const double* a, const double* b, const d
 
 inline const double* at(const double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
 
-// Dihedral angle (between the outward normals) from which a convex edge has the whole contact
-// law (rad): 15 degrees.
-constexpr double kFullEdgeAngle = 0.2617993877991494;
-
 // The tangent of one contact point, stiffness_scale K + damping_scale D, as 3x3 blocks between
 // two of the nodes it acts on (its own, or for a body pair one of the other body's): for
 // depth gradients g_a, g_b and shares w_a, w_b, K_ab = k g_a g_b^T, D_ab = c g_a g_b^T +
@@ -131,27 +127,9 @@ BodyContacts::BodyContacts(const Body& body) : body_(body) {
     for (size_t i = 0; i < n; ++i)
         if (on_surface[i]) surface_nodes_.push_back(static_cast<int32_t>(i));
     if (tris.empty()) boxes_.resize(surface_nodes_.size());
-    // Each surface edge's two triangles, by sorting the edges by their node pair.
+    // Each surface edge's two triangles.
     edge_neighbor_.assign(tris.size(), -1);
-    struct Side {
-        int32_t lo, hi, index;  ///< node pair, and 3 triangle + k
-    };
-    vec<Side> sides(tris.size());
-    for (size_t i = 0; i < tris.size(); ++i) {
-        const int32_t a = tris[i], b = tris[i - i % 3 + (i % 3 + 1) % 3];
-        sides[i] = {std::min(a, b), std::max(a, b), static_cast<int32_t>(i)};
-    }
-    std::sort(sides.begin(), sides.end(),
-              [](const Side& p, const Side& q) { return p.lo != q.lo ? p.lo < q.lo : p.hi != q.hi ? p.hi < q.hi : p.index < q.index; });
-    for (size_t i = 0; i < sides.size();) {
-        size_t j = i;
-        while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
-        if (j - i == 2) {  // a manifold edge
-            edge_neighbor_[static_cast<size_t>(sides[i].index)] = sides[i + 1].index / 3;
-            edge_neighbor_[static_cast<size_t>(sides[i + 1].index)] = sides[i].index / 3;
-        }
-        i = j;
-    }
+    pair_triangles_across_edges(tris.data(), tris.size() / 3, edge_neighbor_.data());
     stamp_.assign(n, 0);
     node_depth_.assign(n, 0.0);
 }
@@ -223,8 +201,7 @@ bool BodyContacts::detect(Collider& collider, double reach) {
                 if (across <= prim) continue;
                 const int32_t a = t[k], b = t[(k + 1) % 3];
                 const int32_t* u = &tris[3 * static_cast<size_t>(across)];
-                const int32_t opposite = u[0] != a && u[0] != b ? u[0] : u[1] != a && u[1] != b ? u[1] : u[2];
-                candidates_.push_back({ContactCandidate::kEdgeShape, opposite, {a, b, t[(k + 2) % 3]}, target, nullptr,
+                candidates_.push_back({ContactCandidate::kEdgeShape, third_node(u, a, b), {a, b, t[(k + 2) % 3]}, target, nullptr,
                                        &collider.params});
             }
         });
@@ -450,92 +427,26 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
             for (int k = 0; k < 3; ++k) out.gradient[a][k] = weights[a] * out.normal[k];
         }
     };
+    // A tool between the nodes of a face or an edge: once one of them (or, for an edge, a node
+    // of the two triangles that meet there, whose contacts take over at either side) touches
+    // the same collider, the node contacts carry it (their constraint is what the mesh can
+    // resolve).
+    auto node_touches = [&](const int32_t* nodes, int count) {
+        for (int k = 0; k < count; ++k)
+            if (node_depth_[static_cast<size_t>(nodes[k])] > 0.0) return true;
+        return false;
+    };
     const double one = 1.0;
     switch (c.kind) {
-        case ContactCandidate::kNodeShape: {
-            Penetration pen;
-            if (!c.collider->shape.penetrate_point(c.collider->pose, at(x, c.node), pen)) return false;
-            out.depth = pen.depth;
-            for (int k = 0; k < 3; ++k) {
-                out.normal[k] = pen.normal[k];
-                out.point[k] = pen.point[k];
-            }
-            set_nodes(1, &c.node, &one);
-            if (v) {
-                double vc[3];
-                c.collider->point_velocity(out.point, vc);
-                sub(at(v, c.node), vc, vrel);
-            }
+        case ContactCandidate::kNodeShape:
+            if (!node_shape_contact(*c.collider, x, c.node, out)) return false;
             break;
-        }
-        case ContactCandidate::kFaceShape: {
-            Penetration pen;
-            double w[3];
-            if (!c.collider->shape.penetrate_triangle(c.collider->pose, at(x, c.face[0]), at(x, c.face[1]),
-                                                      at(x, c.face[2]), pen, w))
-                return false;
-            // A tool between the nodes: once one of them touches the same collider, the node
-            // contacts carry it (their constraint is what the mesh can resolve).
-            for (int k = 0; k < 3; ++k)
-                if (node_depth_[static_cast<size_t>(c.face[k])] > 0.0) return false;
-            out.depth = pen.depth;
-            for (int k = 0; k < 3; ++k) {
-                out.normal[k] = pen.normal[k];
-                out.point[k] = pen.point[k];
-            }
-            set_nodes(3, c.face, w);
-            if (v) {
-                double vc[3];
-                c.collider->point_velocity(out.point, vc);
-                for (int k = 0; k < 3; ++k)
-                    vrel[k] = w[0] * at(v, c.face[0])[k] + w[1] * at(v, c.face[1])[k] + w[2] * at(v, c.face[2])[k] - vc[k];
-            }
+        case ContactCandidate::kFaceShape:
+            if (!face_shape_contact(*c.collider, x, c.face, out) || node_touches(c.face, 3)) return false;
             break;
-        }
         case ContactCandidate::kEdgeShape: {
-            const double *a = at(x, c.face[0]), *b = at(x, c.face[1]);
-            double ab[3], ac[3], ad[3], n1[3], n2[3];
-            sub(b, a, ab);
-            sub(at(x, c.face[2]), a, ac);
-            sub(at(x, c.node), a, ad);
-            cross(ab, ac, n1);  // own triangle (a, b, c), outward
-            cross(ad, ab, n2);  // the one across, (b, a, d), outward
-            const double l1 = std::sqrt(dot(n1, n1)), l2 = std::sqrt(dot(n2, n2));
-            if (!(l1 > 0.0 && l2 > 0.0)) return false;
-            for (int k = 0; k < 3; ++k) {
-                n1[k] /= l1;
-                n2[k] /= l2;
-            }
-            // Convex there: the node across lies behind own triangle's plane.
-            if (!(dot(n1, ad) < -1e-9 * std::sqrt(dot(ab, ab) * dot(ad, ad)))) return false;
-            // The edge's region (the directions between n1 and n2) closes as the edge
-            // flattens, and past flat the two faces' regions overlap instead (each takes the
-            // tool, see penetrate_triangle): its law ramps in with the dihedral angle up to
-            // kFullEdgeAngle, so that an edge that folds through flat under load (the faces
-            // of a dent) changes the force continuously. A sharp edge has the whole law.
-            double fold[3];
-            cross(n1, n2, fold);
-            out.law_scale = std::min(1.0, std::atan2(std::sqrt(dot(fold, fold)), dot(n1, n2)) / kFullEdgeAngle);
-            Penetration pen;
-            double t = 0.0;
-            if (!c.collider->shape.penetrate_edge(c.collider->pose, a, b, n1, n2, pen, t)) return false;
-            // As for a face: once a node of it or of the two triangles that meet there (whose
-            // contacts take over from the edge's at either side) touches the collider, the node
-            // contacts carry it.
-            for (const int32_t node : {c.face[0], c.face[1], c.face[2], c.node})
-                if (node_depth_[static_cast<size_t>(node)] > 0.0) return false;
-            out.depth = pen.depth;
-            for (int k = 0; k < 3; ++k) {
-                out.normal[k] = pen.normal[k];
-                out.point[k] = pen.point[k];
-            }
-            const double w[2] = {1.0 - t, t};
-            set_nodes(2, c.face, w);
-            if (v) {
-                double vc[3];
-                c.collider->point_velocity(out.point, vc);
-                for (int k = 0; k < 3; ++k) vrel[k] = w[0] * at(v, c.face[0])[k] + w[1] * at(v, c.face[1])[k] - vc[k];
-            }
+            const int32_t edge[4] = {c.face[0], c.face[1], c.face[2], c.node};
+            if (!edge_shape_contact(*c.collider, x, edge, out) || node_touches(edge, 4)) return false;
             break;
         }
         case ContactCandidate::kNodeFace:
@@ -565,18 +476,8 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
             break;
         }
     }
-    const double normal_speed = dot(out.normal, vrel);
-    NormalForce fn = hunt_crossley(p, out.depth, -normal_speed);
-    fn.force *= out.law_scale;
-    fn.stiffness *= out.law_scale;
-    fn.damping *= out.law_scale;
-    out.stiffness = fn.stiffness;
-    out.damping = fn.damping;
-    out.normal_force = fn.force;
-    out.friction = 0.0;
-    out.friction_normal = 0.0;
-    for (int k = 0; k < 3; ++k) out.relative_velocity[k] = vrel[k];
-    double ft[3] = {0.0, 0.0, 0.0};
+    if (v && c.collider) velocity_against_collider(*c.collider, out, v, vrel);
+    apply_normal_law(p, v ? vrel : nullptr, out);
     // Friction of an implicit body is proportional to the normal force at the step's start
     // (lagged, as IPC does), not at the state being tried: then it depends on the velocity alone
     // and its tangent (add_tangent) is its exact derivative. With the current normal force the
@@ -586,15 +487,8 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
     // next (and one that comes off keeps it, see lagged_friction). Explicit bodies evaluate
     // forces at the (sub)step's start, so their current normal force is that one.
     const bool implicit = body_.settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER;
-    const double friction_normal = implicit ? c.friction_normal : fn.force;
-    if (v && friction_normal > 0.0 && p.static_friction > 0.0) {
-        out.friction_normal = friction_normal;
-        double vt[3];
-        for (int k = 0; k < 3; ++k) vt[k] = vrel[k] - normal_speed * out.normal[k];
-        out.friction = coulomb_friction(p, out.friction_normal, vt, ft);
-    }
-    for (int a = 0; a < out.count; ++a)
-        for (int k = 0; k < 3; ++k) out.node_force[a][k] = fn.force * out.gradient[a][k] + out.weights[a] * ft[k];
+    const double friction_normal = implicit ? c.friction_normal : out.normal_force;
+    if (v && friction_normal > 0.0 && p.static_friction > 0.0) apply_friction(p, friction_normal, out);
     return true;
 }
 
@@ -643,20 +537,7 @@ void BodyContacts::add_forces(const double* x, const double* v, double* f) const
                 f[3 * static_cast<size_t>(p.nodes[a]) + k] +=
                     explicit_friction && friction ? p.normal_force * p.gradient[a][k] : p.node_force[a][k];
         if (!(explicit_friction && friction && record)) return;
-        FrictionRecord r;
-        r.count = p.count;
-        r.normal_force = p.friction_normal;
-        r.params = c.params;
-        for (int k = 0; k < 3; ++k) {
-            r.normal[k] = p.normal[k];
-            r.offset[k] = -p.relative_velocity[k];
-        }
-        for (int a = 0; a < p.count; ++a) {
-            r.nodes[a] = p.nodes[a];
-            r.weights[a] = p.weights[a];
-            for (int k = 0; k < 3; ++k) r.offset[k] += p.weights[a] * v[3 * static_cast<size_t>(p.nodes[a]) + k];
-        }
-        friction_records_.push_back(r);
+        friction_records_.push_back(friction_record(p, *c.params, v));
     });
 }
 
@@ -666,42 +547,12 @@ void BodyContacts::begin_explicit_step() const {
 }
 
 void BodyContacts::end_explicit_step(double h, bool move_positions, double* x, double* v) const {
-    // Friction taken implicitly (backward Euler) on the velocities the step reached without it,
-    // contact by contact (Gauss-Seidel over contacts sharing nodes), with the normal force and
-    // normal of the step's start: the tangential velocity each contact ends the step with is
-    // implicit_slip_speed's. An explicit viscous friction mu_s fn / s0 would need a step below
-    // the node's mass over it (or a cap there, which lets a node that carries more weight than
-    // its own creep at its load times h over its mass); this one holds a sticking contact at
-    // the regularised law's creep, at most slip_velocity, at any step.
+    // Friction taken implicitly on the velocities the step reached without it, contact by
+    // contact (Gauss-Seidel over contacts sharing nodes), with the normal force and normal of
+    // the step's start (see apply_implicit_friction).
     recording_ = false;
-    const double* inverse_mass = body_.inverse_mass.data();
-    for (const FrictionRecord& r : friction_records_) {
-        double w = 0.0;  // effective inverse mass of the contact (1/kg)
-        double vt[3];
-        for (int k = 0; k < 3; ++k) vt[k] = -r.offset[k];
-        for (int a = 0; a < r.count; ++a) {
-            const size_t node = static_cast<size_t>(r.nodes[a]);
-            w += r.weights[a] * r.weights[a] * inverse_mass[node];
-            for (int k = 0; k < 3; ++k) vt[k] += r.weights[a] * v[3 * node + k];
-        }
-        if (!(w > 0.0)) continue;
-        const double vn = dot(vt, r.normal);
-        for (int k = 0; k < 3; ++k) vt[k] -= vn * r.normal[k];
-        const double speed = std::sqrt(dot(vt, vt));
-        if (!(speed > 0.0)) continue;
-        const double slowed = implicit_slip_speed(*r.params, r.normal_force, speed, w * h);
-        // The impulse J = -(speed - slowed) / w along vt changes node a's velocity by
-        // weights[a] J / m_a, and the contact's relative velocity by w J.
-        const double scale = -(speed - slowed) / (w * speed);
-        for (int a = 0; a < r.count; ++a) {
-            const size_t node = static_cast<size_t>(r.nodes[a]);
-            const double share = scale * r.weights[a] * inverse_mass[node];
-            for (int k = 0; k < 3; ++k) {
-                v[3 * node + k] += share * vt[k];
-                if (move_positions) x[3 * node + k] += h * share * vt[k];
-            }
-        }
-    }
+    for (const FrictionRecord& r : friction_records_)
+        apply_implicit_friction(r, body_.inverse_mass.data(), h, move_positions ? x : nullptr, v);
     friction_records_.clear();
 }
 

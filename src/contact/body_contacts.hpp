@@ -4,6 +4,7 @@
 
 #include "collision/aabb_tree.hpp"
 #include "contact/collider.hpp"
+#include "contact/shape_contact.hpp"
 #include "model/body.hpp"
 #include "model/external_field.hpp"
 
@@ -36,30 +37,6 @@ struct ContactCandidate {
     /// Implicit bodies: the candidate's normal force at the start of the step (N, 0 if it did
     /// not touch then), which its friction uses throughout the step (see finish_detection).
     double friction_normal = 0.0;
-};
-
-/// One acting contact, as evaluate() reports it.
-struct ContactPoint {
-    double depth;            ///< penetration (m), > 0
-    double normal[3];        ///< unit direction of the push on the node side (node or face)
-    double point[3];         ///< touching point (world)
-    int32_t nodes[3];        ///< own nodes the contact acts on
-    int count;               ///< 1, 2 (kEdgeShape) or 3
-    double weights[3];       ///< own nodes' shares of the node side's motion and friction (sign
-                             ///< included: kFaceNode's own face is the far side)
-    double gradient[3][3];   ///< per own node: -d depth / d x, its weight times the normal (the
-                             ///< normal force on it is the normal force times this)
-    double node_force[3][3]; ///< per own node: the force it feels (N)
-    double stiffness;        ///< dFn/dx (N/m)
-    double damping;          ///< dFn/dx' (N s/m)
-    double friction;         ///< viscous coefficient of the friction (N s/m)
-    double normal_force;     ///< Hunt-Crossley normal force (N)
-    double friction_normal;  ///< normal force the friction is proportional to (N); 0: no friction
-    double relative_velocity[3]; ///< node side's velocity relative to the other side (m/s)
-    double law_scale;        ///< share of the contact law it carries: 1 but for an edge flatter
-                             ///< than kFullEdgeAngle (body_contacts.cpp)
-    double other_weights[3]; ///< kNodeFace: the other body's face nodes' shares (-w, the far
-                             ///< side); their gradients are these times the normal
 };
 
 /// The contact state of one body: surface, broad phase and candidates.
@@ -180,15 +157,6 @@ private:
     mutable double evaluation_seconds_ = 0.0;
     /// Explicit bodies: a friction contact as the (sub)step's first add_forces found it, for
     /// end_explicit_step.
-    struct FrictionRecord {
-        int32_t nodes[3];
-        double weights[3];
-        int count;
-        double normal[3];
-        double offset[3];      ///< sum of weights[a] v[a] minus the relative velocity (m/s)
-        double normal_force;   ///< N
-        const sh_contact_params* params;
-    };
     mutable vec<FrictionRecord> friction_records_;
     mutable bool recording_ = false;  ///< the next add_forces records the friction contacts
     /// Implicit bodies with friction: per candidate, its geometry at the step's start and its

@@ -1,13 +1,22 @@
 #include "contact/shape_contact.hpp"
 
 #include "contact/hunt_crossley.hpp"
+#include "core/vec3.hpp"
+
+#include <algorithm>
+#include <cmath>
 
 namespace sh {
 namespace {
 
+// Dihedral angle (between the outward normals) from which a convex edge has the whole contact
+// law (rad): 15 degrees.
+constexpr double kFullEdgeAngle = 0.2617993877991494;
+
 void set_geometry(const Penetration& pen, int count, const int32_t* nodes, const double* weights, ContactPoint& out) {
     out.depth = pen.depth;
     out.count = count;
+    out.law_scale = 1.0;
     for (int k = 0; k < 3; ++k) {
         out.normal[k] = pen.normal[k];
         out.point[k] = pen.point[k];
@@ -40,6 +49,38 @@ bool face_shape_contact(const Collider& collider, const double* x, const int32_t
     return true;
 }
 
+bool edge_shape_contact(const Collider& collider, const double* x, const int32_t edge[4], ContactPoint& out) {
+    const double *a = at(x, edge[0]), *b = at(x, edge[1]);
+    double ab[3], ac[3], ad[3], n1[3], n2[3];
+    sub3(b, a, ab);
+    sub3(at(x, edge[2]), a, ac);
+    sub3(at(x, edge[3]), a, ad);
+    cross3(ab, ac, n1);  // own triangle (a, b, c), outward
+    cross3(ad, ab, n2);  // the one across, (b, a, d), outward
+    const double l1 = norm3(n1), l2 = norm3(n2);
+    if (!(l1 > 0.0 && l2 > 0.0)) return false;
+    for (int k = 0; k < 3; ++k) {
+        n1[k] /= l1;
+        n2[k] /= l2;
+    }
+    // Convex there: the node across lies behind own triangle's plane.
+    if (!(dot3(n1, ad) < -1e-9 * std::sqrt(dot3(ab, ab) * dot3(ad, ad)))) return false;
+    Penetration pen;
+    double t = 0.0;
+    if (!collider.shape.penetrate_edge(collider.pose, a, b, n1, n2, pen, t)) return false;
+    const double w[2] = {1.0 - t, t};
+    set_geometry(pen, 2, edge, w, out);
+    // The edge's region (the directions between n1 and n2) closes as the edge flattens, and
+    // past flat the two faces' regions overlap instead (each takes the tool, see
+    // penetrate_triangle): its law ramps in with the dihedral angle up to kFullEdgeAngle, so
+    // that an edge that folds through flat under load (the faces of a dent) changes the force
+    // continuously. A sharp edge has the whole law.
+    double fold[3];
+    cross3(n1, n2, fold);
+    out.law_scale = std::min(1.0, std::atan2(norm3(fold), dot3(n1, n2)) / kFullEdgeAngle);
+    return true;
+}
+
 void velocity_against_collider(const Collider& collider, const ContactPoint& out, const double* v, double vrel[3]) {
     double vc[3];
     collider.point_velocity(out.point, vc);
@@ -50,26 +91,108 @@ void velocity_against_collider(const Collider& collider, const ContactPoint& out
     }
 }
 
-void apply_contact_law(const sh_contact_params& p, const double* vrel, double friction_cap, ContactPoint& out) {
-    const double normal_speed =
-        vrel ? out.normal[0] * vrel[0] + out.normal[1] * vrel[1] + out.normal[2] * vrel[2] : 0.0;
-    const NormalForce fn = hunt_crossley(p, out.depth, -normal_speed);
-    out.stiffness = fn.stiffness;
-    out.damping = fn.damping;
+void apply_normal_law(const sh_contact_params& p, const double* vrel, ContactPoint& out) {
+    const double zero[3] = {0.0, 0.0, 0.0};
+    if (!vrel) vrel = zero;
+    const double normal_speed = dot3(out.normal, vrel);
+    NormalForce fn = hunt_crossley(p, out.depth, -normal_speed);
+    out.stiffness = out.law_scale * fn.stiffness;
+    out.damping = out.law_scale * fn.damping;
+    out.normal_force = out.law_scale * fn.force;
     out.friction = 0.0;
-    double ft[3] = {0.0, 0.0, 0.0};
-    if (vrel && fn.force > 0.0 && p.static_friction > 0.0) {
-        double vt[3];
-        for (int k = 0; k < 3; ++k) vt[k] = vrel[k] - normal_speed * out.normal[k];
-        out.friction = coulomb_friction(p, fn.force, vt, ft);
-        if (friction_cap > 0.0 && out.friction > friction_cap) {
-            const double scale = friction_cap / out.friction;
-            out.friction *= scale;
-            for (double& f : ft) f *= scale;
+    out.friction_normal = 0.0;
+    for (int k = 0; k < 3; ++k) out.relative_velocity[k] = vrel[k];
+    for (int a = 0; a < out.count; ++a)
+        for (int k = 0; k < 3; ++k) out.node_force[a][k] = out.normal_force * out.gradient[a][k];
+}
+
+void apply_friction(const sh_contact_params& p, double friction_normal, ContactPoint& out) {
+    const double normal_speed = dot3(out.normal, out.relative_velocity);
+    double vt[3], ft[3];
+    for (int k = 0; k < 3; ++k) vt[k] = out.relative_velocity[k] - normal_speed * out.normal[k];
+    out.friction_normal = friction_normal;
+    out.friction = coulomb_friction(p, friction_normal, vt, ft);
+    for (int a = 0; a < out.count; ++a)
+        for (int k = 0; k < 3; ++k) out.node_force[a][k] += out.weights[a] * ft[k];
+}
+
+FrictionRecord friction_record(const ContactPoint& p, const sh_contact_params& params, const double* v) {
+    FrictionRecord r;
+    r.count = p.count;
+    r.normal_force = p.friction_normal;
+    r.params = &params;
+    for (int k = 0; k < 3; ++k) {
+        r.normal[k] = p.normal[k];
+        r.offset[k] = -p.relative_velocity[k];
+        r.point[k] = p.point[k];
+    }
+    for (int a = 0; a < p.count; ++a) {
+        r.nodes[a] = p.nodes[a];
+        r.weights[a] = p.weights[a];
+        for (int k = 0; k < 3; ++k) r.offset[k] += p.weights[a] * at(v, p.nodes[a])[k];
+    }
+    return r;
+}
+
+void apply_implicit_friction(const FrictionRecord& r, const double* inverse_mass, double h, double* x, double* v,
+                             double impulse[3]) {
+    if (impulse) impulse[0] = impulse[1] = impulse[2] = 0.0;
+    // Backward Euler on the velocities the step reached without friction, with the normal
+    // force and normal of the step's start. An explicit viscous friction mu_s fn / s0 would
+    // need a step below the node's mass over it (or a cap there, which lets a node that carries
+    // more weight than its own creep at its load times h over its mass); this one holds a
+    // sticking contact at the regularised law's creep, at most slip_velocity, at any step.
+    double w = 0.0;  // effective inverse mass of the contact (1/kg)
+    double vt[3];
+    for (int k = 0; k < 3; ++k) vt[k] = -r.offset[k];
+    for (int a = 0; a < r.count; ++a) {
+        const size_t node = static_cast<size_t>(r.nodes[a]);
+        w += r.weights[a] * r.weights[a] * inverse_mass[node];
+        for (int k = 0; k < 3; ++k) vt[k] += r.weights[a] * v[3 * node + k];
+    }
+    if (!(w > 0.0)) return;
+    const double vn = dot3(vt, r.normal);
+    for (int k = 0; k < 3; ++k) vt[k] -= vn * r.normal[k];
+    const double speed = norm3(vt);
+    if (!(speed > 0.0)) return;
+    const double slowed = implicit_slip_speed(*r.params, r.normal_force, speed, w * h);
+    // The impulse J = -(speed - slowed) / w along vt changes node a's velocity by
+    // weights[a] J / m_a, and the contact's relative velocity by w J.
+    const double scale = -(speed - slowed) / (w * speed);
+    if (impulse)
+        for (int k = 0; k < 3; ++k) impulse[k] = scale * vt[k];
+    for (int a = 0; a < r.count; ++a) {
+        const size_t node = static_cast<size_t>(r.nodes[a]);
+        const double share = scale * r.weights[a] * inverse_mass[node];
+        for (int k = 0; k < 3; ++k) {
+            v[3 * node + k] += share * vt[k];
+            if (x) x[3 * node + k] += h * share * vt[k];
         }
     }
-    for (int a = 0; a < out.count; ++a)
-        for (int k = 0; k < 3; ++k) out.node_force[a][k] = fn.force * out.gradient[a][k] + out.weights[a] * ft[k];
+}
+
+void pair_triangles_across_edges(const int32_t* tris, size_t count, int32_t* neighbor) {
+    struct Side {
+        int32_t lo, hi, index;  ///< node pair, and 3 triangle + k
+    };
+    const size_t sides_count = 3 * count;
+    vec<Side> sides(sides_count);
+    for (size_t i = 0; i < sides_count; ++i) {
+        const int32_t a = tris[i], b = tris[i - i % 3 + (i % 3 + 1) % 3];
+        sides[i] = {std::min(a, b), std::max(a, b), static_cast<int32_t>(i)};
+        neighbor[i] = -1;
+    }
+    std::sort(sides.begin(), sides.end(),
+              [](const Side& p, const Side& q) { return p.lo != q.lo ? p.lo < q.lo : p.hi != q.hi ? p.hi < q.hi : p.index < q.index; });
+    for (size_t i = 0; i < sides.size();) {
+        size_t j = i;
+        while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
+        if (j - i == 2) {  // a manifold edge
+            neighbor[static_cast<size_t>(sides[i].index)] = sides[i + 1].index / 3;
+            neighbor[static_cast<size_t>(sides[i + 1].index)] = sides[i].index / 3;
+        }
+        i = j;
+    }
 }
 
 }  // namespace sh

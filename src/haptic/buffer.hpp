@@ -17,6 +17,8 @@ struct BufferCapacity {
     int32_t tets, nodes;
     int32_t blocks() const { return (tets + kLanes - 1) / kLanes + 4; }  ///< one partial per model
     int32_t triangles() const { return 4 * tets; }  ///< each buffer tet has at most 4 surface faces
+    int32_t edges() const { return 6 * tets; }      ///< 3 per triangle, each shared by two
+    int32_t friction_records() const { return 2 * nodes; }  ///< friction contacts per sub-step
 };
 
 /// One exchanged buffer. The arrays are carved at creation with the capacities; the counts
@@ -25,7 +27,7 @@ struct Buffer {
     uint64_t sequence = 0;      ///< extraction number (0: nothing extracted yet)
     sh_body_id body = 0;        ///< the body it was cut from (0: none near the tool)
     bool tool_alive = true;     ///< false once the tool is destroyed
-    int32_t node_count = 0, tet_count = 0, triangle_count = 0, surface_node_count = 0;
+    int32_t node_count = 0, tet_count = 0, triangle_count = 0, surface_node_count = 0, edge_count = 0;
     int32_t block_begin[5] = {};  ///< blocks of material model m: [block_begin[m], block_begin[m + 1])
     double period = 0.0;          ///< the full-model step the boundary moves across (s)
     double gravity[3] = {};       ///< m/s^2
@@ -46,6 +48,8 @@ struct Buffer {
     double* inverse_mass = nullptr;  ///< 0 for boundary nodes (driven by the full model)
     double* mass = nullptr;
     int32_t* triangles = nullptr;    ///< 3 local nodes per surface triangle, outward
+    int32_t* edges = nullptr;        ///< 4 local nodes per surface edge shared by two triangles:
+                                     ///< the edge's two, own third, the one across (edge_shape_contact)
     int32_t* surface_nodes = nullptr;
 
     /// Carves the arrays for capacity from arena (or measures them).
@@ -59,6 +63,7 @@ struct Buffer {
         inverse_mass = arena.take<double>(n);
         mass = arena.take<double>(n);
         triangles = arena.take<int32_t>(3 * static_cast<size_t>(capacity.triangles()));
+        edges = arena.take<int32_t>(4 * static_cast<size_t>(capacity.edges()));
         surface_nodes = arena.take<int32_t>(n);
     }
 };

@@ -1,6 +1,7 @@
 // The sim side of the Volumetric Buffer Model: after each full-model step, the tets around the
 // tool's nearest surface point are copied into the back buffer with the full model's state.
 #include "collision/closest_point.hpp"
+#include "contact/shape_contact.hpp"
 #include "core/vec3.hpp"
 #include "haptic/haptic_context.hpp"
 #include "model/fem_body.hpp"
@@ -210,6 +211,23 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
         ++count;
     }
     out.triangle_count = count;
+    // The surface edges two buffer triangles share, each once.
+    neighbor_.resize(3 * static_cast<size_t>(count));
+    pair_triangles_across_edges(out.triangles, static_cast<size_t>(count), neighbor_.data());
+    int32_t edges = 0;
+    for (int32_t t = 0; t < count; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const int32_t across = neighbor_[3 * static_cast<size_t>(t) + static_cast<size_t>(k)];
+            if (across <= t) continue;
+            const int32_t* own = out.triangles + 3 * t;
+            const int32_t a = own[k], b = own[(k + 1) % 3];
+            int32_t* edge = out.edges + 4 * edges++;
+            edge[0] = a;
+            edge[1] = b;
+            edge[2] = own[(k + 2) % 3];
+            edge[3] = third_node(out.triangles + 3 * across, a, b);
+        }
+    out.edge_count = edges;
     int32_t surface = 0;
     for (int32_t i = 0; i < n; ++i) out.surface_nodes[i] = 0;
     for (int32_t j = 0; j < 3 * count; ++j) out.surface_nodes[out.triangles[j]] = 1;
@@ -230,7 +248,7 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
 void HapticContext::extract(World& world, double period, Buffer& out) {
     out.sequence = ++extract_count_;
     out.body = 0;
-    out.node_count = out.tet_count = out.triangle_count = out.surface_node_count = 0;
+    out.node_count = out.tet_count = out.triangle_count = out.surface_node_count = out.edge_count = 0;
     for (int32_t& b : out.block_begin) b = 0;
     out.warnings = 0;
     out.has_proxy = false;

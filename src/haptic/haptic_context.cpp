@@ -1,5 +1,7 @@
 #include "haptic/haptic_context.hpp"
 
+#include "contact/shape_contact.hpp"
+
 #include "core/error.hpp"
 #include "model/fem_body.hpp"
 #include "world/world.hpp"
@@ -19,6 +21,7 @@ struct WorkingArrays {
     double* saved_x;
     double* saved_v;
     double* depth;
+    FrictionRecord* friction;
 };
 
 void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3], WorkingArrays& w) {
@@ -33,6 +36,7 @@ void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3
     w.saved_x = arena.take<double>(3 * n);
     w.saved_v = arena.take<double>(3 * n);
     w.depth = arena.take<double>(n);
+    w.friction = arena.take<FrictionRecord>(static_cast<size_t>(capacity.friction_records()));
 }
 
 BufferCapacity capacity_of(const sh_haptic_def& def) { return BufferCapacity{def.capacity_tets, def.capacity_nodes}; }
@@ -90,6 +94,7 @@ HapticContext::HapticContext(World& world, const sh_haptic_def& def)
     saved_x_ = w.saved_x;
     saved_v_ = w.saved_v;
     depth_ = w.depth;
+    friction_ = w.friction;
     pose_ = tool_.target;
     try {
         extract(world, 0.0, buffers_[buffer_index_.back()]);

@@ -20,6 +20,7 @@ namespace sh {
 
 class Body;
 class FemBody;
+struct FrictionRecord;
 class World;
 
 /// Validates def's fields (messages name them as def->field).
@@ -76,8 +77,9 @@ private:
     // haptic side
     void adopt(const Buffer& b);
     bool step_buffer(const Buffer& b, double dt, double force[3], double torque[3], int32_t& substeps, bool& contact);
-    void add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double h, double force[3],
+    void add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double force[3],
                             double torque[3], bool& contact);
+    void apply_friction_impulses(const Buffer& b, double h, double* x, double* v, double force[3], double torque[3]);
     bool proxy_force(const Buffer& b, double force[3], double torque[3]) const;
     double substep_limit(const Buffer& b, const double* x, double travel) const;
 
@@ -106,6 +108,9 @@ private:
     double* saved_x_ = nullptr;
     double* saved_v_ = nullptr;
     double* depth_ = nullptr;  ///< per node: its depth in the tool at this evaluation
+    FrictionRecord* friction_ = nullptr;  ///< the sub-step's friction contacts
+    int32_t friction_count_ = 0;
+    uint32_t step_warnings_ = 0;  ///< SH_WARN bits raised inside the current step
     double age_ = 0.0;         ///< haptic time since the newest buffer arrived (s)
     Pose pose_;                ///< the last good device pose
     bool have_pose_ = false;
@@ -126,6 +131,7 @@ private:
     vec<int32_t> chosen_;                      ///< the buffer's tets (body numbers)
     vec<int32_t> ring_;                        ///< the buffer's body nodes, ascending
     vec<int32_t> members_;                     ///< the buffer's tets of one material model
+    vec<int32_t> neighbor_;                    ///< per buffer triangle side: the triangle across
 };
 
 }  // namespace sh

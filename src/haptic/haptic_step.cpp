@@ -101,20 +101,28 @@ double HapticContext::substep_limit(const Buffer& b, const double* x, double tra
     return kSafety * step;
 }
 
-void HapticContext::add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double h,
-                                       double force[3], double torque[3], bool& contact) {
+void HapticContext::add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double force[3],
+                                       double torque[3], bool& contact) {
     double lo[3], hi[3];
     tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
     const sh_contact_params& law = tool_.params;
-    auto act = [&](ContactPoint& p, double touched_mass) {
+    friction_count_ = 0;
+    auto act = [&](ContactPoint& p) {
         double vrel[3];
         velocity_against_collider(tool_, p, v, vrel);
-        // Explicit friction may stop a node within a sub-step, never reverse it.
-        apply_contact_law(law, vrel, touched_mass / h, p);
+        apply_normal_law(law, vrel, p);
         for (int a = 0; a < p.count; ++a)
             for (int k = 0; k < 3; ++k) at(f, p.nodes[a])[k] += p.node_force[a][k];
         add_reaction(p, x, tool_.pose.p, 1.0, force, torque);
         contact = true;
+        // Friction as the full model's explicit bodies take it: implicitly, after the update.
+        if (!(law.static_friction > 0.0 && p.normal_force > 0.0)) return;
+        if (friction_count_ == BufferCapacity{def_.capacity_tets, def_.capacity_nodes}.friction_records()) {
+            step_warnings_ |= 1u << SH_WARN_CAPACITY;
+            return;
+        }
+        p.friction_normal = p.normal_force;
+        friction_[friction_count_++] = friction_record(p, law, v);
     };
     for (int32_t s = 0; s < b.surface_node_count; ++s) {
         const int32_t i = b.surface_nodes[s];
@@ -123,16 +131,38 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         ContactPoint p;
         if (!node_shape_contact(tool_, x, i, p)) continue;
         depth_[i] = p.depth;
-        act(p, b.mass[i]);
+        act(p);
     }
-    // A tool between nodes: triangles act while none of their nodes touches.
+    // A tool between nodes: edges and triangles act while none of their nodes touches.
+    for (int32_t e = 0; e < b.edge_count; ++e) {
+        const int32_t* edge = b.edges + 4 * e;
+        if (depth_[edge[0]] > 0.0 || depth_[edge[1]] > 0.0 || depth_[edge[2]] > 0.0 || depth_[edge[3]] > 0.0) continue;
+        if (!boxes_overlap(lo, hi, at(x, edge[0]), at(x, edge[1]), at(x, edge[1]))) continue;
+        ContactPoint p;
+        if (edge_shape_contact(tool_, x, edge, p)) act(p);
+    }
     for (int32_t t = 0; t < b.triangle_count; ++t) {
         const int32_t* face = b.triangles + 3 * t;
         if (depth_[face[0]] > 0.0 || depth_[face[1]] > 0.0 || depth_[face[2]] > 0.0) continue;
         if (!boxes_overlap(lo, hi, at(x, face[0]), at(x, face[1]), at(x, face[2]))) continue;
         ContactPoint p;
-        if (!face_shape_contact(tool_, x, face, p)) continue;
-        act(p, std::min({b.mass[face[0]], b.mass[face[1]], b.mass[face[2]]}));
+        if (face_shape_contact(tool_, x, face, p)) act(p);
+    }
+}
+
+void HapticContext::apply_friction_impulses(const Buffer& b, double h, double* x, double* v, double force[3],
+                                            double torque[3]) {
+    for (int32_t i = 0; i < friction_count_; ++i) {
+        const FrictionRecord& r = friction_[i];
+        double impulse[3], reaction[3], arm[3], t[3];
+        apply_implicit_friction(r, b.inverse_mass, h, x, v, impulse);
+        for (int k = 0; k < 3; ++k) reaction[k] = -impulse[k] / h;
+        sub3(r.point, tool_.pose.p, arm);
+        cross3(arm, reaction, t);
+        for (int k = 0; k < 3; ++k) {
+            force[k] += reaction[k];
+            torque[k] += t[k];
+        }
     }
 }
 
@@ -175,11 +205,7 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
         });
         double f_tool[3] = {0.0, 0.0, 0.0}, t_tool[3] = {0.0, 0.0, 0.0};
         bool touching = false;
-        add_contact_forces(b, x, v, force_, h, f_tool, t_tool, touching);
-        for (int k = 0; k < 3; ++k) {  // the step's mean wrench
-            force[k] += f_tool[k] / substeps;
-            torque[k] += t_tool[k] / substeps;
-        }
+        add_contact_forces(b, x, v, force_, f_tool, t_tool, touching);
         contact = touching;
         // Symplectic Euler, mass damping implicit.
         const double damping = 1.0 / (1.0 + h * b.damping_mass);
@@ -191,6 +217,11 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
                 vi = (vi + h * w * at(force_, i)[k]) * damping;
                 at(x, i)[k] += h * vi;
             }
+        }
+        apply_friction_impulses(b, h, x, v, f_tool, t_tool);
+        for (int k = 0; k < 3; ++k) {  // the step's mean wrench
+            force[k] += f_tool[k] / substeps;
+            torque[k] += t_tool[k] / substeps;
         }
     }
     // Finite and not running away, or back to the state before the step.
@@ -226,6 +257,7 @@ sh_status HapticContext::step(const double position[3], const double orientation
                               sh_haptic_output& out) noexcept {
     sh_status status = SH_OK;
     uint32_t faults = 0;
+    step_warnings_ = 0;
     const bool dt_ok = std::isfinite(dt) && dt > 0.0 && dt <= kLongestStep;
     if (!dt_ok) {
         faults |= SH_HAPTIC_FAULT_DT;
@@ -278,7 +310,8 @@ sh_status HapticContext::step(const double position[3], const double orientation
     if (age_ > def_.stale_after) faults |= SH_HAPTIC_FAULT_STALE;
 
     out = sh_haptic_output{};
-    const uint32_t warnings = filter_.update(raw_force, raw_torque, faults == 0, step_dt, out.force, out.torque);
+    const uint32_t warnings =
+        step_warnings_ | filter_.update(raw_force, raw_torque, faults == 0, step_dt, out.force, out.torque);
     for (int k = 0; k < SH_WARN_COUNT; ++k)
         if (warnings & (1u << k)) warnings_[k].fetch_add(1, std::memory_order_relaxed);
     for (int k = 0; k < 3; ++k) out.raw_force[k] = std::isfinite(raw_force[k]) ? raw_force[k] : 0.0;

@@ -119,3 +119,36 @@ def test_sub_steps_follow_the_buffers_own_tets(meshes):
         substeps[radius] = (result.buffer_tets, result.substeps)
     assert substeps[1.0][0] == mesh.info.tet_count > substeps[0.01][0]
     assert substeps[0.01][1] < substeps[1.0][1]
+
+
+def _sliding_box(friction):
+    """Mean tool force over the steady part of a flat box tool sliding 10 mm/s over the block."""
+    world = softhap.World(gravity=(0.0, 0.0, 0.0))
+    body = world.add_fem_body(
+        box_mesh((0.02, 0.02, TOP), (8, 8, 4)), model="linear", young=5e4, poisson=0.3, density=1000.0,
+        damping_mass=40.0,
+    )
+    body.fix_nodes(np.flatnonzero(np.abs(body.positions[:, 2]) < 1e-12))
+    half = 0.003
+    start = np.array([0.006, 0.01, TOP + half - 3e-4])
+    tool = world.add_tool(
+        "box", half_extents=(half, half, half), position=start + (0.0, 0.0, 3e-4), stiffness=1000.0, exponent=1.0,
+        damping=0.2, friction=friction,
+    )
+    haptic = world.add_haptic(tool, radius=1.0, max_force_rate=1e6, ramp_time=0.0, stale_after=100.0)
+    forces = []
+    for i in range(1200):
+        t = (i + 1) * 1e-3
+        result = haptic.step(start + (0.0 if t < 0.2 else 0.01 * (t - 0.2), 0.0, 0.0))
+        if t > 0.6:
+            forces.append(result.raw_force)
+    return np.mean(forces, axis=0)
+
+
+def test_sliding_flat_tool_feels_coulomb_friction():
+    # The box's flat bottom presses its nodes straight down; its front also ploughs the
+    # surface, which pushes back with or without friction. The difference the friction makes
+    # along the motion is Coulomb's -mu F_z (mu_s = mu_d: no speed dependence).
+    with_friction, without = _sliding_box(0.3), _sliding_box(0.0)
+    assert with_friction[2] > 0.1 and without[2] > 0.1
+    assert (with_friction[0] - without[0]) / with_friction[2] == pytest.approx(-0.3, rel=0.1)

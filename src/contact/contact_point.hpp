@@ -1,0 +1,32 @@
+// ContactPoint: one acting contact as the contact code evaluates it at a state.
+#pragma once
+
+#include <cstdint>
+
+namespace sh {
+
+/// One acting contact, as evaluate() reports it.
+struct ContactPoint {
+    double depth;            ///< penetration (m), > 0
+    double normal[3];        ///< unit direction of the push on the node side (node or face)
+    double point[3];         ///< touching point (world)
+    int32_t nodes[3];        ///< own nodes the contact acts on
+    int count;               ///< 1, 2 (kEdgeShape) or 3
+    double weights[3];       ///< own nodes' shares of the node side's motion and friction (sign
+                             ///< included: kFaceNode's own face is the far side)
+    double gradient[3][3];   ///< per own node: -d depth / d x, its weight times the normal (the
+                             ///< normal force on it is the normal force times this)
+    double node_force[3][3]; ///< per own node: the force it feels (N)
+    double stiffness;        ///< dFn/dx (N/m)
+    double damping;          ///< dFn/dx' (N s/m)
+    double friction;         ///< viscous coefficient of the friction (N s/m)
+    double normal_force;     ///< Hunt-Crossley normal force (N)
+    double friction_normal;  ///< normal force the friction is proportional to (N); 0: no friction
+    double relative_velocity[3]; ///< node side's velocity relative to the other side (m/s)
+    double law_scale;        ///< share of the contact law it carries: 1 but for an edge flatter
+                             ///< than kFullEdgeAngle (body_contacts.cpp)
+    double other_weights[3]; ///< kNodeFace: the other body's face nodes' shares (-w, the far
+                             ///< side); their gradients are these times the normal
+};
+
+}  // namespace sh

@@ -4,7 +4,7 @@ PYTHON ?= python3
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-c test-python test-reduced demo palpation bench report report-deps haptic-report clean
+.PHONY: all deps build test test-c test-python test-reduced demo palpation haptic-loop tsan bench report report-deps haptic-report clean
 
 all: build
 
@@ -38,6 +38,25 @@ demo: build
 palpation: build
 	$(BUILD)/examples/palpation
 
+# A fixed-timestep haptic host (~9 s): a simulated hand on a device thread at 1 kHz, then at
+# 10 kHz, renders the liver through a haptic context while a sim thread steps the full model at
+# 60 Hz. CSV of the force trace on stdout; deadline lateness and step times on stderr.
+haptic-loop: build
+	$(BUILD)/examples/haptic_loop
+
+# ThreadSanitizer build (build-tsan) of the haptic test: its haptic thread beside the sim thread,
+# with fewer haptic steps than the default 1e5 (TSan slows the steps down). Any report fails.
+# OMP_THREAD_LIMIT=1 keeps CHOLMOD's OpenMP regions on the calling thread: libgomp is not built
+# with TSan, so its barriers are invisible to it and every parallel region would be reported.
+TSAN_BUILD ?= build-tsan
+TSAN_HAPTIC_STEPS ?= 20000
+tsan: deps
+	cmake -S . -B $(TSAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSOFTHAP_TSAN=ON \
+	  -DSOFTHAP_BUILD_TESTS=ON -DSOFTHAP_BUILD_EXAMPLES=OFF -DSOFTHAP_BUILD_BENCH=OFF $(CMAKE_FLAGS) > /dev/null
+	cmake --build $(TSAN_BUILD) -j $(JOBS) --target test_haptic
+	TSAN_OPTIONS="halt_on_error=1 $(TSAN_OPTIONS)" OMP_THREAD_LIMIT=1 SOFTHAP_HAPTIC_STEPS=$(TSAN_HAPTIC_STEPS) \
+	  $(TSAN_BUILD)/tests/test_haptic
+
 bench: build
 	$(BUILD)/bench/softhap_bench
 
@@ -65,4 +84,4 @@ haptic-report: build report-deps
 	$(PYTHON) scripts/haptic_report.py report/
 
 clean:
-	rm -rf build build-no-cholmod build-no-ccd
+	rm -rf build build-no-cholmod build-no-ccd build-tsan

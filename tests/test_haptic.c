@@ -390,6 +390,12 @@ static void test_unstable_buffer_rolls_back(void** state) {
     printf("unstable buffer: %llu roll-backs in 50 ticks\n", (unsigned long long)counters[SH_WARN_UNSTABLE]);
     assert_true(faults & SH_HAPTIC_FAULT_UNSTABLE);
     assert_true(counters[SH_WARN_UNSTABLE] > 0);
+    /* Lifted off, the buffer starts again from the full model and is healthy at once. */
+    const double above[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top + 0.001};
+    assert_ok(sh_haptic_step(haptic, above, kIdentity, dt, &out));
+    assert_ok(sh_haptic_step(haptic, above, kIdentity, dt, &out));
+    assert_int_equal(out.faults, 0);
+    assert_int_equal(out.contact, 0);
     assert_ok(sh_haptic_destroy(haptic));
     sh_world_destroy(s.world);
 }
@@ -515,6 +521,21 @@ static void* haptic_thread(void* arg) {
     return NULL;
 }
 
+/* Haptic steps of the threaded test: the environment's SOFTHAP_HAPTIC_STEPS (at least 3000, one
+ * press-and-slide cycle), else 1e5. The ThreadSanitizer run (make tsan) takes fewer. */
+static long haptic_steps(void) {
+    const char* text = getenv("SOFTHAP_HAPTIC_STEPS");
+    char* end = NULL;
+    long steps;
+    if (!text || !*text) return 100000;
+    steps = strtol(text, &end, 10);
+    if (*end != '\0' || steps < 3000) {
+        printf("SOFTHAP_HAPTIC_STEPS=%s ignored: not a whole number of at least 3000\n", text);
+        return 100000;
+    }
+    return steps;
+}
+
 static void test_haptic_thread_never_allocates_nor_locks(void** state) {
     (void)state;
     const sh_allocator allocator = {counting_alloc, counting_free, NULL};
@@ -529,7 +550,7 @@ static void test_haptic_thread_never_allocates_nor_locks(void** state) {
     memset(&r, 0, sizeof r);
     r.world = s.world;
     r.haptic = haptic;
-    r.steps = 100000;
+    r.steps = haptic_steps();
 #if COUNTING_INTERPOSED
     /* The counters see what they must: a malloc and free, a mutex, and the allocation of an
      * error message inside the library (through operator new). */

@@ -75,6 +75,7 @@ private:
     void ensure_adjacency(const FemBody& body, sh_body_id id);
 
     // haptic side
+    void load_state(const Buffer& b, bool keep);
     void adopt(const Buffer& b);
     bool step_buffer(const Buffer& b, double dt, double force[3], double torque[3], int32_t& substeps, bool& contact);
     void add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double force[3],
@@ -103,7 +104,6 @@ private:
     int current_ = 0;
     int32_t node_count_ = 0;
     sh_body_id state_body_ = 0;
-    uint64_t state_sequence_ = 0;
     double* force_ = nullptr;  ///< 3 per node
     double* saved_x_ = nullptr;
     double* saved_v_ = nullptr;

@@ -56,11 +56,11 @@ void add_reaction(const ContactPoint& p, const double* x, const double tool_posi
 
 }  // namespace
 
-void HapticContext::adopt(const Buffer& b) {
-    // Nodes the old buffer integrated keep the haptic side's state; new ones start from the
-    // full model at the start of its step, where the boundary starts too.
+void HapticContext::load_state(const Buffer& b, bool keep) {
+    // With keep, nodes the old buffer integrated keep the haptic side's state; the others
+    // start from the full model at the start of its step, where the boundary starts too.
     const int other = 1 - current_;
-    const bool same_body = b.body != 0 && b.body == state_body_;
+    const bool same_body = keep && b.body != 0 && b.body == state_body_;
     int32_t j = 0;
     for (int32_t i = 0; i < b.node_count; ++i) {
         const int32_t id = b.node_id[i];
@@ -77,7 +77,10 @@ void HapticContext::adopt(const Buffer& b) {
     current_ = other;
     node_count_ = b.node_count;
     state_body_ = b.body;
-    state_sequence_ = b.sequence;
+}
+
+void HapticContext::adopt(const Buffer& b) {
+    load_state(b, true);
     age_ = 0.0;
     for (int k = 0; k < SH_WARN_COUNT; ++k)
         if (b.warnings & (1u << k)) warnings_[k].fetch_add(1, std::memory_order_relaxed);
@@ -300,6 +303,8 @@ sh_status HapticContext::step(const double position[3], const double orientation
             if (!step_buffer(b, dt, raw_force, raw_torque, substeps, contact)) {
                 faults |= SH_HAPTIC_FAULT_UNSTABLE;
                 warnings_[SH_WARN_UNSTABLE].fetch_add(1, std::memory_order_relaxed);
+                // The state before this step led there: start again from the full model's.
+                load_state(b, false);
             }
         } else if (b.has_proxy) {
             contact = proxy_force(b, raw_force, raw_torque);

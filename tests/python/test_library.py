@@ -11,11 +11,11 @@ from conftest import compile_c, run_python
 from softhap import _lib
 
 
-def test_version_is_0_1_0():
-    # SH_VERSION of include/softhap/softhap.h: 0 * 1000000 + 4 * 1000 + 0.
-    assert softhap.SH_VERSION == 4000
-    assert softhap.version() == 4000
-    assert softhap.__version__ == "0.4.0"
+def test_version_is_0_5_0():
+    # SH_VERSION of include/softhap/softhap.h: 0 * 1000000 + 5 * 1000 + 0.
+    assert softhap.SH_VERSION == 5000
+    assert softhap.version() == 5000
+    assert softhap.__version__ == "0.5.0"
     assert softhap.version_string(2003004) == "2.3.4"
 
 

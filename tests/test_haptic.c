@@ -77,32 +77,19 @@ void free(void* ptr) {
     __libc_free(ptr);
 }
 
-typedef int (*mutex_fn)(pthread_mutex_t*);
-typedef int (*rwlock_fn)(pthread_rwlock_t*);
-int pthread_mutex_lock(pthread_mutex_t* m) {
-    static mutex_fn real;
-    if (!real) real = (mutex_fn)dlsym(RTLD_NEXT, "pthread_mutex_lock");
-    if (tl_watched) atomic_fetch_add(&g_watched_locks, 1);
-    return real(m);
-}
-int pthread_mutex_trylock(pthread_mutex_t* m) {
-    static mutex_fn real;
-    if (!real) real = (mutex_fn)dlsym(RTLD_NEXT, "pthread_mutex_trylock");
-    if (tl_watched) atomic_fetch_add(&g_watched_locks, 1);
-    return real(m);
-}
-int pthread_rwlock_rdlock(pthread_rwlock_t* l) {
-    static rwlock_fn real;
-    if (!real) real = (rwlock_fn)dlsym(RTLD_NEXT, "pthread_rwlock_rdlock");
-    if (tl_watched) atomic_fetch_add(&g_watched_locks, 1);
-    return real(l);
-}
-int pthread_rwlock_wrlock(pthread_rwlock_t* l) {
-    static rwlock_fn real;
-    if (!real) real = (rwlock_fn)dlsym(RTLD_NEXT, "pthread_rwlock_wrlock");
-    if (tl_watched) atomic_fetch_add(&g_watched_locks, 1);
-    return real(l);
-}
+/* A lock function that counts its calls from the watched thread, then calls the real one. */
+#define COUNTED_LOCK(name, type)                                              \
+    int name(type* lock) {                                                    \
+        static int (*real)(type*);                                            \
+        if (!real) real = (int (*)(type*))dlsym(RTLD_NEXT, #name);            \
+        if (tl_watched) atomic_fetch_add(&g_watched_locks, 1);                \
+        return real(lock);                                                    \
+    }
+COUNTED_LOCK(pthread_mutex_lock, pthread_mutex_t)
+COUNTED_LOCK(pthread_mutex_trylock, pthread_mutex_t)
+COUNTED_LOCK(pthread_rwlock_rdlock, pthread_rwlock_t)
+COUNTED_LOCK(pthread_rwlock_wrlock, pthread_rwlock_t)
+COUNTED_LOCK(pthread_spin_lock, pthread_spinlock_t)
 #endif
 
 /* The host allocator counts too (everything softhap allocates goes through it). */

@@ -32,6 +32,8 @@ test-reduced: deps
 
 demo: build
 	$(BUILD)/examples/liver_sag
+	@mkdir -p frames
+	$(BUILD)/examples/haptic_loop > frames/haptic_loop.csv
 
 # A sphere tool presses into the liver on a table, slides and lifts off (~5 s): CSV of the tool
 # force on stdout, a summary on stderr.

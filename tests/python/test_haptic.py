@@ -152,3 +152,17 @@ def test_sliding_flat_tool_feels_coulomb_friction():
     with_friction, without = _sliding_box(0.3), _sliding_box(0.0)
     assert with_friction[2] > 0.1 and without[2] > 0.1
     assert (with_friction[0] - without[0]) / with_friction[2] == pytest.approx(-0.3, rel=0.1)
+
+
+def test_rings_grow_the_buffer_to_the_whole_body():
+    # Ring k adds the tets that share a node with ring k - 1; the block is connected, so enough
+    # rings take every tet (6 per cube of the 6 x 6 x 3 grid).
+    world, _, tool = pressed_block(tool_z=TOP + RADIUS)
+    counts = []
+    for rings in (1, 2, 3, 50):
+        haptic = world.add_haptic(tool, rings=rings, radius=1e-6)
+        counts.append(haptic.step((0.01, 0.01, TOP + RADIUS + 1e-3)).buffer_tets)
+    assert counts[0] < counts[1] < counts[2] < counts[3] == 6 * 6 * 3 * 6
+    capped = world.add_haptic(tool, rings=50, capacity_tets=100)
+    assert capped.step((0.01, 0.01, TOP + RADIUS + 1e-3)).buffer_tets == 100
+    assert capped.warnings["SH_WARN_CAPACITY"] >= 1

@@ -48,13 +48,11 @@
  * the largest force after lift-off, and the step times.
  *
  * What you see: the force is exactly 0 until the tool touches (t = 0.37 s, about a millimetre
- * above the predicted height: the liver settles a little further), grows to 3.1 N by the end
- * of the press with a fitted exponent of 1.6, the tool penetrating at most 0.2 mm. For the first
- * 2 cm of the slide the force along the sliding direction is -1.0 to -1.3 N: about -0.2 N is
- * friction (the same run without friction gives the rest, the push of the rising slope ahead),
- * less than mu_d times the normal force because the tissue is dragged along under the tool.
- * Over the last centimetre the tool crosses a convex edge and one contact point carries 1-2.6 N
- * (penetration up to 0.85 mm). After lift-off the force is 0 again.
+ * above the predicted height: the liver settles a little further), grows to 4.1 N by the end
+ * of the press with a fitted exponent of 1.7, the tool penetrating at most 0.4 mm. While it
+ * slides, the force along the sliding direction is -1.4 to -2.4 N (friction, and the push of the
+ * rising slope ahead) under a normal force of 3.6-5.0 N; near the end of the path the surface
+ * falls away and the tool briefly loses contact. After lift-off the force is 0 again.
  *
  * Exit status: 0 on success; 1 if any call fails or a force is not finite. */
 #include "liver_scene.h"

@@ -703,7 +703,8 @@ typedef struct sh_static_report {
  *  velocities zeroed. A body with no fixed node that no contact holds (singular K) is
  *  SH_ERR_SOLVER; SH_ERR_NOT_CONVERGED if the tolerance is
  *  not reached; on any error every body keeps its previous state and report (if not NULL)
- *  still tells what was tried (converged = 0).
+ *  still tells what was tried (converged = 0). Haptic contexts move their tool to the newest
+ *  device pose first and restart from the equilibrium after a successful solve.
  *  Thread: sim. Alloc: may. */
 SH_API sh_status sh_world_solve_static(sh_world* world, const sh_static_def* def,
                                        sh_static_report* report);

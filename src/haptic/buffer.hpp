@@ -29,7 +29,9 @@ struct Buffer {
     bool tool_alive = true;     ///< false once the tool is destroyed
     int32_t node_count = 0, tet_count = 0, triangle_count = 0, surface_node_count = 0, edge_count = 0;
     int32_t block_begin[5] = {};  ///< blocks of material model m: [block_begin[m], block_begin[m + 1])
-    double period = 0.0;          ///< the full-model step the boundary moves across (s)
+    double period = 0.0;          ///< the full-model step the boundary moves across (s); 0 after a
+                                  ///< jump (creation, a static solve): the haptic side then
+                                  ///< restarts from the full model instead of keeping its state
     double gravity[3] = {};       ///< m/s^2
     double damping_mass = 0.0;       ///< Rayleigh alpha (1/s)
     double damping_stiffness = 0.0;  ///< Rayleigh beta (s)

@@ -148,7 +148,7 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
     out.node_count = n;
     out.tet_count = static_cast<int32_t>(chosen_.size());
 
-    const bool have_start = x_before_body_ == out.body && x_before_.size() == body.x.size();
+    const bool have_start = out.period > 0.0 && x_before_body_ == out.body && x_before_.size() == body.x.size();
     const double* start = have_start ? x_before_.data() : body.x.data();
     for (int32_t i = 0; i < n; ++i) {
         const int32_t node = ring_[static_cast<size_t>(i)];

@@ -80,7 +80,7 @@ void HapticContext::load_state(const Buffer& b, bool keep) {
 }
 
 void HapticContext::adopt(const Buffer& b) {
-    load_state(b, true);
+    load_state(b, b.period > 0.0);
     age_ = 0.0;
     for (int k = 0; k < SH_WARN_COUNT; ++k)
         if (b.warnings & (1u << k)) warnings_[k].fetch_add(1, std::memory_order_relaxed);

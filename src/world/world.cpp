@@ -400,6 +400,7 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
     sh_static_report r{};
     for (Slot& slot : slots_)
         if (slot.body) save_start_state(*slot.body);
+    for (HapticContext* haptic : haptics_) haptic->before_step(*this);
     try {
         if (has_contact()) {
             // Tools rest at their host-set poses; candidates reach as far as the tool's size,
@@ -442,6 +443,8 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
         throw;
     }
     r.converged = 1;
+    // The haptic contexts take up the equilibrium at once (no step to move across).
+    for (HapticContext* haptic : haptics_) haptic->after_step(*this, 0.0);
     r.wall_seconds = now_seconds() - start;
     if (report) *report = r;
 }

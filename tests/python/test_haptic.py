@@ -166,3 +166,21 @@ def test_rings_grow_the_buffer_to_the_whole_body():
     capped = world.add_haptic(tool, rings=50, capacity_tets=100)
     assert capped.step((0.01, 0.01, TOP + RADIUS + 1e-3)).buffer_tets == 100
     assert capped.warnings["SH_WARN_CAPACITY"] >= 1
+
+
+def test_static_solve_hands_its_equilibrium_to_the_haptic_side():
+    # The static solve takes the tool to the device pose and the haptic side restarts from the
+    # equilibrium as fresh data: its buffer, at equilibrium, renders the solve's force from its
+    # first step.
+    depth = 0.0015
+    pose = (0.01, 0.01, TOP + RADIUS - depth)
+    world, _, tool = pressed_block(tool_z=TOP + RADIUS)
+    haptic = world.add_haptic(tool, radius=1.0, max_force_rate=1e6, ramp_time=0.0, stale_after=100.0)
+    for _ in range(5):
+        haptic.step(pose)
+    assert haptic.step(pose).data_age > 5e-3
+    world.solve_static(tolerance=1e-10)
+    assert tool.pose[0] == pytest.approx(pose)
+    result = haptic.step(pose)
+    assert result.data_age == pytest.approx(1e-3)
+    assert result.raw_force == pytest.approx(tool.force, rel=1e-3, abs=1e-6)

@@ -738,7 +738,7 @@ typedef struct sh_haptic_def {
     double ramp_time;         /**< force ramp-in on engagement and ramp-out on stale data or a
                                    fault (s), >= 0; default 0.05 */
     double stale_after;       /**< full-model data older than this (s of haptic time) is
-                                   stale: the force ramps out; > 0; default 0.1 */
+                                   stale: the force ramps out; >= dt; default 0.1 */
 } sh_haptic_def;
 
 /** Fill a haptic def with defaults (the tool stays 0 and must be set). Thread: any.

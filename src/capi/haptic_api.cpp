@@ -59,8 +59,8 @@ SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_
         *out = nullptr;
         World& w = capi::world_of(world);
         const sh_haptic_def d = checked_def(def);
-        require(w.is_valid_collider(d.tool, true), SH_ERR_INVALID_HANDLE,
-                format("def->tool = 0x%llx is not a live tool of this world", static_cast<unsigned long long>(d.tool)));
+        SH_REQUIRE(w.is_valid_collider(d.tool, true), SH_ERR_INVALID_HANDLE,
+                   "def->tool = 0x%llx is not a live tool of this world", static_cast<unsigned long long>(d.tool));
         HapticContext* context = sh::create<HapticContext>(w, d);
         sh_haptic* handle = nullptr;
         try {
@@ -80,8 +80,8 @@ SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_
 SH_API sh_status sh_haptic_destroy(sh_haptic* haptic) {
     return capi::guard([&] {
         if (!haptic) return;
-        require(capi::unregister_handle(capi::HandleKind::Haptic, haptic), SH_ERR_INVALID_HANDLE,
-                "haptic is not a live object (destroyed twice or never created)");
+        if (!capi::unregister_handle(capi::HandleKind::Haptic, haptic))
+            throw Error(SH_ERR_INVALID_HANDLE, "haptic is not a live object (destroyed twice or never created)");
         if (World* w = haptic->context->world()) w->remove_haptic(haptic->context);
         haptic->magic = 0;
         sh::destroy(haptic->context);

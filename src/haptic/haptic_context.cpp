@@ -47,25 +47,28 @@ ForceLimits limits_of(const sh_haptic_def& def) {
 
 void require_range(double value, double lo, double hi, bool lo_open, const char* name) {
     const bool ok = std::isfinite(value) && (lo_open ? value > lo : value >= lo) && value <= hi;
-    require(ok, SH_ERR_INVALID_ARGUMENT,
-            format("def->%s = %g must be finite and in %s%g, %g]", name, value, lo_open ? "(" : "[", lo, hi));
+    SH_REQUIRE(ok, SH_ERR_INVALID_ARGUMENT, "def->%s = %g must be finite and in %s%g, %g]", name, value,
+               lo_open ? "(" : "[", lo, hi);
 }
 
 }  // namespace
 
 void validate_haptic_def(const sh_haptic_def& def) {
-    require(def.capacity_tets >= 1 && def.capacity_tets <= 10000000, SH_ERR_INVALID_ARGUMENT,
-            format("def->capacity_tets = %d must be in [1, 1e7]", def.capacity_tets));
-    require(def.capacity_nodes >= 4 && def.capacity_nodes <= 10000000, SH_ERR_INVALID_ARGUMENT,
-            format("def->capacity_nodes = %d must be in [4, 1e7]", def.capacity_nodes));
-    require(def.rings >= 0 && def.rings <= 1000, SH_ERR_INVALID_ARGUMENT,
-            format("def->rings = %d must be in [0, 1000]", def.rings));
+    SH_REQUIRE(def.capacity_tets >= 1 && def.capacity_tets <= 10000000, SH_ERR_INVALID_ARGUMENT,
+               "def->capacity_tets = %d must be in [1, 1e7]", def.capacity_tets);
+    SH_REQUIRE(def.capacity_nodes >= 4 && def.capacity_nodes <= 10000000, SH_ERR_INVALID_ARGUMENT,
+               "def->capacity_nodes = %d must be in [4, 1e7]", def.capacity_nodes);
+    SH_REQUIRE(def.rings >= 0 && def.rings <= 1000, SH_ERR_INVALID_ARGUMENT, "def->rings = %d must be in [0, 1000]",
+               def.rings);
     require_range(def.radius, 0.0, 1e3, true, "radius");
     require_range(def.dt, 0.0, 1.0, true, "dt");
     require_range(def.max_force, 0.0, 1e6, true, "max_force");
     require_range(def.max_force_rate, 0.0, 1e12, true, "max_force_rate");
     require_range(def.ramp_time, 0.0, 1e3, false, "ramp_time");
     require_range(def.stale_after, 0.0, 1e3, true, "stale_after");
+    SH_REQUIRE(def.stale_after >= def.dt, SH_ERR_INVALID_ARGUMENT,
+               "def->stale_after = %g s is shorter than def->dt = %g s: every step would be stale", def.stale_after,
+               def.dt);
 }
 
 size_t HapticContext::memory_bytes(const sh_haptic_def& def) {

@@ -82,7 +82,7 @@ private:
                             double torque[3], bool& contact);
     void apply_friction_impulses(const Buffer& b, double h, double* x, double* v, double force[3], double torque[3]);
     bool proxy_force(const Buffer& b, double force[3], double torque[3]) const;
-    double substep_limit(const Buffer& b, const double* x, double travel) const;
+    double substep_limit(const Buffer& b, const double* x, const double* v, double dt);
 
     sh_haptic_def def_;
     World* world_;

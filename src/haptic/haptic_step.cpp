@@ -86,20 +86,58 @@ void HapticContext::adopt(const Buffer& b) {
         if (b.warnings & (1u << k)) warnings_[k].fetch_add(1, std::memory_order_relaxed);
 }
 
-double HapticContext::substep_limit(const Buffer& b, const double* x, double travel) const {
-    // omega^2 of the elements plus the stiffest contact a node may reach within the step.
-    const double omega_fem = b.dt_stable > 0.0 && std::isfinite(b.dt_stable) ? 2.0 / b.dt_stable : 0.0;
-    double lo[3], hi[3];
-    tool_.shape.bounds(tool_.pose, travel, lo, hi);
-    double step = omega_fem > 0.0 ? 2.0 / omega_fem : INFINITY;
+double HapticContext::substep_limit(const Buffer& b, const double* x, const double* v, double dt) {
+    // How far the tool and the surface may close in on each other within the step: the tool's
+    // travel and turn, and the fastest interior node's travel.
+    double lo[3], hi[3], extent[3];
+    tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
+    sub3(hi, lo, extent);
+    double fastest = 0.0;
+    for (int32_t i = 0; i < b.node_count; ++i)
+        if (b.inverse_mass[i] > 0.0) fastest = std::max(fastest, dot3(at(v, i), at(v, i)));
+    const double closing =
+        dt * (norm3(tool_.velocity) + 0.5 * norm3(extent) * norm3(tool_.angular) + std::sqrt(fastest));
+    tool_.shape.bounds(tool_.pose, closing, lo, hi);
+    // Per node: the stiffest contact it may feel in the step, at the depth its node, edge or
+    // face contact has now plus the closing distance (weights are at most 1). force_ holds the
+    // stiffness (x) and damping (y) until the step's forces overwrite it.
+    for (int32_t i = 0; i < b.node_count; ++i) at(force_, i)[0] = at(force_, i)[1] = 0.0;
+    const sh_contact_params& law = tool_.params;
+    auto reach = [&](const int32_t* nodes, int count, bool touching, double depth) {
+        const NormalForce fn = hunt_crossley(law, (touching ? depth : 0.0) + closing, 0.0);
+        for (int a = 0; a < count; ++a) {
+            double* k = at(force_, nodes[a]);
+            k[0] = std::max(k[0], fn.stiffness);
+            k[1] = std::max(k[1], fn.damping);
+        }
+    };
     for (int32_t s = 0; s < b.surface_node_count; ++s) {
         const int32_t i = b.surface_nodes[s];
-        if (b.inverse_mass[i] == 0.0 || !inside_box(lo, hi, at(x, i))) continue;
+        if (!inside_box(lo, hi, at(x, i))) continue;
         ContactPoint p;
-        const double depth = node_shape_contact(tool_, x, i, p) ? p.depth : 0.0;
-        const NormalForce fn = hunt_crossley(tool_.params, depth + travel, 0.0);
-        const double m = b.mass[i];
-        step = std::min(step, damped_stable_step(m * omega_fem * omega_fem + fn.stiffness, fn.damping, m));
+        const bool touching = node_shape_contact(tool_, x, i, p);
+        reach(&i, 1, touching, p.depth);
+    }
+    for (int32_t e = 0; e < b.edge_count; ++e) {
+        const int32_t* edge = b.edges + 4 * e;
+        if (!boxes_overlap(lo, hi, at(x, edge[0]), at(x, edge[1]), at(x, edge[1]))) continue;
+        ContactPoint p;
+        const bool touching = edge_shape_contact(tool_, x, edge, p);
+        reach(edge, 2, touching, p.depth);
+    }
+    for (int32_t t = 0; t < b.triangle_count; ++t) {
+        const int32_t* face = b.triangles + 3 * t;
+        if (!boxes_overlap(lo, hi, at(x, face[0]), at(x, face[1]), at(x, face[2]))) continue;
+        ContactPoint p;
+        const bool touching = face_shape_contact(tool_, x, face, p);
+        reach(face, 3, touching, p.depth);
+    }
+    const double omega_fem = b.dt_stable > 0.0 && std::isfinite(b.dt_stable) ? 2.0 / b.dt_stable : 0.0;
+    double step = omega_fem > 0.0 ? 2.0 / omega_fem : INFINITY;
+    for (int32_t i = 0; i < b.node_count; ++i) {
+        if (b.inverse_mass[i] == 0.0) continue;
+        const double m = b.mass[i], k = at(force_, i)[0], c = at(force_, i)[1];
+        if (k > 0.0 || c > 0.0) step = std::min(step, damped_stable_step(m * omega_fem * omega_fem + k, c, m));
     }
     return kSafety * step;
 }
@@ -177,10 +215,11 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
     std::memcpy(saved_x_, x, n3 * sizeof(double));
     std::memcpy(saved_v_, v, n3 * sizeof(double));
     tool_.pose = tool_.start;
-    const double travel = std::sqrt(dot3(tool_.velocity, tool_.velocity)) * dt;
-    const double limit = substep_limit(b, x, travel);
-    substeps = limit > 0.0 && std::isfinite(limit) ? static_cast<int32_t>(std::min<double>(kMaxSubsteps, std::ceil(dt / limit))) : 1;
-    substeps = std::max(substeps, 1);
+    const double limit = substep_limit(b, x, v, dt);
+    const double needed = limit > 0.0 ? std::max(1.0, std::ceil(dt / limit)) : INFINITY;  // NaN: the cap
+    substeps = needed <= kMaxSubsteps ? static_cast<int32_t>(needed) : kMaxSubsteps;
+    // More than the cap: the step goes ahead with it, warned, and the runaway check decides.
+    if (!(needed <= kMaxSubsteps)) step_warnings_ |= 1u << SH_WARN_SUBSTEPPED;
     const double h = dt / substeps;
     const double t0 = age_ - dt;  // age_ already counts this step
     const Pose start = tool_.start;

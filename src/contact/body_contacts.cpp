@@ -541,6 +541,21 @@ void BodyContacts::add_forces(const double* x, const double* v, double* f) const
     });
 }
 
+void BodyContacts::mark_nodes_of_other_contacts(const Collider* except, uint8_t* marks) const {
+    for (const ContactCandidate& c : candidates_) {
+        if (c.collider && c.collider == except) continue;
+        switch (c.kind) {
+            case ContactCandidate::kNodeShape:
+            case ContactCandidate::kNodeFace: marks[c.node] = 1; break;
+            case ContactCandidate::kEdgeShape: marks[c.face[0]] = marks[c.face[1]] = 1; break;
+            case ContactCandidate::kFaceShape:
+            case ContactCandidate::kFaceNode:
+                for (const int32_t node : c.face) marks[node] = 1;
+                break;
+        }
+    }
+}
+
 void BodyContacts::begin_explicit_step() const {
     recording_ = true;
     friction_records_.clear();

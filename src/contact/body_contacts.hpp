@@ -79,6 +79,11 @@ public:
     /// Number of candidates.
     int32_t candidate_count() const { return static_cast<int32_t>(candidates_.size()); }
 
+    /// Sets marks[node] = 1 for every node of the last detection's candidates other than those
+    /// against collider `except` (obstacles, other tools, other bodies): the nodes whose
+    /// contacts the haptic buffer of `except` does not model.
+    void mark_nodes_of_other_contacts(const Collider* except, uint8_t* marks) const;
+
     /// Anticipated extra depth (m) used by stable_step for contacts that deepen in the step.
     double anticipated_depth = 0.0;
 

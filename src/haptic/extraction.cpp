@@ -1,6 +1,7 @@
 // The sim side of the Volumetric Buffer Model: after each full-model step, the tets around the
 // tool's nearest surface point are copied into the back buffer with the full model's state.
 #include "collision/closest_point.hpp"
+#include "contact/body_contacts.hpp"
 #include "contact/shape_contact.hpp"
 #include "core/vec3.hpp"
 #include "haptic/haptic_context.hpp"
@@ -55,6 +56,31 @@ double centroid_distance(const FemBody& body, int32_t t, const double center[3])
     double d[3];
     sub3(c, center, d);
     return norm3(d);
+}
+
+// The surface node deepest inside the tool (ties: the one nearest the tool's centre), as the
+// contact point of near, if any node of near's body is inside.
+void deepest_contact(const Collider& tool, NearestSurface& near) {
+    const double* x = near.fem->x.data();
+    const vec<int32_t>& tris = near.fem->surface_triangles;
+    double lo[3], hi[3];
+    tool.shape.bounds(tool.target, 0.0, lo, hi);
+    double best_depth = 0.0, best_distance = INFINITY;
+    for (size_t j = 0; j < tris.size(); ++j) {
+        const double* p = at(x, tris[j]);
+        if (p[0] < lo[0] || p[0] > hi[0] || p[1] < lo[1] || p[1] > hi[1] || p[2] < lo[2] || p[2] > hi[2]) continue;
+        Penetration pen;
+        if (!tool.shape.penetrate_point(tool.target, p, pen)) continue;
+        double d[3];
+        sub3(p, tool.target.p, d);
+        const double distance = norm3(d);
+        const bool deeper = pen.depth > best_depth * (1.0 + 1e-9);
+        if (!deeper && !(pen.depth >= best_depth * (1.0 - 1e-9) && distance < best_distance)) continue;
+        best_depth = pen.depth;
+        best_distance = distance;
+        near.triangle = static_cast<int32_t>(j / 3);
+        for (int k = 0; k < 3; ++k) near.point[k] = p[k];
+    }
 }
 
 }  // namespace
@@ -165,7 +191,7 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
         for (int32_t j = node_tet_begin_[static_cast<size_t>(node)]; j < node_tet_begin_[static_cast<size_t>(node) + 1]; ++j)
             around += in_buffer_[static_cast<size_t>(node_tet_[static_cast<size_t>(j)])];
         const bool interior = around == node_tet_begin_[static_cast<size_t>(node) + 1] - node_tet_begin_[static_cast<size_t>(node)] &&
-                              body.is_free(node);
+                              body.is_free(node) && !other_contact_[static_cast<size_t>(node)];
         out.inverse_mass[i] = interior ? 1.0 / out.mass[i] : 0.0;
     }
 
@@ -243,6 +269,7 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
 
     for (const int32_t node : ring_) local_of_[static_cast<size_t>(node)] = -1;
     for (const int32_t t : chosen_) in_buffer_[static_cast<size_t>(t)] = 0;
+    std::fill(other_contact_.begin(), other_contact_.end(), 0);
 }
 
 void HapticContext::extract(World& world, double period, Buffer& out) {
@@ -257,8 +284,11 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
     extracted_body_ = 0;
     if (!out.tool_alive) return;
     const Collider& tool = world.collider(def_.tool, true);
-    const NearestSurface near = nearest_surface(world, tool.target.p);
+    // The surface point nearest the tool's centre; once the tool is in the surface, where it
+    // is deepest (a long tool's tip, the middle of a flat press).
+    NearestSurface near = nearest_surface(world, tool.target.p);
     if (!near.fem) return;
+    deepest_contact(tool, near);
     const int32_t* tri = near.fem->surface_triangles.data() + 3 * static_cast<size_t>(near.triangle);
     const double* x = near.fem->x.data();
     double ab[3], ac[3], n[3];
@@ -278,10 +308,17 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
     tool.shape.bounds(tool.target, 0.0, lo, hi);
     sub3(hi, lo, extent);
     out.max_gap = def_.radius + 0.5 * norm3(extent);
-    if (near.distance > out.max_gap) return;
+    double offset[3];
+    sub3(near.point, tool.target.p, offset);
+    if (norm3(offset) > out.max_gap) return;
     out.body = near.body;
     extracted_body_ = near.body;
     ensure_adjacency(*near.fem, near.body);
+    // Nodes held by anything else (a table, another tool or body) follow the full model: the
+    // buffer models the tool's contact only.
+    other_contact_.assign(static_cast<size_t>(near.fem->node_count()), 0);
+    if (const BodyContacts* contacts = world.contacts_of(near.body))
+        contacts->mark_nodes_of_other_contacts(&tool, other_contact_.data());
     select_tets(*near.fem, near.point, near.triangle, out);
     fill_buffer(*near.fem, world.gravity, out);
 }

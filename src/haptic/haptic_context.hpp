@@ -132,6 +132,7 @@ private:
     vec<int32_t> ring_;                        ///< the buffer's body nodes, ascending
     vec<int32_t> members_;                     ///< the buffer's tets of one material model
     vec<int32_t> neighbor_;                    ///< per buffer triangle side: the triangle across
+    vec<uint8_t> other_contact_;               ///< per body node: in contact with something else
 };
 
 }  // namespace sh

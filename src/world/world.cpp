@@ -183,6 +183,8 @@ void World::set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params
     }
 }
 
+const BodyContacts* World::contacts_of(sh_body_id id) const { return is_valid(id) ? slots_[slot_of(id)].contacts : nullptr; }
+
 void World::add_haptic(HapticContext* haptic) { haptics_.push_back(haptic); }
 
 void World::remove_haptic(HapticContext* haptic) {

@@ -69,6 +69,9 @@ public:
     /// Unregisters a haptic context.
     void remove_haptic(HapticContext* haptic);
 
+    /// The contact state of body id after the last step, or null if it has none yet.
+    const BodyContacts* contacts_of(sh_body_id id) const;
+
     /// Calls visit(id, body) for every live body.
     template <class Visit>
     void for_each_body(Visit&& visit) const {

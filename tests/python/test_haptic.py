@@ -201,3 +201,58 @@ def test_face_contact_sub_steps_hold_at_the_device_rate():
     assert fine.mean() > 0.05
     assert coarse.mean() == pytest.approx(fine.mean(), rel=0.05)
     assert np.abs(coarse).max() < 2.0 * np.abs(fine).max()
+
+
+def test_buffer_is_cut_where_a_long_tool_touches():
+    # A capsule tilted 45 degrees touches with its tip, 4 cm from its centre: the buffer (5 mm
+    # radius) must be cut at the tip, and then it renders the full model's force.
+    world = softhap.World(gravity=(0.0, 0.0, 0.0))
+    body = world.add_fem_body(
+        box_mesh((0.05, 0.04, TOP), (10, 8, 2)), model="linear", young=5e3, poisson=0.3, density=1000.0,
+        damping_mass=40.0,
+    )
+    body.fix_nodes(np.flatnonzero(np.abs(body.positions[:, 2]) < 1e-12))
+    half_length, radius = 0.03, 0.002
+    q = (math.cos(math.pi / 8), 0.0, math.sin(math.pi / 8), 0.0)  # 45 degrees about y
+    axis = np.array([math.sin(math.pi / 4), 0.0, math.cos(math.pi / 4)])
+
+    def centre(depth):
+        return np.array([0.01, 0.02, TOP - depth + radius]) + half_length * axis
+
+    tool = world.add_tool(
+        "capsule", radius=radius, half_length=half_length, position=centre(-1e-3), orientation=q, stiffness=100.0,
+        exponent=1.0, damping=0.0,
+    )
+    haptic = world.add_haptic(tool, radius=0.005, ramp_time=0.0, stale_after=100.0)
+    for i in range(200):
+        result = haptic.step(centre(min(1.0, (i + 1) / 100) * 1e-3), q)
+        if i % 10 == 9:
+            world.step(1e-2)
+    assert result.contact and tool.force[2] > 0.01
+    assert result.raw_force == pytest.approx(tool.force, rel=0.02, abs=1e-4)
+
+
+def test_nodes_on_a_table_stay_with_the_full_model():
+    # A block resting on a plane obstacle: the buffer models the tool's contact only, so the
+    # nodes on the table follow the full model instead of falling through it, and the tool
+    # feels what the full model feels (within the table's extra give there: 10 %).
+    world = softhap.World(gravity=(0.0, 0.0, -9.81))
+    body = world.add_fem_body(
+        box_mesh((0.02, 0.02, TOP), (6, 6, 3)), model="linear", young=5e3, poisson=0.3, density=1000.0,
+        damping_mass=40.0,
+    )
+    world.add_obstacle("plane", point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), stiffness=1e3, exponent=1.0)
+    tool = world.add_tool("sphere", radius=RADIUS, position=(0.01, 0.01, 0.05), stiffness=100.0, exponent=1.0, damping=0.0)
+    for _ in range(300):
+        world.step(1e-3)
+    top = body.positions[:, 2].max()
+    pose = (*body.positions.mean(axis=0)[:2], top + RADIUS - 0.002)
+    haptic = world.add_haptic(tool, radius=1.0, ramp_time=0.0, stale_after=100.0, max_force_rate=1e6)
+    for _ in range(300):
+        result = haptic.step(pose)
+    tool.set_pose(pose)
+    for _ in range(300):
+        world.step(1e-3)
+    assert result.buffer_tets == 6 * 6 * 3 * 6
+    assert tool.force[2] > 0.02
+    assert result.raw_force[2] == pytest.approx(tool.force[2], rel=0.1)

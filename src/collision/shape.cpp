@@ -6,6 +6,7 @@
 #include "collision/shape.hpp"
 
 #include "core/error.hpp"
+#include "core/vec3.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,20 +19,6 @@
 
 namespace sh {
 namespace {
-
-double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-void cross3(const double a[3], const double b[3], double out[3]) {
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-double norm3(const double a[3]) { return std::sqrt(dot3(a, a)); }
-
-bool finite3(const double a[3]) {
-    return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]);
-}
 
 /// Scales v to unit length (safe for tiny and huge magnitudes). Returns false and leaves v
 /// untouched when v is zero or not finite.

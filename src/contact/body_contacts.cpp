@@ -3,6 +3,7 @@
 #include "collision/closest_point.hpp"
 #include "contact/hunt_crossley.hpp"
 #include "core/clock.hpp"
+#include "core/vec3.hpp"
 #include "solver/sparse_system.hpp"
 
 #include <algorithm>
@@ -11,16 +12,6 @@
 namespace sh {
 namespace {
 
-inline void sub(const double* a, const double* b, double* out) {
-    for (int k = 0; k < 3; ++k) out[k] = a[k] - b[k];
-}
-inline double dot(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-inline void cross(const double* a, const double* b, double* out) {
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 // Where p lies against the plane of triangle (a, b, c): its height above it along the outward
 // unit normal n, and the barycentric weights w of the point of the triangle nearest to p's
 // projection, at distance lateral from it. False if the triangle is degenerate. Sets edge2 to
@@ -28,15 +19,15 @@ inline void cross(const double* a, const double* b, double* out) {
 bool over_face(const double* p, const double* a, const double* b, const double* c, double& height, double n[3],
                double w[3], double& lateral, double& edge2) {
     double ab[3], ac[3], ap[3];
-    sub(b, a, ab);
-    sub(c, a, ac);
-    cross(ab, ac, n);
-    const double area2 = std::sqrt(dot(n, n));
-    edge2 = std::max(dot(ab, ab), dot(ac, ac));
+    sub3(b, a, ab);
+    sub3(c, a, ac);
+    cross3(ab, ac, n);
+    const double area2 = std::sqrt(dot3(n, n));
+    edge2 = std::max(dot3(ab, ab), dot3(ac, ac));
     if (!(area2 > 1e-14 * edge2)) return false;
     for (int k = 0; k < 3; ++k) n[k] /= area2;
-    sub(p, a, ap);
-    height = dot(n, ap);
+    sub3(p, a, ap);
+    height = dot3(n, ap);
     double q[3];
     for (int k = 0; k < 3; ++k) q[k] = p[k] - height * n[k];
     lateral = closest_on_triangle(q, a, b, c, w);
@@ -75,9 +66,9 @@ public:
                  double chord = -1.0)
         : p_(p), normal_scale_(stiffness_scale * p.stiffness + damping_scale * p.damping), damping_scale_(damping_scale) {
         if (p.friction_normal > 0.0) {
-            const double vn = dot(p.relative_velocity, p.normal);
+            const double vn = dot3(p.relative_velocity, p.normal);
             for (int k = 0; k < 3; ++k) t_[k] = p.relative_velocity[k] - vn * p.normal[k];
-            const double speed = std::sqrt(dot(t_, t_));
+            const double speed = std::sqrt(dot3(t_, t_));
             ft_ = friction_tangent(params, p.friction_normal, speed, chord);
             for (int k = 0; k < 3; ++k) t_[k] = speed > 0.0 ? t_[k] / speed : 0.0;
         }
@@ -111,10 +102,10 @@ BodyContacts::BodyContacts(const Body& body) : body_(body) {
     if (!tris.empty()) {
         for (size_t t = 0; t < tris.size(); t += 3) {
             double ab[3], ac[3], c[3];
-            sub(at(body.x.data(), tris[t + 1]), at(body.x.data(), tris[t]), ab);
-            sub(at(body.x.data(), tris[t + 2]), at(body.x.data(), tris[t]), ac);
-            cross(ab, ac, c);
-            const double third = std::sqrt(dot(c, c)) / 6.0;
+            sub3(at(body.x.data(), tris[t + 1]), at(body.x.data(), tris[t]), ab);
+            sub3(at(body.x.data(), tris[t + 2]), at(body.x.data(), tris[t]), ac);
+            cross3(ab, ac, c);
+            const double third = std::sqrt(dot3(c, c)) / 6.0;
             for (int k = 0; k < 3; ++k) {
                 on_surface[static_cast<size_t>(tris[t + k])] = 1;
                 node_area_[static_cast<size_t>(tris[t + k])] += third;
@@ -180,8 +171,8 @@ bool BodyContacts::detect(Collider& collider, double reach) {
         stamp_[static_cast<size_t>(node)] = pass_;
         if (plane) {  // the plane's bounds are unbounded sideways: keep only nodes near it
             double d[3];
-            sub(at(x, node), collider.pose.p, d);
-            if (dot(d, normal) > reach) return;
+            sub3(at(x, node), collider.pose.p, d);
+            if (dot3(d, normal) > reach) return;
         }
         candidates_.push_back({ContactCandidate::kNodeShape, node, {-1, -1, -1}, target, nullptr, &collider.params});
     };
@@ -244,15 +235,15 @@ bool BodyContacts::detect_pair(BodyContacts& a, BodyContacts& b, const sh_contac
             // Barycentric coordinates of p by signed volumes.
             const double* v0 = at(xb, tet[0]);
             double e[3][3], r[3];
-            for (int k = 0; k < 3; ++k) sub(at(xb, tet[k + 1]), v0, e[k]);
-            sub(p, v0, r);
+            for (int k = 0; k < 3; ++k) sub3(at(xb, tet[k + 1]), v0, e[k]);
+            sub3(p, v0, r);
             double c12[3], c20[3], c01[3];
-            cross(e[1], e[2], c12);
-            cross(e[2], e[0], c20);
-            cross(e[0], e[1], c01);
-            const double det = dot(e[0], c12);
+            cross3(e[1], e[2], c12);
+            cross3(e[2], e[0], c20);
+            cross3(e[0], e[1], c01);
+            const double det = dot3(e[0], c12);
             if (!(std::fabs(det) > 0.0)) return;
-            const double l1 = dot(r, c12) / det, l2 = dot(r, c20) / det, l3 = dot(r, c01) / det;
+            const double l1 = dot3(r, c12) / det, l2 = dot3(r, c20) / det, l3 = dot3(r, c01) / det;
             inside = l1 >= 0.0 && l2 >= 0.0 && l3 >= 0.0 && l1 + l2 + l3 <= 1.0;
         });
         // Outside b, the node is a candidate while the bodies may close the gap in the step
@@ -406,7 +397,7 @@ bool BodyContacts::lagged_friction(const ContactCandidate& c, const double* v, C
     out.law_scale = 1.0;
     out.friction_normal = c.friction_normal;
     for (int k = 0; k < 3; ++k) out.relative_velocity[k] = vrel[k];
-    const double vn = dot(vrel, out.normal);
+    const double vn = dot3(vrel, out.normal);
     double vt[3], ft[3];
     for (int k = 0; k < 3; ++k) vt[k] = vrel[k] - vn * out.normal[k];
     out.friction = coulomb_friction(*c.params, out.friction_normal, vt, ft);
@@ -647,7 +638,7 @@ void BodyContacts::record_friction_iterate(const ContactCandidate& c, const Cont
     r.has_cur = true;
     FrictionIterate::Point& q = r.cur;
     double slip[3];
-    const double vn = dot(u, point->normal);
+    const double vn = dot3(u, point->normal);
     for (int k = 0; k < 3; ++k) {
         q.vrel[k] = u[k];
         slip[k] = u[k] - vn * point->normal[k];
@@ -661,11 +652,11 @@ void BodyContacts::record_friction_iterate(const ContactCandidate& c, const Cont
     for (int k = 0; k < 3; ++k) d_dv[k] = r.tangent[3 * k] * dv[0] + r.tangent[3 * k + 1] * dv[1] + r.tangent[3 * k + 2] * dv[2];
     for (int k = 0; k < 3; ++k) q.residual[k] = r.prev.force[k] - d_dv[k] - q.force[k];
     q.has_residual = true;
-    const double dv2 = dot(dv, dv);
+    const double dv2 = dot3(dv, dv);
     if (r.prev.has_residual && dv2 > 0.0) {
         double answer[3];
         for (int k = 0; k < 3; ++k) answer[k] = -(r.prev.residual[k] + d_dv[k]);
-        q.response = dot(answer, dv) / dv2;
+        q.response = dot3(answer, dv) / dv2;
         q.has_response = q.response > 0.0 && std::isfinite(q.response);
     }
 }
@@ -675,12 +666,12 @@ double BodyContacts::friction_chord(const ContactCandidate& c, const ContactPoin
     FrictionIterate& r = iterates_[static_cast<size_t>(&c - candidates_.data())];
     const sh_contact_params& params = *c.params;
     const double s0 = params.slip_velocity;
-    const double vn = dot(p.relative_velocity, p.normal);
+    const double vn = dot3(p.relative_velocity, p.normal);
     double slip[3], t[3];
     for (int k = 0; k < 3; ++k) slip[k] = p.relative_velocity[k] - vn * p.normal[k];
-    const double speed = std::sqrt(dot(slip, slip));
+    const double speed = std::sqrt(dot3(slip, slip));
     for (int k = 0; k < 3; ++k) t[k] = speed > 0.0 ? slip[k] / speed : 0.0;
-    if (r.tangents > 0 && dot(r.last_slip, slip) < 0.0) r.reversed = true;
+    if (r.tangents > 0 && dot3(r.last_slip, slip) < 0.0) r.reversed = true;
     for (int k = 0; k < 3; ++k) r.last_slip[k] = slip[k];
     ++r.tangents;
 
@@ -695,14 +686,14 @@ double BodyContacts::friction_chord(const ContactCandidate& c, const ContactPoin
             // The contact's own problem: response (v - w) = F(v), on the tangent plane.
             double w[3];
             for (int k = 0; k < 3; ++k) w[k] = slip[k] - (q.residual[k] + q.force[k]) / q.response;
-            const double wn = dot(w, p.normal);
+            const double wn = dot3(w, p.normal);
             for (int k = 0; k < 3; ++k) w[k] -= wn * p.normal[k];
-            const double free_speed = std::sqrt(dot(w, w));
+            const double free_speed = std::sqrt(dot3(w, w));
             const double end_speed = implicit_slip_speed(params, p.friction_normal, free_speed, 1.0 / q.response);
-            const double target = free_speed > 0.0 ? dot(w, t) * end_speed / free_speed : 0.0;  // along t
+            const double target = free_speed > 0.0 ? dot3(w, t) * end_speed / free_speed : 0.0;  // along t
             if (target != speed) {
                 // The update solves (response + along) (target - speed) = -residual . t.
-                const double along = -dot(q.residual, t) / (target - speed) - q.response;
+                const double along = -dot3(q.residual, t) / (target - speed) - q.response;
                 if (std::isfinite(along)) chord = std::min(std::max(along, 0.0), params.static_friction * p.friction_normal / s0);
             }
         }
@@ -776,11 +767,11 @@ double BodyContacts::stable_step(const double* x, const double* v, const double*
         const int count = point ? point->count : c.kind == ContactCandidate::kEdgeShape ? 2 : face ? 3 : 1;
         const NormalForce fn = hunt_crossley(*c.params, (point ? point->depth : 0.0) + anticipated_depth, 0.0);
         double row = 0.0;
-        for (int b = 0; point && b < count; ++b) row += std::sqrt(dot(point->gradient[b], point->gradient[b]));
+        for (int b = 0; point && b < count; ++b) row += std::sqrt(dot3(point->gradient[b], point->gradient[b]));
         for (int a = 0; a < count; ++a) {
             const int32_t node = point ? point->nodes[a] : face ? c.face[a] : c.node;
             if (!body_.is_free(node)) continue;
-            const double share = point ? std::sqrt(dot(point->gradient[a], point->gradient[a])) * row : 1.0;
+            const double share = point ? std::sqrt(dot3(point->gradient[a], point->gradient[a])) * row : 1.0;
             step = std::min(step, damped_stable_step(share * fn.stiffness, share * fn.damping, mass[node]));
         }
     });
@@ -797,8 +788,8 @@ int32_t BodyContacts::accumulate_reactions() {
         for (int a = 0; a < p.count; ++a) {
             double r[3], torque[3];
             const double reaction[3] = {-p.node_force[a][0], -p.node_force[a][1], -p.node_force[a][2]};
-            sub(&body_.x[3 * static_cast<size_t>(p.nodes[a])], c.collider->pose.p, r);
-            cross(r, reaction, torque);
+            sub3(&body_.x[3 * static_cast<size_t>(p.nodes[a])], c.collider->pose.p, r);
+            cross3(r, reaction, torque);
             for (int k = 0; k < 3; ++k) {
                 s.force[k] += reaction[k];
                 s.torque[k] += torque[k];

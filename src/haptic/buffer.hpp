@@ -24,7 +24,6 @@ struct BufferCapacity {
 /// One exchanged buffer. The arrays are carved at creation with the capacities; the counts
 /// say how much of them is in use.
 struct Buffer {
-    uint64_t sequence = 0;      ///< extraction number (0: nothing extracted yet)
     sh_body_id body = 0;        ///< the body it was cut from (0: none near the tool)
     bool tool_alive = true;     ///< false once the tool is destroyed
     int32_t node_count = 0, tet_count = 0, triangle_count = 0, surface_node_count = 0, edge_count = 0;
@@ -40,7 +39,6 @@ struct Buffer {
     uint32_t warnings = 0;           ///< SH_WARN bits of the extraction (capacity)
     bool has_proxy = false;          ///< proxy_point/normal hold the nearest surface point
     double proxy_point[3] = {}, proxy_normal[3] = {};  ///< outward normal (world)
-    double max_gap = 0.0;            ///< how far from the surface the buffer reaches (m)
 
     TetBlock* blocks = nullptr;   ///< local node numbers
     int32_t* node_id = nullptr;   ///< body node of each local node, ascending

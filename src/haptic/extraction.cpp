@@ -273,7 +273,6 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
 }
 
 void HapticContext::extract(World& world, double period, Buffer& out) {
-    out.sequence = ++extract_count_;
     out.body = 0;
     out.node_count = out.tet_count = out.triangle_count = out.surface_node_count = out.edge_count = 0;
     for (int32_t& b : out.block_begin) b = 0;
@@ -307,10 +306,10 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
     double lo[3], hi[3], extent[3];
     tool.shape.bounds(tool.target, 0.0, lo, hi);
     sub3(hi, lo, extent);
-    out.max_gap = def_.radius + 0.5 * norm3(extent);
+    const double max_gap = def_.radius + 0.5 * norm3(extent);
     double offset[3];
     sub3(near.point, tool.target.p, offset);
-    if (norm3(offset) > out.max_gap) return;
+    if (norm3(offset) > max_gap) return;
     out.body = near.body;
     extracted_body_ = near.body;
     ensure_adjacency(*near.fem, near.body);

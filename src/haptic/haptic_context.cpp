@@ -98,6 +98,7 @@ HapticContext::HapticContext(World& world, const sh_haptic_def& def)
     saved_v_ = w.saved_v;
     depth_ = w.depth;
     friction_ = w.friction;
+    friction_capacity_ = capacity_of(def).friction_records();
     pose_ = tool_.target;
     try {
         extract(world, 0.0, buffers_[buffer_index_.back()]);

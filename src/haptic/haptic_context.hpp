@@ -109,6 +109,7 @@ private:
     double* saved_v_ = nullptr;
     double* depth_ = nullptr;  ///< per node: its depth in the tool at this evaluation
     FrictionRecord* friction_ = nullptr;  ///< the sub-step's friction contacts
+    int32_t friction_capacity_ = 0;
     int32_t friction_count_ = 0;
     uint32_t step_warnings_ = 0;  ///< SH_WARN bits raised inside the current step
     double age_ = 0.0;         ///< haptic time since the newest buffer arrived (s)
@@ -119,7 +120,6 @@ private:
 
     // sim side (may allocate)
     sh_body_id extracted_body_ = 0;  ///< the body of the last extraction
-    uint64_t extract_count_ = 0;
     sh_body_id adjacency_body_ = 0;
     int32_t adjacency_tets_ = -1;
     vec<int32_t> node_tet_begin_, node_tet_;  ///< per body node: its tets (CSR)

@@ -40,11 +40,11 @@ bool inside_box(const double lo[3], const double hi[3], const double* p) {
     return p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] && p[2] <= hi[2];
 }
 
-void add_reaction(const ContactPoint& p, const double* x, const double tool_position[3], double weight, double force[3],
+void add_reaction(const ContactPoint& p, const double* x, const double tool_position[3], double force[3],
                   double torque[3]) {
     for (int a = 0; a < p.count; ++a) {
         double r[3], t[3];
-        const double reaction[3] = {-weight * p.node_force[a][0], -weight * p.node_force[a][1], -weight * p.node_force[a][2]};
+        const double reaction[3] = {-p.node_force[a][0], -p.node_force[a][1], -p.node_force[a][2]};
         sub3(at(x, p.nodes[a]), tool_position, r);
         cross3(r, reaction, t);
         for (int k = 0; k < 3; ++k) {
@@ -52,6 +52,30 @@ void add_reaction(const ContactPoint& p, const double* x, const double tool_posi
             torque[k] += t[k];
         }
     }
+}
+
+// Calls visit(nodes, count) for each surface node (count 1), edge (count 4: its two nodes, own
+// third, the one across) and triangle (count 3) of buffer b whose box at x meets lo..hi, nodes
+// first.
+template <class Visit>
+void visit_features_in_box(const Buffer& b, const double* x, const double lo[3], const double hi[3], Visit&& visit) {
+    for (int32_t s = 0; s < b.surface_node_count; ++s)
+        if (inside_box(lo, hi, at(x, b.surface_nodes[s]))) visit(&b.surface_nodes[s], 1);
+    for (int32_t e = 0; e < b.edge_count; ++e) {
+        const int32_t* edge = b.edges + 4 * e;
+        if (boxes_overlap(lo, hi, at(x, edge[0]), at(x, edge[1]), at(x, edge[1]))) visit(edge, 4);
+    }
+    for (int32_t t = 0; t < b.triangle_count; ++t) {
+        const int32_t* face = b.triangles + 3 * t;
+        if (boxes_overlap(lo, hi, at(x, face[0]), at(x, face[1]), at(x, face[2]))) visit(face, 3);
+    }
+}
+
+// The contact of the tool with a feature of visit_features_in_box.
+bool feature_contact(const Collider& tool, const double* x, const int32_t* nodes, int count, ContactPoint& out) {
+    if (count == 1) return node_shape_contact(tool, x, nodes[0], out);
+    if (count == 4) return edge_shape_contact(tool, x, nodes, out);
+    return face_shape_contact(tool, x, nodes, out);
 }
 
 }  // namespace
@@ -111,27 +135,11 @@ double HapticContext::substep_limit(const Buffer& b, const double* x, const doub
             k[1] = std::max(k[1], fn.damping);
         }
     };
-    for (int32_t s = 0; s < b.surface_node_count; ++s) {
-        const int32_t i = b.surface_nodes[s];
-        if (!inside_box(lo, hi, at(x, i))) continue;
+    visit_features_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count) {
         ContactPoint p;
-        const bool touching = node_shape_contact(tool_, x, i, p);
-        reach(&i, 1, touching, p.depth);
-    }
-    for (int32_t e = 0; e < b.edge_count; ++e) {
-        const int32_t* edge = b.edges + 4 * e;
-        if (!boxes_overlap(lo, hi, at(x, edge[0]), at(x, edge[1]), at(x, edge[1]))) continue;
-        ContactPoint p;
-        const bool touching = edge_shape_contact(tool_, x, edge, p);
-        reach(edge, 2, touching, p.depth);
-    }
-    for (int32_t t = 0; t < b.triangle_count; ++t) {
-        const int32_t* face = b.triangles + 3 * t;
-        if (!boxes_overlap(lo, hi, at(x, face[0]), at(x, face[1]), at(x, face[2]))) continue;
-        ContactPoint p;
-        const bool touching = face_shape_contact(tool_, x, face, p);
-        reach(face, 3, touching, p.depth);
-    }
+        const bool touching = feature_contact(tool_, x, nodes, count, p);
+        reach(nodes, count == 4 ? 2 : count, touching, p.depth);
+    });
     const double omega_fem = b.dt_stable > 0.0 && std::isfinite(b.dt_stable) ? 2.0 / b.dt_stable : 0.0;
     double step = omega_fem > 0.0 ? 2.0 / omega_fem : INFINITY;
     for (int32_t i = 0; i < b.node_count; ++i) {
@@ -154,41 +162,28 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         apply_normal_law(law, vrel, p);
         for (int a = 0; a < p.count; ++a)
             for (int k = 0; k < 3; ++k) at(f, p.nodes[a])[k] += p.node_force[a][k];
-        add_reaction(p, x, tool_.pose.p, 1.0, force, torque);
+        add_reaction(p, x, tool_.pose.p, force, torque);
         contact = true;
         // Friction as the full model's explicit bodies take it: implicitly, after the update.
         if (!(law.static_friction > 0.0 && p.normal_force > 0.0)) return;
-        if (friction_count_ == BufferCapacity{def_.capacity_tets, def_.capacity_nodes}.friction_records()) {
+        if (friction_count_ == friction_capacity_) {
             step_warnings_ |= 1u << SH_WARN_CAPACITY;
             return;
         }
         p.friction_normal = p.normal_force;
         friction_[friction_count_++] = friction_record(p, law, v);
     };
-    for (int32_t s = 0; s < b.surface_node_count; ++s) {
-        const int32_t i = b.surface_nodes[s];
-        depth_[i] = 0.0;
-        if (!inside_box(lo, hi, at(x, i))) continue;
+    for (int32_t s = 0; s < b.surface_node_count; ++s) depth_[b.surface_nodes[s]] = 0.0;
+    // Nodes first; a tool between nodes: edges and triangles act while none of their nodes
+    // touches.
+    visit_features_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count) {
+        for (int a = 0; a < count && count > 1; ++a)
+            if (depth_[nodes[a]] > 0.0) return;
         ContactPoint p;
-        if (!node_shape_contact(tool_, x, i, p)) continue;
-        depth_[i] = p.depth;
+        if (!feature_contact(tool_, x, nodes, count, p)) return;
+        if (count == 1) depth_[nodes[0]] = p.depth;
         act(p);
-    }
-    // A tool between nodes: edges and triangles act while none of their nodes touches.
-    for (int32_t e = 0; e < b.edge_count; ++e) {
-        const int32_t* edge = b.edges + 4 * e;
-        if (depth_[edge[0]] > 0.0 || depth_[edge[1]] > 0.0 || depth_[edge[2]] > 0.0 || depth_[edge[3]] > 0.0) continue;
-        if (!boxes_overlap(lo, hi, at(x, edge[0]), at(x, edge[1]), at(x, edge[1]))) continue;
-        ContactPoint p;
-        if (edge_shape_contact(tool_, x, edge, p)) act(p);
-    }
-    for (int32_t t = 0; t < b.triangle_count; ++t) {
-        const int32_t* face = b.triangles + 3 * t;
-        if (depth_[face[0]] > 0.0 || depth_[face[1]] > 0.0 || depth_[face[2]] > 0.0) continue;
-        if (!boxes_overlap(lo, hi, at(x, face[0]), at(x, face[1]), at(x, face[2]))) continue;
-        ContactPoint p;
-        if (face_shape_contact(tool_, x, face, p)) act(p);
-    }
+    });
 }
 
 void HapticContext::apply_friction_impulses(const Buffer& b, double h, double* x, double* v, double force[3],

@@ -94,7 +94,10 @@ typedef enum sh_warning {
     SH_WARN_FORCE_CLAMPED = 4,  /**< an output force was clamped */
     SH_WARN_LOCKING = 5,        /**< a material with nu > 0.45 was given to linear tets, which
                                      lock (are too stiff) when nearly incompressible */
-    SH_WARN_COUNT = 6           /**< number of warning kinds */
+    SH_WARN_NOT_CONVERGED = 6,  /**< an implicit step's Newton loop missed its tolerance even in
+                                     max_substeps sub-steps and kept its best iterate (the lowest
+                                     incremental potential it reached) */
+    SH_WARN_COUNT = 7           /**< number of warning kinds */
 } sh_warning;
 
 /* ------------------------------------------------------------------------------------------ */
@@ -317,12 +320,23 @@ typedef struct sh_implicit_settings {
                                          damping refactorises. 0 = a new factorisation at every
                                          Newton iteration (exact Newton); must be in [0, 1);
                                          default 0.25 */
+    int32_t max_substeps;           /**< with on_unstable = SH_UNSTABLE_SUBSTEP: a step whose
+                                         Newton loop does not converge (or whose energy runs
+                                         away) is retried as 2, 4, ... equal sub-steps up to this
+                                         many; if the last still does not converge it keeps its
+                                         best iterate and counts SH_WARN_NOT_CONVERGED. 1 = no
+                                         retry; >= 1; default 16 */
 } sh_implicit_settings;
 
 /** What a step larger than the body's critical step does. */
 typedef enum sh_unstable_policy {
-    SH_UNSTABLE_REJECT = 0, /**< return SH_ERR_UNSTABLE, body state untouched */
-    SH_UNSTABLE_SUBSTEP = 1 /**< split the step into equal sub-steps below dt_crit */
+    SH_UNSTABLE_REJECT = 0, /**< return SH_ERR_UNSTABLE (explicit, dt above dt_crit) or the
+                                 implicit step's error (SH_ERR_NOT_CONVERGED, ...), body state
+                                 untouched */
+    SH_UNSTABLE_SUBSTEP = 1 /**< explicit: split the step into equal sub-steps below dt_crit;
+                                 implicit: retry a step that does not converge in up to
+                                 max_substeps sub-steps, then keep the best iterate with
+                                 SH_WARN_NOT_CONVERGED (the world always advances) */
 } sh_unstable_policy;
 
 /** Constitutive models for tetrahedral elements. */

@@ -39,6 +39,8 @@ sh_implicit_settings checked_implicit_settings(const sh_implicit_settings& in) {
                "def->implicit.cg_max_iterations = %d, must be >= 1", in.cg_max_iterations);
     SH_REQUIRE(std::isfinite(in.factor_reuse) && in.factor_reuse >= 0.0 && in.factor_reuse < 1.0,
                SH_ERR_INVALID_ARGUMENT, "def->implicit.factor_reuse = %g, must be in [0, 1)", in.factor_reuse);
+    SH_REQUIRE(in.max_substeps >= 1, SH_ERR_INVALID_ARGUMENT, "def->implicit.max_substeps = %d, must be >= 1",
+               in.max_substeps);
     sh_implicit_settings out = in;
     out.linear_solver = static_cast<sh_linear_solver>(solver);
     return out;
@@ -52,6 +54,7 @@ sh_implicit_settings default_implicit_settings() {
     s.cg_tolerance = 1e-8;
     s.cg_max_iterations = 2000;
     s.factor_reuse = 0.25;
+    s.max_substeps = 16;
     return s;
 }
 

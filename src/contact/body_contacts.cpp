@@ -284,7 +284,7 @@ bool BodyContacts::keep_deepest(Group& group, int32_t capacity) {
     for (int32_t i = 0; i < count; ++i) {
         ContactPoint point;
         const ContactCandidate& c = candidates_[static_cast<size_t>(group.begin + i)];
-        keys_[static_cast<size_t>(i)] = contact(c, body_.x.data(), nullptr, point) ? point.depth : -1.0;
+        keys_[static_cast<size_t>(i)] = touching(c, body_.x.data(), nullptr, point) ? point.depth : -1.0;
     }
     // Order the group by depth, deepest first, and keep the first `capacity`.
     vec<int32_t> order(static_cast<size_t>(count));
@@ -304,19 +304,23 @@ bool BodyContacts::keep_deepest(Group& group, int32_t capacity) {
     return true;
 }
 
-BodyContacts* BodyContacts::finish_detection() {
+BodyContacts* BodyContacts::finish_detection(double h) {
     iterates_.clear();
+    step_ = 0.0;
     if (candidates_.empty()) return nullptr;
-    if (body_.settings.integrator != SH_INTEGRATOR_IMPLICIT_EULER) return this;
+    if (!implicit_step()) return this;
     bool friction = false;
     for (const ContactCandidate& c : candidates_) friction |= c.params->static_friction > 0.0;
-    if (!friction) return this;
-    // At the step's start state: each candidate's normal force and where it acts.
-    for (ContactCandidate& c : candidates_) c.friction_normal = 0.0;
-    vec<FrictionIterate> iterates(candidates_.size(), FrictionIterate{});
+    // At the step's start state (colliders where the step starts, see World::detect_contacts):
+    // each candidate's depth, for the depth rate of the step's law, and for friction its
+    // normal force (the law at rest) and where it acts.
+    for (ContactCandidate& c : candidates_) c.friction_normal = c.start_depth = 0.0;
+    vec<FrictionIterate> iterates(friction ? candidates_.size() : 0, FrictionIterate{});
     evaluate_candidates(body_.x.data(), body_.v.data(), [&](const ContactCandidate& c, const ContactPoint* point) {
         if (!point) return;
         const size_t index = static_cast<size_t>(&c - candidates_.data());
+        candidates_[index].start_depth = point->depth;
+        if (!friction) return;
         candidates_[index].friction_normal = point->normal_force;
         FrictionIterate& r = iterates[index];
         for (int k = 0; k < 3; ++k) {
@@ -331,19 +335,18 @@ BodyContacts* BodyContacts::finish_detection() {
         }
     });
     iterates_.swap(iterates);
+    step_ = h;
     return this;
 }
 
-bool BodyContacts::contact(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const {
-    if (touching(c, x, v, out)) return true;
-    return v && lagged_friction(c, v, out);
-}
+bool BodyContacts::implicit_step() const { return body_.settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER; }
 
 bool BodyContacts::lagged_friction(const ContactCandidate& c, const double* v, ContactPoint& out) const {
-    // An implicit body's candidate that touched at the step's start keeps its friction through
-    // the step even at iterates where it has come off (its normal force is lagged, so is
-    // whether it acts): else the friction would vanish as a node leaves the surface, a jump in
-    // the force that Newton cannot converge across. It acts where it did at the start.
+    // An implicit body's friction is that of the step's start: the normal force, normal, point
+    // and weights there (lagged, as in IPC), so that it depends on the velocities alone and is
+    // the gradient of a dissipation potential (dissipation()). A candidate that touched at the
+    // start keeps it through the step even at iterates where it has come off: else it would
+    // vanish as a node leaves the surface, a jump Newton cannot converge across.
     if (!(c.friction_normal > 0.0) || iterates_.size() != candidates_.size() || !(c.params->static_friction > 0.0))
         return false;
     const FrictionIterate& r = iterates_[static_cast<size_t>(&c - candidates_.data())];
@@ -468,19 +471,27 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
         }
     }
     if (v && c.collider) velocity_against_collider(*c.collider, out, v, vrel);
+    if (implicit_step() && v) {
+        // In an implicit step the depth rate is the step's backward difference, so the normal
+        // force is a function of the positions, the gradient of energy(); its friction comes
+        // separately from the step's start (evaluate_friction).
+        apply_step_normal_law(p, hunt_crossley_step_law(p, c.start_depth, step_), vrel, out);
+        return true;
+    }
     apply_normal_law(p, v ? vrel : nullptr, out);
-    // Friction of an implicit body is proportional to the normal force at the step's start
-    // (lagged, as IPC does), not at the state being tried: then it depends on the velocity alone
-    // and its tangent (add_tangent) is its exact derivative. With the current normal force the
-    // friction would also change with every node's depth, a coupling (mu times the contact
-    // stiffness, far above the viscous friction's own) that a symmetric tangent cannot hold, and
-    // Newton cycles. The lag is one step: a contact new in the step has no friction until the
-    // next (and one that comes off keeps it, see lagged_friction). Explicit bodies evaluate
-    // forces at the (sub)step's start, so their current normal force is that one.
-    const bool implicit = body_.settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER;
-    const double friction_normal = implicit ? c.friction_normal : out.normal_force;
-    if (v && friction_normal > 0.0 && p.static_friction > 0.0) apply_friction(p, friction_normal, out);
+    // Explicit bodies evaluate forces at the (sub)step's start: the friction there is
+    // proportional to the normal force there.
+    if (v && out.normal_force > 0.0 && p.static_friction > 0.0) apply_friction(p, out.normal_force, out);
     return true;
+}
+
+template <class Emit>
+void BodyContacts::evaluate_friction(const double* v, Emit&& emit) const {
+    if (!v || !implicit_step() || iterates_.size() != candidates_.size()) return;
+    for (const ContactCandidate& c : candidates_) {
+        ContactPoint point;
+        if (lagged_friction(c, v, point)) emit(c, point);
+    }
 }
 
 template <class Emit>
@@ -489,7 +500,7 @@ void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& 
         for (int32_t i = group.begin; i < group.end; ++i) {
             const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
             ContactPoint point;
-            if (!contact(c, x, v, point)) {
+            if (!touching(c, x, v, point)) {
                 emit(c, static_cast<const ContactPoint*>(nullptr));
                 continue;
             }
@@ -513,23 +524,45 @@ void BodyContacts::evaluate(const double* x, const double* v, Emit&& emit) const
 void BodyContacts::add_forces(const double* x, const double* v, double* f) const {
     const ScopedTimer timer(evaluation_seconds_);
     // Explicit bodies feel their friction in end_explicit_step, not here.
-    const bool explicit_friction = body_.settings.integrator != SH_INTEGRATOR_IMPLICIT_EULER;
+    const bool explicit_friction = !implicit_step();
     const bool record = recording_ && v;
     if (record) friction_records_.clear();
     recording_ = false;
-    const bool iterate = v && !explicit_friction && iterates_.size() == candidates_.size();
-    evaluate_candidates(x, v, [&](const ContactCandidate& c, const ContactPoint* point) {
-        if (iterate) record_friction_iterate(c, point);
-        if (!point) return;
-        const ContactPoint& p = *point;
-        const bool friction = p.friction_normal > 0.0;
+    const auto add = [&](const ContactPoint& p, bool normal_only) {
         for (int a = 0; a < p.count; ++a)
             for (int k = 0; k < 3; ++k)
-                f[3 * static_cast<size_t>(p.nodes[a]) + k] +=
-                    explicit_friction && friction ? p.normal_force * p.gradient[a][k] : p.node_force[a][k];
-        if (!(explicit_friction && friction && record)) return;
-        friction_records_.push_back(friction_record(p, *c.params, v));
+                f[3 * static_cast<size_t>(p.nodes[a]) + k] += normal_only ? p.normal_force * p.gradient[a][k] : p.node_force[a][k];
+    };
+    evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
+        const bool friction = explicit_friction && p.friction_normal > 0.0;
+        add(p, friction);
+        if (friction && record) friction_records_.push_back(friction_record(p, *c.params, v));
     });
+    evaluate_friction(v, [&](const ContactCandidate& c, const ContactPoint& p) {
+        record_friction_iterate(c, &p);
+        add(p, false);
+    });
+}
+
+bool BodyContacts::does_work() const {
+    for (const ContactCandidate& c : candidates_) {
+        if (c.other) return true;
+        const double* u = c.collider->velocity;
+        const double* w = c.collider->angular;
+        if (u[0] != 0.0 || u[1] != 0.0 || u[2] != 0.0 || w[0] != 0.0 || w[1] != 0.0 || w[2] != 0.0) return true;
+    }
+    return false;
+}
+
+double BodyContacts::dissipation(const double* v) const {
+    double total = 0.0;
+    evaluate_friction(v, [&](const ContactCandidate& c, const ContactPoint& p) {
+        const double vn = dot3(p.relative_velocity, p.normal);
+        double vt[3];
+        for (int k = 0; k < 3; ++k) vt[k] = p.relative_velocity[k] - vn * p.normal[k];
+        total += friction_potential(*c.params, p.friction_normal, norm3(vt));
+    });
+    return total;
 }
 
 void BodyContacts::mark_nodes_of_other_contacts(const Collider* except, uint8_t* marks) const {
@@ -562,22 +595,35 @@ void BodyContacts::end_explicit_step(double h, bool move_positions, double* x, d
     friction_records_.clear();
 }
 
+namespace {
+
+// The blocks of one contact point's tangent among its own nodes (free_index >= 0) into system.
+void add_point_tangent(const ContactPoint& p, const PointTangent& tangent, const int32_t* free_index,
+                       SparseSystem& system) {
+    for (int a = 0; a < p.count; ++a) {
+        const int32_t fa = free_index[p.nodes[a]];
+        if (fa < 0) continue;
+        for (int b = a; b < p.count; ++b) {
+            const int32_t fb = free_index[p.nodes[b]];
+            if (fb < 0) continue;
+            double block[9];
+            tangent.block(p.gradient[a], p.weights[a], p.gradient[b], p.weights[b], block);
+            system.add_block(fa, fb, block, 1.0);
+        }
+    }
+}
+
+}  // namespace
+
 void BodyContacts::add_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
                                const int32_t* free_index, SparseSystem& system) const {
     const ScopedTimer timer(evaluation_seconds_);
     evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
+        add_point_tangent(p, PointTangent(p, *c.params, stiffness_scale, damping_scale), free_index, system);
+    });
+    evaluate_friction(v, [&](const ContactCandidate& c, const ContactPoint& p) {
         const PointTangent tangent(p, *c.params, stiffness_scale, damping_scale, friction_chord(c, p));
-        for (int a = 0; a < p.count; ++a) {
-            const int32_t fa = free_index[p.nodes[a]];
-            if (fa < 0) continue;
-            for (int b = a; b < p.count; ++b) {
-                const int32_t fb = free_index[p.nodes[b]];
-                if (fb < 0) continue;
-                double block[9];
-                tangent.block(p.gradient[a], p.weights[a], p.gradient[b], p.weights[b], block);
-                system.add_block(fa, fb, block, 1.0);
-            }
-        }
+        add_point_tangent(p, tangent, free_index, system);
     });
 }
 
@@ -732,9 +778,7 @@ void BodyContacts::add_coupling_tangent(const double* x, const double* v, double
     // with gradient n and share 1, the other's face nodes with -w_k n and -w_k. Each body's
     // add_tangent has the blocks among its own nodes; these are the ones across.
     const ScopedTimer timer(evaluation_seconds_);
-    for_each_pair_candidate(other, own_index, [&](const ContactCandidate& c) {
-        ContactPoint p;
-        if (!contact(c, x, v, p)) return;
+    const auto add = [&](const ContactCandidate& c, const ContactPoint& p) {
         const PointTangent tangent(p, *c.params, stiffness_scale, damping_scale);
         for (int k = 0; k < 3; ++k) {
             const int32_t j = other_index[c.face[k]];
@@ -744,14 +788,23 @@ void BodyContacts::add_coupling_tangent(const double* x, const double* v, double
             tangent.block(p.gradient[0], p.weights[0], gradient, p.other_weights[k], block);
             system.add_block(own_index[c.node], j, block, 1.0);
         }
+    };
+    for_each_pair_candidate(other, own_index, [&](const ContactCandidate& c) {
+        ContactPoint p;
+        if (touching(c, x, v, p)) add(c, p);
+        if (v && implicit_step() && iterates_.size() == candidates_.size() && lagged_friction(c, v, p)) add(c, p);
     });
 }
 
 double BodyContacts::energy(const double* x) const {
+    // In an implicit step, the potential of the step's law (its damping is in the depth).
+    const bool step_law = implicit_step() && step_ > 0.0;
     double e = 0.0;
     evaluate(x, nullptr, [&](const ContactCandidate& c, const ContactPoint& p) {
         const bool pair = c.kind == ContactCandidate::kNodeFace || c.kind == ContactCandidate::kFaceNode;
-        e += (pair ? 0.5 : 1.0) * p.law_scale * hunt_crossley_energy(*c.params, p.depth);
+        const double potential = step_law ? hunt_crossley_step_energy(*c.params, hunt_crossley_step_law(*c.params, c.start_depth, step_), p.depth)
+                                          : hunt_crossley_energy(*c.params, p.depth);
+        e += (pair ? 0.5 : 1.0) * p.law_scale * potential;
     });
     return e;
 }
@@ -780,7 +833,7 @@ double BodyContacts::stable_step(const double* x, const double* v, const double*
 
 int32_t BodyContacts::accumulate_reactions() {
     int32_t count = 0;
-    evaluate(body_.x.data(), body_.v.data(), [&](const ContactCandidate& c, const ContactPoint& p) {
+    const auto accumulate = [&](const ContactCandidate& c, const ContactPoint& p) {
         if (c.kind == ContactCandidate::kFaceNode) return;
         if (p.depth > 0.0) ++count;
         if (!c.collider) return;
@@ -799,7 +852,9 @@ int32_t BodyContacts::accumulate_reactions() {
         ++s.contact_count;
         s.max_depth = std::max(s.max_depth, p.depth);
         if (c.kind == ContactCandidate::kNodeShape) s.penetration_volume += p.depth * node_area_[static_cast<size_t>(c.node)];
-    });
+    };
+    evaluate(body_.x.data(), body_.v.data(), accumulate);
+    evaluate_friction(body_.v.data(), accumulate);
     return count;
 }
 

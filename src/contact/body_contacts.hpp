@@ -37,6 +37,9 @@ struct ContactCandidate {
     /// Implicit bodies: the candidate's normal force at the start of the step (N, 0 if it did
     /// not touch then), which its friction uses throughout the step (see finish_detection).
     double friction_normal = 0.0;
+    /// Implicit bodies: its depth at the start of the step (m, 0 if it did not touch then),
+    /// from which the step's law takes the depth rate (hunt_crossley_step_law).
+    double start_depth = 0.0;
 };
 
 /// The contact state of one body: surface, broad phase and candidates.
@@ -87,17 +90,22 @@ public:
     /// Anticipated extra depth (m) used by stable_step for contacts that deepen in the step.
     double anticipated_depth = 0.0;
 
-    /// Ends a detection pass (after every detect and detect_pair): an implicit body's
-    /// candidates record their normal force at the body's current state, the step's start,
-    /// for their friction (lagged normal force, see contact()). Returns this if there are
-    /// candidates, else null: the field to attach to the body.
-    BodyContacts* finish_detection();
+    /// Ends a detection pass (after every detect and detect_pair) for a step of h (s; 0 for
+    /// a static solve): an implicit body's candidates record their depth at the body's
+    /// current state, the step's start (with the colliders where the step starts), and for
+    /// their friction the normal force and geometry there (lagged, see lagged_friction).
+    /// Returns this if there are candidates, else null: the field to attach to the body.
+    BodyContacts* finish_detection(double h);
 
     void add_forces(const double* x, const double* v, double* f) const override;
     void add_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
                      const int32_t* free_index, SparseSystem& system) const override;
     /// Each body-pair contact counts half here and half in the other body's contacts.
     double energy(const double* x) const override;
+    /// Implicit steps: the friction's dissipation potential at velocities v (friction_potential
+    /// of each candidate's lagged friction).
+    double dissipation(const double* v) const override;
+    bool does_work() const override;
     /// The blocks between this body's node and the other body's face of each kNodeFace
     /// candidate against other.
     void add_coupling_pattern(const Body& other, const int32_t* own_index, const int32_t* other_index,
@@ -113,14 +121,17 @@ private:
     struct Group {
         int32_t begin, end;  ///< candidates [begin, end): node kinds first, then faces
     };
-    /// Candidate c at (x, v) (v null: at rest): true if it acts, with out filled: touching,
-    /// or an implicit body's friction kept through the step (lagged_friction).
-    bool contact(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const;
-    /// contact() where the candidate touches at x.
+    /// True if the body is stepped implicitly (the step's law, lagged friction).
+    bool implicit_step() const;
+    /// Candidate c at (x, v) (v null: at rest): true if it touches, with out filled: the
+    /// normal law, and for explicit bodies with v their friction.
     bool touching(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const;
-    /// Implicit bodies: the friction of a candidate that touched at the step's start but not at
-    /// this iterate, at its start geometry (depth 0, no normal force).
+    /// Implicit bodies: the friction of a candidate that touched at the step's start, at its
+    /// start geometry (depth 0, no normal force), at velocities v; false if it has none.
     bool lagged_friction(const ContactCandidate& c, const double* v, ContactPoint& out) const;
+    /// Implicit bodies with v: calls emit(candidate, point) for each lagged_friction point.
+    template <class Emit>
+    void evaluate_friction(const double* v, Emit&& emit) const;
     /// Implicit bodies, from add_forces: records candidate c's friction at a Newton iterate
     /// (point null: not touching there) for friction_chord.
     void record_friction_iterate(const ContactCandidate& c, const ContactPoint* point) const;
@@ -151,6 +162,7 @@ private:
     vec<Aabb> boxes_;              ///< per surface primitive (triangle, or node for springs)
     AabbTree tree_;
     double margin_ = 0.0;          ///< the last refit's margin (m)
+    double step_ = 0.0;            ///< implicit bodies: the step's length (s); 0: at rest
     vec<Aabb> tet_boxes_;          ///< per tet, for other bodies' nodes (built on first use)
     AabbTree tet_tree_;
     vec<uint32_t> stamp_;          ///< per node: last detection pass that took it

@@ -66,6 +66,7 @@ Collider::Collider(const sh_collider_def& def, bool tool) : shape(def.shape), is
     validate_contact_params(params, "contact");
     pose = initial_pose(def);
     start = pose;
+    previous = pose;
     target = pose;
 }
 

@@ -23,6 +23,7 @@ struct Collider {
     sh_contact_params params;
     Pose pose;    ///< where it is during the current (sub)step
     Pose start;   ///< where the last step left it
+    Pose previous;  ///< where it was at the start of the current (sub)step
     Pose target;  ///< where the next step takes it (a tool's host-set pose)
     double velocity[3] = {};  ///< of its position during the current step (m/s)
     double angular[3] = {};   ///< angular velocity during the current step (rad/s)

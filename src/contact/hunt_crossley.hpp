@@ -37,6 +37,50 @@ inline double hunt_crossley_energy(const sh_contact_params& p, double x) {
     return p.stiffness * std::pow(x, p.exponent + 1.0) / (p.exponent + 1.0);
 }
 
+/// The Hunt-Crossley law over one implicit (backward Euler) step of length h (s): the depth
+/// rate is the step's backward difference (x - x_start) / h, x_start the depth at the step's
+/// start (0 if it did not touch then), so the force F(x) = max(0, x^n (lambda + mu (x -
+/// x_start) / h)) depends on the depth alone. It is then the derivative of a potential
+/// (hunt_crossley_step_energy) and dF/dx >= 0 wherever it acts, which a line search on the
+/// step's incremental potential needs. h = 0 gives the law at rest, lambda x^n.
+struct StepLaw {
+    double a = 0.0;  ///< F = x^n (a + b x) where positive (N/m^n)
+    double b = 0.0;  ///< (N/m^(n+1))
+    double lower = 0.0;  ///< depth (m) below which F is 0 (the damping would pull)
+};
+
+inline StepLaw hunt_crossley_step_law(const sh_contact_params& p, double x_start, double h) {
+    StepLaw law;
+    const double mu = 1.5 * p.damping * p.stiffness;
+    law.b = h > 0.0 ? mu / h : 0.0;
+    law.a = p.stiffness - law.b * (x_start > 0.0 ? x_start : 0.0);
+    law.lower = law.a < 0.0 ? -law.a / law.b : 0.0;
+    return law;
+}
+
+/// F and dF/dx of law at depth x (m); no damping term (the rate is in x).
+inline NormalForce hunt_crossley_step(const sh_contact_params& p, const StepLaw& law, double x) {
+    NormalForce out;
+    if (!(x > law.lower) || !(x > 0.0)) return out;
+    const double xn = p.exponent == 1.0 ? x : std::pow(x, p.exponent);
+    const double factor = law.a + law.b * x;
+    out.force = xn * factor;
+    out.stiffness = p.exponent * xn / x * factor + law.b * xn;
+    return out;
+}
+
+/// The potential of hunt_crossley_step: the integral of F from 0 to x (J).
+inline double hunt_crossley_step_energy(const sh_contact_params& p, const StepLaw& law, double x) {
+    if (!(x > law.lower) || !(x > 0.0)) return 0.0;
+    const double n = p.exponent;
+    const auto primitive = [&](double s) {
+        if (!(s > 0.0)) return 0.0;
+        const double s1 = std::pow(s, n + 1.0);
+        return law.a * s1 / (n + 1.0) + law.b * s1 * s / (n + 2.0);
+    };
+    return primitive(x) - primitive(law.lower);
+}
+
 /// Magnitude (N) of the regularised Coulomb friction at tangential speed s >= 0 (m/s) under
 /// normal force fn (N): below the slip velocity s0 it is viscous, mu_s fn s / s0 (sticking, at
 /// most mu_s fn); above, it falls from mu_s fn at s0 towards mu_d fn as

@@ -91,11 +91,12 @@ void velocity_against_collider(const Collider& collider, const ContactPoint& out
     }
 }
 
-void apply_normal_law(const sh_contact_params& p, const double* vrel, ContactPoint& out) {
+namespace {
+
+// out's normal force, its derivatives and node forces from fn, scaled by out.law_scale.
+void set_normal_force(const NormalForce& fn, const double* vrel, ContactPoint& out) {
     const double zero[3] = {0.0, 0.0, 0.0};
     if (!vrel) vrel = zero;
-    const double normal_speed = dot3(out.normal, vrel);
-    NormalForce fn = hunt_crossley(p, out.depth, -normal_speed);
     out.stiffness = out.law_scale * fn.stiffness;
     out.damping = out.law_scale * fn.damping;
     out.normal_force = out.law_scale * fn.force;
@@ -104,6 +105,17 @@ void apply_normal_law(const sh_contact_params& p, const double* vrel, ContactPoi
     for (int k = 0; k < 3; ++k) out.relative_velocity[k] = vrel[k];
     for (int a = 0; a < out.count; ++a)
         for (int k = 0; k < 3; ++k) out.node_force[a][k] = out.normal_force * out.gradient[a][k];
+}
+
+}  // namespace
+
+void apply_normal_law(const sh_contact_params& p, const double* vrel, ContactPoint& out) {
+    const double normal_speed = vrel ? dot3(out.normal, vrel) : 0.0;
+    set_normal_force(hunt_crossley(p, out.depth, -normal_speed), vrel, out);
+}
+
+void apply_step_normal_law(const sh_contact_params& p, const StepLaw& law, const double* vrel, ContactPoint& out) {
+    set_normal_force(hunt_crossley_step(p, law, out.depth), vrel, out);
 }
 
 void apply_friction(const sh_contact_params& p, double friction_normal, ContactPoint& out) {

@@ -6,6 +6,7 @@
 
 #include "contact/collider.hpp"
 #include "contact/contact_point.hpp"
+#include "contact/hunt_crossley.hpp"
 
 #include <softhap/softhap.h>
 
@@ -36,6 +37,10 @@ void velocity_against_collider(const Collider& collider, const ContactPoint& out
 /// the relative velocity vrel (null: at rest), its stiffness and damping, out.relative_velocity,
 /// and node forces of the normal force alone; no friction yet.
 void apply_normal_law(const sh_contact_params& p, const double* vrel, ContactPoint& out);
+
+/// apply_normal_law for a body stepped implicitly: the force of law (hunt_crossley_step_law,
+/// whose damping is in the depth) at out.depth; out.damping is 0.
+void apply_step_normal_law(const sh_contact_params& p, const StepLaw& law, const double* vrel, ContactPoint& out);
 
 /// Adds Coulomb friction proportional to friction_normal (N) against out.relative_velocity's
 /// tangential part to out's node forces, out.friction and out.friction_normal.

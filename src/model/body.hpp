@@ -43,6 +43,10 @@ public:
     /// internal damping (stiffness-proportional or spring dashpots) when v is not null.
     virtual void add_internal_forces(const double* x, const double* v, double* f) const = 0;
 
+    /// True if add_internal_forces with velocities adds damping (stiffness-proportional
+    /// damping or spring dashpots).
+    virtual bool has_internal_damping() const = 0;
+
     /// Elastic energy at positions x (J).
     virtual double elastic_energy(const double* x) const = 0;
 

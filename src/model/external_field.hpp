@@ -31,6 +31,18 @@ public:
     /// together sum to their joint potential.
     virtual double energy(const double* x) const = 0;
 
+    /// Implicit steps: the dissipation potential (W) of the field's velocity-dependent forces
+    /// at velocities v, whose gradient in v is minus those forces (friction with its normal
+    /// force lagged). 0 by default.
+    virtual double dissipation(const double* v) const {
+        (void)v;
+        return 0.0;
+    }
+
+    /// True if the field can do work on the body during the step (a moving collider, another
+    /// body), so that the body's energy may rise. False by default.
+    virtual bool does_work() const { return false; }
+
     /// Largest explicit step (s) that stays stable under the field at (x, v) for nodes of
     /// these masses (kg); INFINITY when the field adds no stiffness.
     virtual double stable_step(const double* x, const double* v, const double* mass) const = 0;

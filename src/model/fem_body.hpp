@@ -35,6 +35,7 @@ public:
 
     /// Rayleigh beta (s).
     double damping_stiffness() const { return damping_stiffness_; }
+    bool has_internal_damping() const override { return damping_stiffness_ > 0.0; }
 
     /// Largest stable step (as stable_step) of the tets listed in tets[count] alone.
     double stable_step_of(const int32_t* tets, size_t count) const;

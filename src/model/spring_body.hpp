@@ -15,6 +15,7 @@ public:
                IntegrationSettings settings);
 
     void add_internal_forces(const double* x, const double* v, double* f) const override;
+    bool has_internal_damping() const override { return law_.damping() > 0.0; }
     double elastic_energy(const double* x) const override;
     double stable_step(const double* x) const override;
     void add_tangent(const double* x, double stiffness_scale, double damping_scale,

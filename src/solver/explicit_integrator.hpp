@@ -22,6 +22,8 @@ struct BodyStepResult {
     double factorize_seconds = 0.0; ///< implicit: time in factorisations (s)
     double solve_seconds = 0.0;     ///< implicit: time in solves (s)
     int32_t factorizations = 0;     ///< implicit: factorisations in this step
+    bool not_converged = false;     ///< implicit: Newton missed its tolerance and the step kept
+                                    ///< its best iterate (stable stays true)
 };
 
 

@@ -24,8 +24,14 @@ constexpr int kMaxStaleSolves = 4;
 // Newton iterations allowed to a body with contact candidates, whatever its settings.
 constexpr int kContactNewtonIterations = 20;
 
-// Halvings of an update of bodies solved together before it is taken anyway.
-constexpr int kMaxHalvings = 20;
+// Halvings of a Newton update in the line search before the loop counts as stalled, and
+// Armijo's sufficient-decrease fraction.
+constexpr int kMaxHalvings = 30;
+constexpr double kArmijo = 1e-4;
+
+// The runaway guard's bound: a step with no outside work may not raise the bodies' mechanical
+// energy by more than this times the magnitude of its terms at the start.
+constexpr double kEnergyGrowth = 1.0;
 
 LinearSolverKind solver_kind(sh_linear_solver kind) {
     switch (kind) {
@@ -34,12 +40,6 @@ LinearSolverKind solver_kind(sh_linear_solver kind) {
         case SH_LINEAR_SOLVER_CG: return LinearSolverKind::ConjugateGradient;
         default: return (sh_build_features() & SH_FEATURE_CHOLMOD) ? LinearSolverKind::Cholmod : LinearSolverKind::Ldlt;
     }
-}
-
-double norm(const vec<double>& a) {
-    double s = 0.0;
-    for (double v : a) s += v * v;
-    return std::sqrt(s);
 }
 
 }  // namespace
@@ -118,258 +118,401 @@ void fill_mass_diagonal(const Body& body, ImplicitState& state, double dt) {
     }
 }
 
-// One attempt at the step; allow_stale: updates may use a kept factorisation. used_stale
-// tells whether any did.
-BodyStepResult attempt_step(const NewtonGroup& group, const sh_implicit_settings& s, double dt, const double g[3],
-                            bool allow_stale, bool& used_stale) {
-    BodyStepResult result;
-    result.dt_critical = INFINITY;
-    NewtonSystem& ns = group.newton;
+// The step's incremental potential at one iterate, and the terms it was summed from.
+struct Potential {
+    double value = 0.0;  ///< J
+    double scale = 0.0;  ///< sum of the terms' magnitudes: the round-off of value is eps times it
+    bool finite() const { return std::isfinite(value) && std::isfinite(scale); }
+};
 
-    group.each([&](Body& body, ImplicitState&, size_t) {
-        save_start_state(body);
-        begin_kinematic_motion(body, dt);
-    });
-    const bool reuse = s.factor_reuse > 0.0 && ns.solver->is_direct();  // keep factorisations
-    const uint64_t matrix_version = group.matrix_version();
-    bool factor_current = reuse && allow_stale && ns.factor_valid && ns.factor_dt == dt &&
-                          ns.factor_matrix_version == matrix_version;
+// One implicit step of the bodies of a NewtonGroup as the minimisation of its incremental
+// potential over the end-of-step velocities v (x = x0 + h v):
+//   Phi(v) = 1/2 (v - v0)^T M (v - v0) + h/2 v^T C v + h/2 v^T D0 v + E(x) + P(x) + h W(v)
+//            - h v^T (f_ext + m g)
+// C: mass and node damping; D0: the bodies' internal damping at the step's start (lagged, so
+// that it has a potential); E: elastic energy; P: the contact potential of the step's law
+// (its damping is in the depth, see hunt_crossley_step_law); W: friction's dissipation
+// potential with the normal force lagged. Every force of the step is minus the gradient of a
+// term, so the residual g(v) = M (v - v0) - h F is grad Phi, and projected Newton (the PSD
+// tangent M + h D + h^2 K) with a backtracking line search never accepts an iterate that
+// raises Phi. Its minimum is the backward Euler step.
+class NewtonStep {
+public:
+    NewtonStep(const NewtonGroup& group, const sh_implicit_settings& s, double dt, const double g[3], bool allow_stale)
+        : group_(group), ns_(group.newton), s_(s), dt_(dt), g_(g), allow_stale_(allow_stale) {}
 
-    double applied_load = 0.0;  // |f_ext + m g| over the free DOFs (N)
-    group.each([&](Body& body, ImplicitState& state, size_t) {
+    /// Runs the step. keep_best: a loop that does not converge keeps its last iterate (the
+    /// lowest potential found) instead of failing.
+    BodyStepResult run(bool keep_best);
+
+    bool used_stale = false;  ///< an update was solved with a kept factorisation
+
+private:
+    void begin();
+    void evaluate();
+    double assemble_member(Body& body, ImplicitState& state);
+    bool factorize_and_solve(bool& failed);
+    void take_update(double scale);
+    bool line_search(double slope, bool fresh);
+    BodyStepResult fail(sh_status status, const char* reason);
+    double mechanical_energy(bool at_start, double& scale) const;
+    bool energy_ran_away() const;
+
+    const NewtonGroup& group_;
+    NewtonSystem& ns_;
+    const sh_implicit_settings& s_;
+    const double dt_;
+    const double* g_;
+    const bool allow_stale_;
+    BodyStepResult result_;
+    bool reuse_ = false;           // factorisations are kept
+    bool factor_current_ = false;  // ns_ holds a factorisation usable for this step
+    bool fresh_ = false;           // it is of the tangent at the current iterate
+    uint64_t matrix_version_ = 0;
+    int stale_solves_ = 0;
+    Potential phi_;                // at the current iterate
+    double r_ = 0.0, r_max_ = 0.0; // residual norms (2 and max) at the current iterate
+    double largest_change_ = 0.0, largest_speed_ = 0.0;  // of the last update taken
+    double energy0_ = 0.0, energy_scale0_ = 0.0;  // mechanical energy at the start, its scale
+    bool work_done_ = false;  // moving tools, other bodies or prescribed nodes work on the bodies
+};
+
+// Kinetic + elastic + contact potential + the applied loads' potential (-x . (f_ext + m g)) of
+// the bodies, at the step's start (x0, v0) or now; scale gets the terms' magnitudes.
+double NewtonStep::mechanical_energy(bool at_start, double& scale) const {
+    double total = 0.0;
+    scale = 0.0;
+    group_.each([&](const Body& body, const ImplicitState& state, size_t) {
+        const double* x = at_start ? body.workspace.x0.data() : body.x.data();
+        const double* v = at_start ? body.workspace.v0.data() : body.v.data();
+        const double elastic = body.elastic_energy(x), field = body.field ? body.field->energy(x) : 0.0;
+        double kinetic = 0.0, loads = 0.0;
         for (const int32_t j : state.system.dof_to_global()) {
-            const double load = body.applied_load(static_cast<size_t>(j), g);
+            const size_t k = static_cast<size_t>(j);
+            kinetic += 0.5 * body.mass[k / 3] * v[k] * v[k];
+            loads -= body.applied_load(k, g_) * x[k];
+        }
+        total += kinetic + elastic + field + loads;
+        scale += kinetic + std::fabs(elastic) + field + std::fabs(loads);
+    });
+    return total;
+}
+
+// The runaway guard: with no work done on the bodies from outside (moving tools, other bodies,
+// prescribed motion), a backward Euler step cannot raise their mechanical energy. A step that
+// raised it by more than kEnergyGrowth times its start's scale has gone wrong, whatever its
+// speeds.
+bool NewtonStep::energy_ran_away() const {
+    if (work_done_) return false;
+    double scale = 0.0;
+    const double energy = mechanical_energy(false, scale);
+    const double allowed = kEnergyGrowth * energy_scale0_ + 1e-12;
+    return !std::isfinite(energy) || energy - energy0_ > allowed;
+}
+
+void NewtonStep::begin() {
+    work_done_ = false;
+    group_.each([&](Body& body, ImplicitState&, size_t) {
+        save_start_state(body);
+        begin_kinematic_motion(body, dt_);
+        for (size_t j = 0; j < body.v.size() && !work_done_; ++j) work_done_ = body.kinematic[j / 3] && body.v[j] != 0.0;
+        work_done_ = work_done_ || (body.field && body.field->does_work());
+        // The internal damping's lagged base: elastic forces at the start state.
+        if (!body.has_internal_damping()) return;
+        vec<double>& base = body.workspace.a[1];
+        std::fill(base.begin(), base.end(), 0.0);
+        body.add_internal_forces(body.workspace.x0.data(), nullptr, base.data());
+    });
+    if (!work_done_) energy0_ = mechanical_energy(true, energy_scale0_);
+    reuse_ = s_.factor_reuse > 0.0 && ns_.solver->is_direct();
+    matrix_version_ = group_.matrix_version();
+    factor_current_ = reuse_ && allow_stale_ && ns_.factor_valid && ns_.factor_dt == dt_ &&
+                      ns_.factor_matrix_version == matrix_version_;
+}
+
+// Moves every body to x = x0 + h v, then fills ns_.residual with g(v), r_, r_max_ and phi_.
+// Every body moves first: the forces between bodies solved together see both ends.
+void NewtonStep::evaluate() {
+    const double h = dt_;
+    group_.each([&](Body& body, ImplicitState&, size_t) {
+        for (size_t j = 0; j < body.x.size(); ++j) body.x[j] = body.workspace.x0[j] + h * body.v[j];
+    });
+    Potential phi;
+    double sum2 = 0.0;
+    r_max_ = 0.0;
+    group_.each([&](Body& body, ImplicitState& state, size_t offset) {
+        double* f = body.workspace.a[0].data();
+        std::fill(f, f + body.x.size(), 0.0);
+        body.add_internal_forces(body.x.data(), nullptr, f);
+        double* damping = nullptr;  // -D0 v, the lagged internal damping force
+        if (body.has_internal_damping()) {
+            damping = body.workspace.a[2].data();
+            std::fill(damping, damping + body.x.size(), 0.0);
+            body.add_internal_forces(body.workspace.x0.data(), body.v.data(), damping);
+            const double* base = body.workspace.a[1].data();
+            for (size_t j = 0; j < body.x.size(); ++j) damping[j] -= base[j];
+        }
+        if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
+        const double elastic = body.elastic_energy(body.x.data());
+        const double field = body.field ? body.field->energy(body.x.data()) + h * body.field->dissipation(body.v.data()) : 0.0;
+        phi.value += elastic + field;
+        phi.scale += std::fabs(elastic) + std::fabs(field);
+        const bool per_node = !body.node_damping.empty();
+        const vec<int32_t>& global = state.system.dof_to_global();
+        for (size_t d = 0; d < global.size(); ++d) {
+            const size_t j = static_cast<size_t>(global[d]), node = j / 3;
+            const double m = body.mass[node], v = body.v[j], dv = v - body.workspace.v0[j];
+            const double c = body.settings.damping_mass + (per_node ? body.node_damping[node] : 0.0);
+            const double load = body.applied_load(j, g_), fd = damping ? damping[j] : 0.0;
+            const double r_d = m * dv + h * m * c * v - h * (f[j] + fd + load);
+            ns_.residual[offset + d] = r_d;
+            sum2 += r_d * r_d;
+            r_max_ = std::max(r_max_, std::fabs(r_d));
+            const double terms[4] = {0.5 * m * dv * dv, 0.5 * h * m * c * v * v, -0.5 * h * v * fd, -h * v * load};
+            for (const double t : terms) {
+                phi.value += t;
+                phi.scale += std::fabs(t);
+            }
+        }
+    });
+    r_ = std::sqrt(sum2);
+    phi_ = phi;
+}
+
+// m (1 + dt c) + dt D + dt^2 K of one body into its own system; its force round-off.
+double NewtonStep::assemble_member(Body& body, ImplicitState& state) {
+    fill_mass_diagonal(body, state, dt_);
+    return assemble_body_tangent(body, state, dt_ * dt_, dt_, body.v.data(), state.diagonal.data(), 1.0 / dt_);
+}
+
+// Solves the tangent system for the update delta = -H^-1 g into ns_.delta, with a new
+// factorisation at the current iterate unless a kept one may serve. False (failed set) if the
+// factorisation or solve failed; throws what is not a solver failure.
+bool NewtonStep::factorize_and_solve(bool& failed) {
+    failed = false;
+    try {
+        if (!factor_current_ || stale_solves_ == kMaxStaleSolves) {
+            ns_.factor_valid = false;
+            ns_.roundoff_floor = group_.assemble([&](Body& b, ImplicitState& st) { return assemble_member(b, st); }, dt_ * dt_,
+                                                 dt_, false);
+            ns_.solver->factorize(ns_.system);
+            result_.factorize_seconds += ns_.solver->factorize_seconds;
+            ++result_.factorizations;
+            ns_.factor_valid = reuse_;
+            ns_.factor_dt = dt_;
+            ns_.factor_matrix_version = matrix_version_;
+            factor_current_ = true;
+            fresh_ = true;
+            stale_solves_ = 0;
+        }
+        for (double& r_d : ns_.residual) r_d = -r_d;
+        result_.linear_iterations += ns_.solver->solve(ns_.system, ns_.residual.data(), ns_.delta.data());
+        for (double& r_d : ns_.residual) r_d = -r_d;
+        result_.solve_seconds += ns_.solver->solve_seconds;
+    } catch (const Error& e) {
+        if (e.status() != SH_ERR_NOT_CONVERGED && e.status() != SH_ERR_SOLVER) throw;
+        result_.status = e.status();
+        failed = true;
+    }
+    return !failed;
+}
+
+// v = previous_v + scale delta, then evaluate().
+void NewtonStep::take_update(double scale) {
+    largest_change_ = largest_speed_ = 0.0;
+    group_.each([&](Body& body, ImplicitState& state, size_t offset) {
+        const vec<int32_t>& global = state.system.dof_to_global();
+        for (size_t d = 0; d < global.size(); ++d) {
+            double& v = body.v[static_cast<size_t>(global[d])];
+            v = ns_.previous_v[offset + d] + scale * ns_.delta[offset + d];
+            largest_change_ = std::max(largest_change_, std::fabs(scale * ns_.delta[offset + d]));
+            largest_speed_ = std::max(largest_speed_, std::fabs(v));
+        }
+    });
+    evaluate();
+}
+
+// Backtracks along delta from the iterate in previous_v (potential phi0 = phi_, slope
+// g^T delta < 0) until Phi falls by Armijo's rule (to round-off). A kept factorisation's
+// update must also be full length and cut the residual by kStaleContraction. Returns false,
+// back at the iterate, if no step length qualifies.
+bool NewtonStep::line_search(double slope, bool fresh) {
+    const Potential phi0 = phi_;
+    const double r0 = r_, r0_max = r_max_;
+    // Phi's round-off: of its sum, and of the forces (ns_.roundoff_floor, in residual units)
+    // along the update, which element energies computed from position differences carry.
+    double length = 0.0;
+    for (const double d : ns_.delta) length += d * d;
+    length = std::sqrt(length);
+    const double sum_roundoff = 64.0 * std::numeric_limits<double>::epsilon() * phi0.scale;
+    double scale = 1.0;
+    for (int halving = 0; halving <= (fresh ? kMaxHalvings : 0); ++halving, scale *= 0.5) {
+        take_update(scale);
+        const double roundoff = sum_roundoff + 4.0 * ns_.roundoff_floor * scale * length;
+        if (!phi_.finite() || phi_.value > phi0.value + kArmijo * scale * slope + roundoff) continue;
+        if (fresh) return true;
+        const double floor = ns_.roundoff_floor;
+        if (r_ <= std::max(kStaleContraction * r0, floor) && r_max_ <= std::max(kStaleContraction * r0_max, floor)) return true;
+    }
+    take_update(0.0);
+    phi_ = phi0;
+    r_ = r0;
+    r_max_ = r0_max;
+    return false;
+}
+
+BodyStepResult NewtonStep::fail(sh_status status, const char* reason) {
+    group_.each([](Body& body, ImplicitState&, size_t) { restore_start_state(body); });
+    ns_.factor_valid = false;  // built at an iterate that went wrong
+    result_.stable = false;
+    result_.status = status;
+    result_.reason = reason;
+    return result_;
+}
+
+BodyStepResult NewtonStep::run(bool keep_best) {
+    result_.dt_critical = INFINITY;
+    begin();
+    double applied_load = 0.0;  // |f_ext + m g| over the free DOFs (N)
+    group_.each([&](Body& body, ImplicitState& state, size_t) {
+        for (const int32_t j : state.system.dof_to_global()) {
+            const double load = body.applied_load(static_cast<size_t>(j), g_);
             applied_load += load * load;
         }
     });
     applied_load = std::sqrt(applied_load);
-    const double gravity_norm = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    const double gravity_norm = std::sqrt(g_[0] * g_[0] + g_[1] * g_[1] + g_[2] * g_[2]);
 
-    // Newton on g(v) = M (v - v0) - dt F(x0 + dt v, v) over the free DOFs, from v = v0.
-    double largest_residual = 0.0;  // max norm of the last residual_norm()
-    auto residual_norm = [&] {
-        // Every body moves first: the forces between bodies solved together see both ends.
-        group.each([&](Body& body, ImplicitState&, size_t) {
-            for (size_t j = 0; j < body.x.size(); ++j) body.x[j] = body.workspace.x0[j] + dt * body.v[j];
-        });
-        largest_residual = 0.0;
-        group.each([&](Body& body, ImplicitState& state, size_t offset) {
-            double* a = body.workspace.a[0].data();
-            compute_accelerations(body, body.x.data(), body.v.data(), g, a);
-            const vec<int32_t>& global = state.system.dof_to_global();
-            for (size_t d = 0; d < global.size(); ++d) {
-                const size_t j = static_cast<size_t>(global[d]);
-                const double r_d = body.mass[j / 3] * (body.v[j] - body.workspace.v0[j] - dt * a[j]);
-                ns.residual[offset + d] = r_d;
-                largest_residual = std::max(largest_residual, std::fabs(r_d));
-            }
-        });
-        return norm(ns.residual);
-    };
-    auto restore = [&] {
-        group.each([](Body& body, ImplicitState&, size_t) { restore_start_state(body); });
-        ns.factor_valid = false;  // built at an iterate that went wrong
-    };
-    auto fail = [&](sh_status status, const char* reason) {
-        restore();
-        result.stable = false;
-        result.status = status;
-        result.reason = reason;
-        return result;
-    };
-    // m (1 + dt c) + dt D + dt^2 K of one body into its own system; its force round-off.
-    auto assemble_member = [&](Body& body, ImplicitState& state) {
-        fill_mass_diagonal(body, state, dt);
-        return assemble_body_tangent(body, state, dt * dt, dt, body.v.data(), state.diagonal.data(), 1.0 / dt);
-    };
-
-    // The incremental potential whose minimum the step is, at the bodies' current v (and x):
-    // 1/2 (v - v0)^T M (v - v0) + dt/2 v^T C v (mass and node damping) + elastic and field
-    // energy at x - dt v^T (f_ext + m g), over the free DOFs. Its gradient is the residual but
-    // for the internal, contact and friction damping, which have no potential.
-    auto step_potential = [&] {
-        double total = 0.0;
-        group.each([&](const Body& body, const ImplicitState& state, size_t) {
-            const vec<int32_t>& global = state.system.dof_to_global();
-            const bool per_node = !body.node_damping.empty();
-            for (size_t d = 0; d < global.size(); ++d) {
-                const size_t j = static_cast<size_t>(global[d]), node = j / 3;
-                const double m = body.mass[node], dv = body.v[j] - body.workspace.v0[j];
-                const double c = body.settings.damping_mass + (per_node ? body.node_damping[node] : 0.0);
-                total += 0.5 * m * dv * dv + 0.5 * dt * m * c * body.v[j] * body.v[j] - dt * body.v[j] * body.applied_load(j, g);
-            }
-            total += body.elastic_energy(body.x.data()) + (body.field ? body.field->energy(body.x.data()) : 0.0);
-        });
-        return total;
-    };
-
-    // Contacts switch on and off within a step, which a single linearised update cannot
-    // follow (it cycles between too deep and too shallow): a body in contact iterates.
+    // Contacts switch on and off within a step, which a single update cannot follow: a body
+    // in contact iterates.
     bool in_contact = false;
-    group.each([&](const Body& body, const ImplicitState&, size_t) { in_contact |= body.field != nullptr; });
-    const int max_iterations = std::max(in_contact ? kContactNewtonIterations : 1, s.newton_max_iterations);
+    group_.each([&](const Body& body, const ImplicitState&, size_t) { in_contact |= body.field != nullptr; });
+    const int max_iterations = std::max(in_contact ? kContactNewtonIterations : 1, s_.newton_max_iterations);
     const bool linearised = max_iterations == 1;
-    double r = residual_norm(), r_max = largest_residual;
-    const double residual0 = std::max(r, dt * applied_load);
-    // Updates with a kept factorisation must reach this in both norms: the max norm keeps a
-    // small badly-solved region from hiding in the sum.
-    const double target = s.factor_reuse * r, target_max = s.factor_reuse * r_max;
-    result.newton_residual = -1.0;
+    try {
+        evaluate();
+    } catch (...) {
+        fail(SH_ERR_INTERNAL, "");
+        throw;
+    }
+    const double residual0 = std::max(r_, dt_ * applied_load);
+    // A linearised step's updates with a kept factorisation go on until both norms are down
+    // by factor_reuse (the max norm keeps a small badly-solved region from hiding in the sum).
+    const double target = s_.factor_reuse * r_, target_max = s_.factor_reuse * r_max_;
+    result_.newton_residual = -1.0;
     bool converged = residual0 == 0.0;
-    bool fresh = false;    // the factorisation is of the tangent at the current iterate
-    int stale_solves = 0;  // solves with a kept factorisation since the last factorisation
-    for (int iteration = 0; !converged;) {
-        // Converged: small against the first residual or the applied load's impulse, or down
-        // to the round-off of the element forces themselves.
-        if (iteration > 0 && r <= std::max(s.newton_tolerance * residual0, ns.roundoff_floor)) {
-            converged = true;
-            break;
-        }
-        if (iteration == max_iterations) break;
-
-        try {
-            if (!factor_current || stale_solves == kMaxStaleSolves) {
-                ns.factor_valid = false;
-                ns.roundoff_floor = group.assemble(assemble_member, dt * dt, dt, false);
-                ns.solver->factorize(ns.system);
-                result.factorize_seconds += ns.solver->factorize_seconds;
-                ++result.factorizations;
-                ns.factor_valid = reuse;
-                ns.factor_dt = dt;
-                ns.factor_matrix_version = matrix_version;
-                factor_current = true;
-                fresh = true;
-                stale_solves = 0;
+    bool solver_failed = false;
+    int iteration = 0;
+    try {
+        while (!converged) {
+            // Converged: the residual is small against the first one or the applied load's
+            // impulse, or down to the round-off of the element forces themselves.
+            if (iteration > 0 && r_ <= std::max(s_.newton_tolerance * residual0, ns_.roundoff_floor)) {
+                converged = true;
+                break;
             }
-            for (double& r_d : ns.residual) r_d = -r_d;
-            result.linear_iterations += ns.solver->solve(ns.system, ns.residual.data(), ns.delta.data());
-            result.solve_seconds += ns.solver->solve_seconds;
-        } catch (const Error& e) {
-            if (e.status() == SH_ERR_NOT_CONVERGED) return fail(e.status(), "the linear solver did not converge");
-            if (e.status() == SH_ERR_SOLVER)
-                return fail(e.status(), "the sparse factorisation or solve failed (matrix not positive definite, "
-                                        "or a non-finite value)");
-            restore();  // anything else (capacity, internal) goes up unchanged
-            throw;
-        } catch (...) {  // out of memory: nothing half done stays behind
-            restore();
-            throw;
-        }
-        group.each([&](Body& body, ImplicitState& state, size_t offset) {
-            const vec<int32_t>& global = state.system.dof_to_global();
-            for (size_t d = 0; d < global.size(); ++d) ns.previous_v[offset + d] = body.v[static_cast<size_t>(global[d])];
-        });
-        double largest_change = 0.0, largest_speed = 0.0;
-        // v = previous_v + scale delta.
-        auto take_update = [&](double scale) {
-            largest_change = largest_speed = 0.0;
-            group.each([&](Body& body, ImplicitState& state, size_t offset) {
+            if (iteration == max_iterations) break;
+            bool failed = false;
+            if (!factorize_and_solve(failed)) {
+                solver_failed = true;
+                break;
+            }
+            group_.each([&](Body& body, ImplicitState& state, size_t offset) {
                 const vec<int32_t>& global = state.system.dof_to_global();
-                for (size_t d = 0; d < global.size(); ++d) {
-                    double& v = body.v[static_cast<size_t>(global[d])];
-                    v = ns.previous_v[offset + d] + scale * ns.delta[offset + d];
-                    largest_change = std::max(largest_change, std::fabs(scale * ns.delta[offset + d]));
-                    largest_speed = std::max(largest_speed, std::fabs(v));
-                }
+                for (size_t d = 0; d < global.size(); ++d) ns_.previous_v[offset + d] = body.v[static_cast<size_t>(global[d])];
             });
-        };
-        // Bodies solved together: the update backtracks until the incremental potential falls
-        // (Armijo) or the residual does. Contacts that switch within an update make the
-        // residual a poor guide on its own (two-sided contact between soft bodies has contacts
-        // resting at zero depth), the potential is not.
-        const bool search = group.coupled && fresh;
-        double potential0 = 0.0, slope = 0.0;  // at the iterate, and along delta
-        if (search) {
-            potential0 = step_potential();
-            for (size_t d = 0; d < ns.delta.size(); ++d) slope += ns.residual[d] * ns.delta[d];  // residual holds -g
-            slope = -slope;
-        }
-        double scale = 1.0;
-        take_update(scale);
-        double r_new = residual_norm(), r_new_max = largest_residual;
-        for (int halving = 0; search && halving < kMaxHalvings; ++halving) {
-            if (r_new < r || step_potential() <= potential0 + 1e-4 * scale * slope) break;
-            scale *= 0.5;
-            take_update(scale);
-            r_new = residual_norm();
-            r_new_max = largest_residual;
-        }
-        if (!fresh) {
-            ++stale_solves;
-            used_stale = true;
-            const double floor = ns.roundoff_floor;  // nothing to gain below it
-            if (!(r_new <= std::max(kStaleContraction * r, floor) &&
-                  r_new_max <= std::max(kStaleContraction * r_max, floor))) {
-                // The kept factorisation is too far from the current tangent: take the update
-                // back and solve again with a new one here.
-                take_update(0.0);
-                r = residual_norm();
-                r_max = largest_residual;
-                factor_current = false;
+            double slope = 0.0;  // d Phi / d scale along delta, at scale 0
+            for (size_t d = 0; d < ns_.delta.size(); ++d) slope += ns_.residual[d] * ns_.delta[d];
+            const bool fresh = fresh_;
+            if (!(slope < 0.0) || !line_search(slope, fresh)) {
+                    if (!fresh) {  // the kept factorisation is too far from the current tangent
+                    factor_current_ = false;
+                    continue;
+                }
+                // No descent left along Newton's direction: converged if the residual is as
+                // small as asked or down to the forces' round-off, else stalled.
+                converged = r_ <= std::max(s_.newton_tolerance * residual0, ns_.roundoff_floor);
+                break;
+            }
+            if (!fresh) {
+                ++stale_solves_;
+                used_stale = true;
+            }
+            fresh_ = false;
+            factor_current_ = reuse_ && allow_stale_;  // exact Newton (or CG): a tangent per iterate
+            ++result_.newton_iterations;
+            result_.newton_residual = residual0 > 0.0 ? r_ / residual0 : 0.0;
+            if (linearised) {
+                // One update with the tangent at its iterate is the linearised step; updates
+                // with a kept factorisation go on until they are as good as factor_reuse asks.
+                const double floor = ns_.roundoff_floor;
+                if (fresh || (r_ <= std::max(target, floor) && r_max_ <= std::max(target_max, floor))) converged = true;
                 continue;
             }
+            ++iteration;
+            // Near equilibrium of a stiff body the residual is cancellation noise of large
+            // element forces, so a negligible whole velocity correction also ends the loop.
+            const double speed_scale = std::max({largest_speed_, dt_ * gravity_norm, kSpeedFloor});
+            if (iteration > 1 && largest_change_ <= s_.newton_tolerance * speed_scale) converged = true;
         }
-        const bool was_fresh = fresh;
-        r = r_new;
-        r_max = r_new_max;
-        fresh = false;
-        factor_current = reuse && allow_stale;  // exact Newton (or CG): a tangent per iterate
-        ++result.newton_iterations;
-        result.newton_residual = residual0 > 0.0 ? r / residual0 : 0.0;
-        if (linearised) {
-            // One update with the tangent at its iterate is the linearised step; updates with a
-            // kept factorisation go on until they are at least as good as factor_reuse asks.
-            const double floor = ns.roundoff_floor;
-            if (was_fresh || (r <= std::max(target, floor) && r_max <= std::max(target_max, floor))) converged = true;
-            continue;
-        }
-        ++iteration;
-        // Near equilibrium of a stiff body the residual is cancellation noise of large element
-        // forces, so a negligible velocity correction (a whole one) also ends the iteration.
-        const double speed_scale = std::max({largest_speed, dt * gravity_norm, kSpeedFloor});
-        if (iteration > 1 && scale == 1.0 && largest_change <= s.newton_tolerance * speed_scale) converged = true;
+    } catch (...) {
+        fail(SH_ERR_INTERNAL, "");  // out of memory or an internal error: nothing half done stays
+        throw;
     }
+    // The last iterate is the best: the line search never raised the potential.
+    const bool progressed = result_.newton_iterations > 0;
+    if (!converged && !(keep_best && progressed)) {
+        if (solver_failed && result_.status == SH_ERR_SOLVER)
+            return fail(SH_ERR_SOLVER, "the sparse factorisation or solve failed (matrix not positive definite, or a "
+                                       "non-finite value)");
+        if (solver_failed) return fail(SH_ERR_NOT_CONVERGED, "the linear solver did not converge");
+        return fail(SH_ERR_NOT_CONVERGED, "Newton iterations did not reach newton_tolerance");
+    }
+    result_.not_converged = !converged;
+    result_.status = SH_OK;
     bool sane = true;
-    group.each([&](Body& body, ImplicitState&, size_t) {
+    group_.each([&](Body& body, ImplicitState&, size_t) {
         end_kinematic_motion(body);
         sane = sane && body_state_is_sane(body);
     });
-    if (!converged) return fail(SH_ERR_NOT_CONVERGED, "Newton iterations did not reach newton_tolerance");
     if (!sane) return fail(SH_ERR_UNSTABLE, kRolledBackReason);
-    return result;
+    if (energy_ran_away())
+        return fail(SH_ERR_UNSTABLE, "the mechanical energy grew with no work done on the body (runaway); rolled back");
+    return result_;
 }
 
 // The step, retried with a factorisation at every iterate if a kept one took it somewhere bad.
-BodyStepResult run_step(const NewtonGroup& group, const sh_implicit_settings& s, double dt, const double g[3]) {
-    bool used_stale = false;
-    BodyStepResult result = attempt_step(group, s, dt, g, true, used_stale);
-    if (result.stable || !used_stale) return result;
+BodyStepResult run_step(const NewtonGroup& group, const sh_implicit_settings& s, double dt, const double g[3],
+                        bool keep_best) {
+    NewtonStep first(group, s, dt, g, true);
+    const BodyStepResult result = first.run(keep_best);
+    if (result.stable || !first.used_stale) return result;
     // The bodies are back at their start state.
-    const BodyStepResult first = result;
-    result = attempt_step(group, s, dt, g, false, used_stale);
-    result.newton_iterations += first.newton_iterations;
-    result.linear_iterations += first.linear_iterations;
-    result.factorize_seconds += first.factorize_seconds;
-    result.solve_seconds += first.solve_seconds;
-    result.factorizations += first.factorizations;
-    return result;
+    NewtonStep again(group, s, dt, g, false);
+    BodyStepResult sum = again.run(keep_best);
+    sum.newton_iterations += result.newton_iterations;
+    sum.linear_iterations += result.linear_iterations;
+    sum.factorize_seconds += result.factorize_seconds;
+    sum.solve_seconds += result.solve_seconds;
+    sum.factorizations += result.factorizations;
+    return sum;
 }
 
 }  // namespace
 
-BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double g[3]) {
+BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double g[3], bool keep_best) {
     prepare_implicit_state(body, state, body.settings.implicit);
-    return run_step(NewtonGroup::alone(body, state), body.settings.implicit, dt, g);
+    return run_step(NewtonGroup::alone(body, state), body.settings.implicit, dt, g, keep_best);
 }
 
-BodyStepResult step_implicit_coupled(CoupledSystem& system, double dt, const double g[3]) {
+BodyStepResult step_implicit_coupled(CoupledSystem& system, double dt, const double g[3], bool keep_best) {
     sh_implicit_settings s = system.member(0).body->settings.implicit;
     for (int32_t m = 1; m < system.member_count(); ++m) {
         const sh_implicit_settings& other = system.member(m).body->settings.implicit;
         s.newton_tolerance = std::min(s.newton_tolerance, other.newton_tolerance);
         s.newton_max_iterations = std::max(s.newton_max_iterations, other.newton_max_iterations);
     }
-    return run_step(NewtonGroup::together(system), s, dt, g);
+    return run_step(NewtonGroup::together(system), s, dt, g, keep_best);
 }
 
 }  // namespace sh

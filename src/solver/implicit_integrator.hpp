@@ -1,6 +1,7 @@
-// Backward (implicit) Euler for one body: Newton iterations on the end-of-step velocity,
-// starting from the current one (one iteration = the linearised Baraff-Witkin step), with the
-// sparse system and linear solver kept across steps while the set of free nodes is unchanged.
+// Backward (implicit) Euler for one body as the minimisation of the step's incremental
+// potential over the end-of-step velocity: projected Newton with a backtracking line search,
+// starting from the current velocity (one iteration = the linearised Baraff-Witkin step), with
+// the sparse system and linear solver kept across steps while the set of free nodes is unchanged.
 // Direct solvers also keep their factorisation across iterations and steps (a chord/lagged
 // Newton method) while the updates it gives cut the residual fast enough. The same Newton loop
 // steps bodies coupled by contact together (CoupledSystem).
@@ -50,16 +51,16 @@ struct ImplicitState : NewtonSystem {
 /// On a failed factorisation (SH_ERR_SOLVER), a
 /// Newton loop that misses its tolerance (SH_ERR_NOT_CONVERGED) or a non-finite or runaway
 /// state (SH_ERR_UNSTABLE) the body is restored and result.status says why.
-BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double gravity[3]);
+/// keep_best: a Newton loop that does not converge keeps its last iterate, the lowest
+/// incremental potential it reached (result.not_converged), instead of failing.
+BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double gravity[3],
+                             bool keep_best = false);
 
 /// step_implicit for the members of system (prepared), as one Newton loop on their joint
 /// residual: every member has contact (at least 20 iterations), the tolerance is the strictest
 /// member's, the iteration cap the largest, the linear solver and factor_reuse the first
-/// member's. An update with a fresh factorisation is halved (up to 20 times) until the step's
-/// incremental potential (Armijo) or the residual falls: between soft bodies in stiff two-sided
-/// contact, contacts resting at zero depth make plain Newton cycle. On failure every member is
-/// restored.
-BodyStepResult step_implicit_coupled(CoupledSystem& system, double dt, const double gravity[3]);
+/// member's. On failure every member is restored.
+BodyStepResult step_implicit_coupled(CoupledSystem& system, double dt, const double gravity[3], bool keep_best = false);
 
 /// Round-off level of internal forces computed at positions x: they come from position
 /// differences that carry about eps |x|, which a stiffness turns into eps |x| K_dd per DOF.

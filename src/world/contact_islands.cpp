@@ -73,7 +73,7 @@ void ContactIslands::drop_unused() {
     for (Kept& k : kept_) k.used = false;
 }
 
-void World::step_islands(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed) {
+void World::step_islands(double h, sh_step_report& r, vec<uint8_t>& skip) {
     ContactIslands& islands = *islands_;
     for (int32_t i = 0; i < islands.island_count(); ++i) {
         const uint32_t* members = islands.members(i);
@@ -82,8 +82,10 @@ void World::step_islands(double h, sh_step_report& r, Failure& failure, vec<uint
         islands.states.clear();
         islands.doublings.clear();
         islands.ids.clear();
+        bool keep_best = false;  // the island's last attempt is that of any member's
         for (int32_t m = 0; m < count; ++m) {
             Slot& slot = slots_[members[m]];
+            keep_best |= slot.keep_best;
             if (!slot.implicit) slot.implicit = sh::create<ImplicitState>();
             islands.bodies.push_back(slot.body);
             islands.states.push_back(slot.implicit);
@@ -99,7 +101,7 @@ void World::step_islands(double h, sh_step_report& r, Failure& failure, vec<uint
                                                          [&](double half) { return step_implicit_coupled(system, half, gravity).stable; });
         }
         for (Body* body : islands.bodies) body->clear_inverted_elements();
-        const BodyStepResult result = step_implicit_coupled(system, h, gravity);
+        const BodyStepResult result = step_implicit_coupled(system, h, gravity, keep_best);
         for (int32_t m = 0; m < count && error_estimate_; ++m) {
             if (half_steps_stable && result.stable && r.error_estimate >= 0.0)
                 r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*islands.bodies[static_cast<size_t>(m)],
@@ -108,7 +110,7 @@ void World::step_islands(double h, sh_step_report& r, Failure& failure, vec<uint
                 r.error_estimate = -1.0;
         }
         add_step_figures(r, result);
-        for (int32_t m = 0; m < count; ++m) note_result(members[m], result, r, failure, failed);
+        for (int32_t m = 0; m < count; ++m) note_result(members[m], result, r, skip);
     }
     islands.drop_unused();
 }

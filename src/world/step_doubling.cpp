@@ -36,7 +36,7 @@ bool take_half_steps(Body& body, StepDoubling& scratch, double dt, const double 
     Body* bodies[1] = {&body};
     StepDoubling* scratches[1] = {&scratch};
     return take_half_steps_together(bodies, scratches, 1, dt,
-                                    [&](double h) { return step_body(body, scratch.implicit, h, gravity).stable; });
+                                    [&](double h) { return step_body(body, scratch.implicit, h, gravity, false).stable; });
 }
 
 double largest_half_step_difference(const Body& body, const StepDoubling& scratch) {

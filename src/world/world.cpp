@@ -90,6 +90,16 @@ sh_body_id World::add_body(Body* body) {
         }
     }
     Slot& slot = slots_[index];
+    try {
+        // Room for the step's start state and attempt flags, so that a step allocates nothing.
+        slot.saved.reserve(body->x.size() + body->v.size());
+        skip_.reserve(slots_.size());
+    } catch (...) {
+        free_slots_.push_back(index);
+        sh::destroy(doubling);
+        sh::destroy(body);
+        throw;
+    }
     slot.body = body;
     slot.doubling = doubling;
     slot.generation = next_generation();
@@ -191,12 +201,12 @@ void World::remove_haptic(HapticContext* haptic) {
     haptics_.erase(std::remove(haptics_.begin(), haptics_.end(), haptic), haptics_.end());
 }
 
-void World::step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed) {
+void World::step_bodies(double h, sh_step_report& r, vec<uint8_t>& skip) {
     // Implicit bodies pressing on each other are stepped together, island by island.
-    const bool coupled = group_islands(true, failed);
+    const bool coupled = group_islands(true, &skip);
     for (size_t index = 0; index < slots_.size(); ++index) {
         Slot& slot = slots_[index];
-        if (!slot.body || (failed && (*failed)[index])) continue;
+        if (!slot.body || skip[index]) continue;
         if (coupled && islands_->island_of(index) >= 0) continue;
         bool half_steps_stable = false;
         if (slot.doubling) {
@@ -204,7 +214,7 @@ void World::step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8
             half_steps_stable = take_half_steps(*slot.body, *slot.doubling, h, gravity);
         }
         slot.body->clear_inverted_elements();
-        const BodyStepResult result = step_body(*slot.body, slot.implicit, h, gravity);
+        const BodyStepResult result = step_body(*slot.body, slot.implicit, h, gravity, slot.keep_best);
         if (slot.doubling) {
             if (half_steps_stable && result.stable && r.error_estimate >= 0.0)
                 r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*slot.body, *slot.doubling));
@@ -212,23 +222,20 @@ void World::step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8
                 r.error_estimate = -1.0;
         }
         add_step_figures(r, result);
-        note_result(index, result, r, failure, failed);
+        note_result(index, result, r, skip);
     }
-    if (coupled) step_islands(h, r, failure, failed);
+    if (coupled) step_islands(h, r, skip);
     else if (islands_) islands_->drop_unused();
 }
 
-void World::note_result(size_t index, const BodyStepResult& result, sh_step_report& r, Failure& failure,
-                        vec<uint8_t>* failed) {
-    if (slots_[index].body->inverted_elements() > 0) r.warnings |= 1u << SH_WARN_INVERTED;
+void World::note_result(size_t index, const BodyStepResult& result, sh_step_report& r, vec<uint8_t>& skip) {
+    Slot& slot = slots_[index];
+    if (slot.body->inverted_elements() > 0) r.warnings |= 1u << SH_WARN_INVERTED;
+    if (result.not_converged) r.warnings |= 1u << SH_WARN_NOT_CONVERGED;
     if (result.stable) return;
-    r.warnings |= 1u << SH_WARN_UNSTABLE;
-    ++r.unstable_body_count;
-    if (failed) (*failed)[index] = 1;
-    if (failure.body == SH_NULL_BODY) {
-        failure.body = id_of(index);
-        failure.result = result;
-    }
+    skip[index] = 1;  // the body sits out the rest of this attempt
+    slot.failure = result;
+    slot.failed = true;
 }
 
 bool World::group_islands(bool implicit_only, const vec<uint8_t>* failed) {
@@ -277,8 +284,14 @@ uint32_t World::detect_contacts(double h, double travel_fraction, double extra_r
         if (BodyContacts::detect_pair(*b.contacts, *a.contacts, pair.params)) warning_bits |= 1u << SH_WARN_CAPACITY;
         pair.has_candidates = a.contacts->candidate_count() + b.contacts->candidate_count() > before;
     }
+    // Implicit bodies take each candidate's depth at the step's start for the depth rate of
+    // the step's contact law: with the colliders where the (sub)step starts.
+    for (ColliderSlot& c : colliders_)
+        if (c.collider) std::swap(c.collider->pose, c.collider->previous);
     for (Slot& slot : slots_)
-        if (slot.body) slot.body->field = slot.contacts->finish_detection();
+        if (slot.body) slot.body->field = slot.contacts->finish_detection(h);
+    for (ColliderSlot& c : colliders_)
+        if (c.collider) std::swap(c.collider->pose, c.collider->previous);
     return warning_bits;
 }
 
@@ -305,59 +318,19 @@ void World::step(double dt, sh_step_report* report) {
     const double start = now_seconds();
     sh_step_report r{};
     r.substeps = 1;
-    r.contact_substeps = 1;
     r.error_estimate = error_estimate_ ? 0.0 : -1.0;
     r.dt_critical = INFINITY;
-    Failure failure;
     for (HapticContext* haptic : haptics_) haptic->before_step(*this);
-    if (!has_contact()) {
-        step_bodies(dt, r, failure, nullptr);
-    } else {
-        // Tools move from their last pose to the host's in sub-steps short enough that none
-        // crosses more than half its inner radius at once.
-        double substeps = 1.0;
-        for (ColliderSlot& c : colliders_) {
-            if (!c.collider) continue;
-            c.collider->begin_step(dt);
-            const double travel = c.collider->travel(), limit = 0.5 * c.collider->shape.inner_radius();
-            if (travel > limit) substeps = std::max(substeps, std::ceil(travel / limit));
-        }
-        substeps = std::min(substeps, kMaxContactSubsteps);
-        r.contact_substeps = static_cast<int32_t>(substeps);
-        const double h = dt / substeps;
-        if (r.contact_substeps > 1) {
-            // A body that fails in a later sub-step goes back to its state before the call.
-            failed_.assign(slots_.size(), 0);
-            for (Slot& slot : slots_) {
-                if (!slot.body) continue;
-                slot.saved.assign(slot.body->x.begin(), slot.body->x.end());
-                slot.saved.insert(slot.saved.end(), slot.body->v.begin(), slot.body->v.end());
-            }
-        }
-        try {
-            for (int32_t s = 0; s < r.contact_substeps; ++s) {
-                const double fraction = (s + 1) / substeps;
-                for (ColliderSlot& c : colliders_)
-                    if (c.collider && c.collider->is_tool) c.collider->pose = interpolate(c.collider->start, c.collider->target, fraction);
-                {
-                    const ScopedTimer timer(r.collision_seconds);
-                    r.warnings |= detect_contacts(h, 1.0 / substeps, 0.0);
-                }
-                step_bodies(h, r, failure, r.contact_substeps > 1 ? &failed_ : nullptr);
-            }
-        } catch (...) {
-            for (Slot& slot : slots_)
-                if (slot.body) slot.body->field = nullptr;
-            throw;
-        }
-        if (r.contact_substeps > 1)
-            for (size_t index = 0; index < slots_.size(); ++index) {
-                Slot& slot = slots_[index];
-                if (!slot.body || !failed_[index]) continue;
-                const size_t n = slot.body->x.size();
-                std::copy(slot.saved.begin(), slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.body->x.begin());
-                std::copy(slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.saved.end(), slot.body->v.begin());
-            }
+    r.contact_substeps = begin_colliders(dt);
+    save_step_start();
+    try {
+        run_attempts(dt, r);
+    } catch (...) {
+        for (Slot& slot : slots_)
+            if (slot.body) slot.body->field = nullptr;
+        throw;
+    }
+    if (has_contact()) {
         {
             const ScopedTimer timer(r.collision_seconds);
             r.contact_count = finish_contacts();
@@ -367,34 +340,134 @@ void World::step(double dt, sh_step_report* report) {
         if (r.warnings & (1u << SH_WARN_CAPACITY)) ++warnings[SH_WARN_CAPACITY];
     }
     for (HapticContext* haptic : haptics_) haptic->after_step(*this, dt);
-    if (r.warnings & (1u << SH_WARN_SUBSTEPPED)) ++warnings[SH_WARN_SUBSTEPPED];
-    if (r.warnings & (1u << SH_WARN_INVERTED)) ++warnings[SH_WARN_INVERTED];
-    warnings[SH_WARN_UNSTABLE] += static_cast<uint64_t>(r.unstable_body_count);
-
-    if (report) {
-        for (const Slot& slot : slots_) {
-            const Body* body = slot.body;
-            if (!body) continue;
-            for (int32_t i = 0; i < body->node_count(); ++i) {
-                const double m = body->mass[static_cast<size_t>(i)];
-                const double* v = &body->v[3 * static_cast<size_t>(i)];
-                const double* x = &body->x[3 * static_cast<size_t>(i)];
-                r.kinetic_energy += 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-                r.potential_energy -= m * (gravity[0] * x[0] + gravity[1] * x[1] + gravity[2] * x[2]);
-            }
-            r.elastic_energy += body->elastic_energy(body->x.data());
+    const Slot* failed = nullptr;
+    for (const Slot& slot : slots_)
+        if (slot.body && slot.failed) {
+            ++r.unstable_body_count;
+            if (!failed) failed = &slot;
         }
+    if (r.unstable_body_count > 0) r.warnings |= 1u << SH_WARN_UNSTABLE;
+    for (const sh_warning kind : {SH_WARN_SUBSTEPPED, SH_WARN_INVERTED, SH_WARN_NOT_CONVERGED})
+        if (r.warnings & (1u << kind)) ++warnings[kind];
+    warnings[SH_WARN_UNSTABLE] += static_cast<uint64_t>(r.unstable_body_count);
+    if (report) {
+        add_energies(r);
         r.wall_seconds = now_seconds() - start;
         *report = r;
     }
-    if (failure.body == SH_NULL_BODY) return;
-    const unsigned long long id = static_cast<unsigned long long>(failure.body);
-    if (failure.result.rejected)
+    if (!failed) return;
+    const unsigned long long id = static_cast<unsigned long long>(id_of(static_cast<size_t>(failed - slots_.data())));
+    if (failed->failure.rejected)
         throw Error(SH_ERR_UNSTABLE, format("body 0x%llx: dt = %g s exceeds its critical step %g s (policy: reject); "
                                             "%d body(ies) left unchanged",
-                                            id, dt, failure.result.dt_critical, r.unstable_body_count));
-    throw Error(failure.result.status, format("body 0x%llx: %s (%d body(ies) left as before the step)", id,
-                                              failure.result.reason, r.unstable_body_count));
+                                            id, dt, failed->failure.dt_critical, r.unstable_body_count));
+    throw Error(failed->failure.status, format("body 0x%llx: %s (%d body(ies) left as before the step)", id,
+                                               failed->failure.reason, r.unstable_body_count));
+}
+
+int32_t World::begin_colliders(double dt) {
+    // Tools move from their last pose to the host's in sub-steps short enough that none
+    // crosses more than half its inner radius at once.
+    double substeps = 1.0;
+    for (ColliderSlot& c : colliders_) {
+        if (!c.collider) continue;
+        c.collider->begin_step(dt);
+        const double travel = c.collider->travel(), limit = 0.5 * c.collider->shape.inner_radius();
+        if (travel > limit) substeps = std::max(substeps, std::ceil(travel / limit));
+    }
+    return static_cast<int32_t>(std::min(substeps, kMaxContactSubsteps));
+}
+
+void World::save_step_start() {
+    for (Slot& slot : slots_) {
+        if (!slot.body) continue;
+        slot.saved.assign(slot.body->x.begin(), slot.body->x.end());
+        slot.saved.insert(slot.saved.end(), slot.body->v.begin(), slot.body->v.end());
+        slot.failed = false;
+        slot.keep_best = false;
+    }
+}
+
+void World::restore_step_start(Slot& slot) {
+    const size_t n = slot.body->x.size();
+    std::copy(slot.saved.begin(), slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.body->x.begin());
+    std::copy(slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.saved.end(), slot.body->v.begin());
+}
+
+// The step as attempts of 1, 2, 4, ... times the contact sub-steps: a body whose attempt
+// failed goes back to the step's start and, if it may (an implicit body sub-stepping within
+// its max_substeps), takes part in the next attempt, whose last allowed one keeps its best
+// iterate; the others' failures are final.
+void World::run_attempts(double dt, sh_step_report& r) {
+    const int32_t base = r.contact_substeps;
+    skip_.assign(slots_.size(), 0);
+    for (int32_t factor = 1;; factor *= 2) {
+        for (Slot& slot : slots_)
+            if (slot.body) slot.keep_best = 2 * factor > retry_limit(*slot.body);
+        run_substeps(dt, base * factor, r);
+        bool retry = false;
+        for (size_t index = 0; index < slots_.size(); ++index) {
+            Slot& slot = slots_[index];
+            if (!slot.body) continue;
+            skip_[index] = 1;  // done, unless it retries
+            if (!slot.failed) continue;
+            restore_step_start(slot);
+            if (2 * factor > retry_limit(*slot.body)) continue;  // final: reported by step()
+            slot.failed = false;
+            skip_[index] = 0;
+            retry = true;
+        }
+        if (!retry) return;
+        r.substeps = std::max(r.substeps, 2 * factor);
+        r.warnings |= 1u << SH_WARN_SUBSTEPPED;
+    }
+}
+
+int32_t World::retry_limit(const Body& body) {
+    const IntegrationSettings& s = body.settings;
+    if (s.integrator != SH_INTEGRATOR_IMPLICIT_EULER || s.on_unstable != SH_UNSTABLE_SUBSTEP) return 1;
+    return s.implicit.max_substeps;
+}
+
+// substeps equal sub-steps of the bodies not in skip_, each tool moving its share of the step
+// from its start pose, with contact detection before each.
+void World::run_substeps(double dt, int32_t substeps, sh_step_report& r) {
+    const double h = dt / substeps;
+    vec<uint8_t>& skip = skip_;
+    if (!has_contact()) {
+        step_bodies(h, r, skip);
+        return;
+    }
+    for (ColliderSlot& c : colliders_)
+        if (c.collider && c.collider->is_tool) c.collider->pose = c.collider->start;
+    for (int32_t s = 0; s < substeps; ++s) {
+        const double fraction = static_cast<double>(s + 1) / substeps;
+        for (ColliderSlot& c : colliders_) {
+            if (!c.collider) continue;
+            c.collider->previous = c.collider->pose;
+            if (c.collider->is_tool) c.collider->pose = interpolate(c.collider->start, c.collider->target, fraction);
+        }
+        {
+            const ScopedTimer timer(r.collision_seconds);
+            r.warnings |= detect_contacts(h, 1.0 / substeps, 0.0);
+        }
+        step_bodies(h, r, skip);
+    }
+}
+
+void World::add_energies(sh_step_report& r) const {
+    for (const Slot& slot : slots_) {
+        const Body* body = slot.body;
+        if (!body) continue;
+        for (int32_t i = 0; i < body->node_count(); ++i) {
+            const double m = body->mass[static_cast<size_t>(i)];
+            const double* v = &body->v[3 * static_cast<size_t>(i)];
+            const double* x = &body->x[3 * static_cast<size_t>(i)];
+            r.kinetic_energy += 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            r.potential_energy -= m * (gravity[0] * x[0] + gravity[1] * x[1] + gravity[2] * x[2]);
+        }
+        r.elastic_energy += body->elastic_energy(body->x.data());
+    }
 }
 
 void World::solve_static(const sh_static_def& def, sh_static_report* report) {
@@ -409,7 +482,7 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
             // since the solve may move the surface that far.
             for (ColliderSlot& c : colliders_) {
                 if (!c.collider) continue;
-                c.collider->start = c.collider->pose = c.collider->target;
+                c.collider->start = c.collider->pose = c.collider->previous = c.collider->target;
                 c.collider->velocity_given = false;
                 for (int k = 0; k < 3; ++k) c.collider->velocity[k] = c.collider->angular[k] = 0.0;
             }
@@ -427,7 +500,7 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
         }
         reach = std::max(reach, 0.05 * extent);
         // Bodies pressing on each other are solved together, for their joint equilibrium.
-        if (has_contact()) detect_contacts(1.0, 0.0, reach);
+        if (has_contact()) detect_contacts(0.0, 0.0, reach);  // h = 0: the contact law at rest
         const bool coupled = group_islands(false, nullptr);
         for (size_t index = 0; index < slots_.size(); ++index)
             if (slots_[index].body && !(coupled && islands_->island_of(index) >= 0))

@@ -88,7 +88,10 @@ private:
         ImplicitState* implicit = nullptr;  ///< built on the first implicit step
         StepDoubling* doubling = nullptr;   ///< with error_estimate_ only
         BodyContacts* contacts = nullptr;   ///< built on the first step with contact
-        vec<double> saved;                  ///< x then v before a sub-stepped contact step
+        vec<double> saved;                  ///< x then v at the step's start
+        BodyStepResult failure;             ///< why the body's last attempt failed
+        bool failed = false;                ///< its last attempt in this step failed
+        bool keep_best = false;             ///< this attempt is its last: keep the best iterate
         uint32_t generation = 0;
     };
     struct ColliderSlot {
@@ -100,24 +103,31 @@ private:
         sh_contact_params params;
         bool has_candidates = false;  ///< the last detection found candidates between them
     };
-    /// The first body that failed in a step and why.
-    struct Failure {
-        sh_body_id body = 0;
-        BodyStepResult result;
-    };
     void destroy_slot(Slot& slot);
     bool has_contact() const { return collider_count_ > 0 || !pairs_.empty(); }
-    /// Steps every body (not in skip) by h, adding to r and recording the first failure.
-    void step_bodies(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed);
-    /// Adds body index's step result to r: warnings, and the failure (also in failed) if it
-    /// was not stable.
-    void note_result(size_t index, const BodyStepResult& result, sh_step_report& r, Failure& failure,
-                     vec<uint8_t>* failed);
+    /// Starts every collider's step of dt; returns the contact sub-steps it needs.
+    int32_t begin_colliders(double dt);
+    /// Saves every body's x and v and clears its attempt flags.
+    void save_step_start();
+    /// Puts slot's body back to the step's start.
+    void restore_step_start(Slot& slot);
+    /// Runs the step's attempts (see world.cpp).
+    void run_attempts(double dt, sh_step_report& r);
+    /// How many sub-steps (times the contact sub-steps) a step of body may be retried in.
+    static int32_t retry_limit(const Body& body);
+    /// Steps the bodies not in skip_ through substeps equal sub-steps of dt.
+    void run_substeps(double dt, int32_t substeps, sh_step_report& r);
+    /// Steps every body not in skip by h, adding to r; a body that fails joins skip.
+    void step_bodies(double h, sh_step_report& r, vec<uint8_t>& skip);
+    /// Adds body index's step result to r (warnings); records a failure in its slot and skip.
+    void note_result(size_t index, const BodyStepResult& result, sh_step_report& r, vec<uint8_t>& skip);
+    /// Kinetic, elastic and gravitational energies of every body into r.
+    void add_energies(sh_step_report& r) const;
     /// Groups the bodies of pairs with candidates into islands (only implicit bodies with
     /// implicit_only, none in failed); false if no island has two bodies. Nothing without pairs.
     bool group_islands(bool implicit_only, const vec<uint8_t>* failed);
     /// Steps each island of more than one body as one implicit system (contact_islands.cpp).
-    void step_islands(double h, sh_step_report& r, Failure& failure, vec<uint8_t>* failed);
+    void step_islands(double h, sh_step_report& r, vec<uint8_t>& skip);
     /// Solves each island of more than one body for its joint equilibrium (contact_islands.cpp).
     void solve_static_islands(const sh_static_def& def, sh_static_report& r);
     /// Finds the contact candidates of every body for a (sub)step of h with colliders at their
@@ -130,7 +140,7 @@ private:
     vec<ColliderSlot> colliders_;
     vec<uint32_t> free_colliders_;
     vec<BodyPair> pairs_;
-    vec<uint8_t> failed_;  ///< per slot, during a sub-stepped step
+    vec<uint8_t> skip_;  ///< per slot: sits out the current attempt
     ContactIslands* islands_ = nullptr;  ///< built on the first step with body pairs
     vec<HapticContext*> haptics_;
     bool error_estimate_ = false;

@@ -198,7 +198,7 @@ def test_implicit_particle_stops_at_the_backward_euler_distance(dt):
         distance = dt * (steps * v0 - mu * G * dt * steps * (steps + 1) / 2)
         assert particle.positions[0, 0] == pytest.approx(distance, rel=1e-3)
         assert abs(particle.velocities[0, 0]) < 1e-6
-        assert most <= 5
+        assert most <= 10  # the stopping step: its line search may shorten an update
         # at rest the plane carries the weight and no friction
         np.testing.assert_allclose(plane.force, [0.0, 0.0, -m * G], rtol=1e-6, atol=1e-9)
 

@@ -138,6 +138,7 @@ def test_status_names_and_strings():
         "SH_WARN_CAPACITY",
         "SH_WARN_FORCE_CLAMPED",
         "SH_WARN_LOCKING",
+        "SH_WARN_NOT_CONVERGED",
     ]
 
 

@@ -75,11 +75,11 @@ def test_sizes_computed_by_hand():
     # double, i32, pad 4
     assert ctypes.sizeof(_lib.sh_mesh_info) == 88  # 7 int32, pad 4, 7 doubles
     assert ctypes.sizeof(_lib.sh_material) == 32
-    assert ctypes.sizeof(_lib.sh_fem_body_def) == 120  # 80 + sh_implicit_settings
+    assert ctypes.sizeof(_lib.sh_fem_body_def) == 128  # 80 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_spring_params) == 72
-    assert ctypes.sizeof(_lib.sh_spring_body_def) == 200  # 160 + sh_implicit_settings
+    assert ctypes.sizeof(_lib.sh_spring_body_def) == 208  # 160 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_body_info) == 32
-    assert ctypes.sizeof(_lib.sh_implicit_settings) == 40  # i32 x2, 2 doubles, i32, pad 4, double
+    assert ctypes.sizeof(_lib.sh_implicit_settings) == 48  # i32 x2, 2 doubles, i32, pad 4, double, i32, pad 4
     assert ctypes.sizeof(_lib.sh_static_def) == 32
     assert ctypes.sizeof(_lib.sh_static_report) == 16 + 8 + 64 * 8 + 8
     assert _lib.sh_spring_body_def.params.offset == 48

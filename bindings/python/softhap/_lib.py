@@ -74,9 +74,10 @@ class WarningKind(enum.IntEnum):
     SH_WARN_CAPACITY = 3
     SH_WARN_FORCE_CLAMPED = 4
     SH_WARN_LOCKING = 5
+    SH_WARN_NOT_CONVERGED = 6
 
 
-SH_WARN_COUNT = 6
+SH_WARN_COUNT = 7
 
 
 class FeatureKind(enum.IntEnum):
@@ -202,6 +203,7 @@ class sh_implicit_settings(Structure):
         ("cg_tolerance", c_double),
         ("cg_max_iterations", c_int32),
         ("factor_reuse", c_double),
+        ("max_substeps", c_int32),
     ]
 
 

@@ -109,6 +109,7 @@ _IMPLICIT_FIELDS = {
     "cg_tolerance": float,
     "cg_max_iterations": _int32("cg_max_iterations"),
     "factor_reuse": float,
+    "max_substeps": _int32("max_substeps"),
 }
 _CONTACT_FIELDS = {
     "stiffness": float,
@@ -351,6 +352,7 @@ class World(OwnedHandle):
         cg_tolerance=None,
         cg_max_iterations=None,
         factor_reuse=None,
+        max_substeps=None,
     ):
         """Add a tetrahedral FEM body whose rest shape is mesh (copied) and return its Body.
 
@@ -362,7 +364,10 @@ class World(OwnedHandle):
           "implicit_euler";
           damping_mass: Rayleigh alpha (1/s), default 0; damping_stiffness: Rayleigh beta (s),
           default 0;
-          on_unstable: "substep" (default) or "reject" for steps above the critical step;
+          on_unstable: "substep" (default) or "reject": explicit steps above the critical
+          step are sub-stepped or rejected; implicit steps that do not converge are retried
+          in up to max_substeps sub-steps and then keep their best iterate
+          ("SH_WARN_NOT_CONVERGED" in the step report's warnings), or rejected;
           runaway_speed: a node faster than this (m/s) rolls the step back, default 1e4;
           implicit_euler only (sh_implicit_settings): linear_solver "default" (CHOLMOD when
           built in, else "ldlt"), "cholmod", "ldlt" or "cg"; newton_max_iterations (default 1:
@@ -370,7 +375,7 @@ class World(OwnedHandle):
           (default 1e-8); cg_max_iterations (default 2000); factor_reuse (default 0.25: keep a
           direct solver's factorisation while its updates at least halve the residual, a
           linearised step taking them until the residual is down 4x; 0 = factorise at every
-          Newton iteration).
+          Newton iteration); max_substeps (default 16).
         Unknown names raise ValueError; invalid values raise softhap.Error
         (SH_ERR_INVALID_ARGUMENT).
         """
@@ -415,6 +420,7 @@ class World(OwnedHandle):
         cg_tolerance=None,
         cg_max_iterations=None,
         factor_reuse=None,
+        max_substeps=None,
     ):
         """Add a mass-spring body and return its Body. Rest lengths are the initial lengths.
 

@@ -33,7 +33,7 @@ extern "C" {
 /** Major version: incremented on ABI-incompatible changes. */
 #define SH_VERSION_MAJOR 0
 /** Minor version: incremented when features are added compatibly. */
-#define SH_VERSION_MINOR 5
+#define SH_VERSION_MINOR 6
 /** Patch version: incremented for fixes. */
 #define SH_VERSION_PATCH 0
 /** Version this header declares: MAJOR*1000000 + MINOR*1000 + PATCH. */

@@ -13,9 +13,9 @@ from softhap import _lib
 
 def test_version_is_0_5_0():
     # SH_VERSION of include/softhap/softhap.h: 0 * 1000000 + 5 * 1000 + 0.
-    assert softhap.SH_VERSION == 5000
-    assert softhap.version() == 5000
-    assert softhap.__version__ == "0.5.0"
+    assert softhap.SH_VERSION == 6000
+    assert softhap.version() == 6000
+    assert softhap.__version__ == "0.6.0"
     assert softhap.version_string(2003004) == "2.3.4"
 
 
@@ -82,7 +82,7 @@ def test_import_uses_softhap_library_variable(tmp_path):
         {"SOFTHAP_LIBRARY": str(copy)},
     )
     assert result.returncode == 0, result.stderr
-    assert result.stdout.split() == [str(copy), "5000"]
+    assert result.stdout.split() == [str(copy), "6000"]
 
 
 def test_import_fails_clearly_when_variable_names_missing_file(tmp_path):
@@ -99,7 +99,7 @@ def test_version_mismatch_is_refused_monkeypatched(monkeypatch):
         _lib.load_library(softhap.library_path)
     text = str(info.value)
     assert "version mismatch" in text
-    assert "0.5.0" in text and "2.0.0" in text
+    assert "0.6.0" in text and "2.0.0" in text
 
 
 def test_version_mismatch_is_refused_on_import(cc, tmp_path):
@@ -115,7 +115,7 @@ def test_version_mismatch_is_refused_on_import(cc, tmp_path):
     assert result.returncode != 0
     assert "ImportError" in result.stderr
     assert "version mismatch" in result.stderr
-    assert "2.0.0" in result.stderr and "0.5.0" in result.stderr
+    assert "2.0.0" in result.stderr and "0.6.0" in result.stderr
 
 
 def test_not_a_softhap_library_is_refused(cc, tmp_path):

@@ -27,7 +27,7 @@ from ctypes import (
 # Version this package was written for (SH_VERSION of include/softhap/softhap.h).
 
 SH_VERSION_MAJOR = 0
-SH_VERSION_MINOR = 5
+SH_VERSION_MINOR = 6
 SH_VERSION_PATCH = 0
 SH_VERSION = SH_VERSION_MAJOR * 1000000 + SH_VERSION_MINOR * 1000 + SH_VERSION_PATCH
 

@@ -302,7 +302,10 @@ typedef struct sh_implicit_settings {
                                          Newton iterations until newton_tolerance. A body with
                                          contact candidates in a step always iterates (up to
                                          max(20, this)): contacts that switch on within the
-                                         step would make a linearised step oscillate */
+                                         step would make a linearised step oscillate. A
+                                         linearised step that would raise the mechanical
+                                         energy with no work done on the body goes on up to 20
+                                         iterations towards the step's minimiser */
     double newton_tolerance;        /**< stop when the residual |g| <= tol max(|g_0|, dt |f_ext +
                                          m g|) or the velocity correction <= tol max(|v|, dt |g|,
                                          1e-9 m/s); default 1e-6 */

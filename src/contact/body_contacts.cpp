@@ -341,6 +341,10 @@ BodyContacts* BodyContacts::finish_detection(double h) {
 
 bool BodyContacts::implicit_step() const { return body_.settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER; }
 
+StepLaw BodyContacts::step_law(const ContactCandidate& c) const {
+    return hunt_crossley_step_law(*c.params, c.start_depth, step_);
+}
+
 bool BodyContacts::lagged_friction(const ContactCandidate& c, const double* v, ContactPoint& out) const {
     // An implicit body's friction is that of the step's start: the normal force, normal, point
     // and weights there (lagged, as in IPC), so that it depends on the velocities alone and is
@@ -475,7 +479,7 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
         // In an implicit step the depth rate is the step's backward difference, so the normal
         // force is a function of the positions, the gradient of energy(); its friction comes
         // separately from the step's start (evaluate_friction).
-        apply_step_normal_law(p, hunt_crossley_step_law(p, c.start_depth, step_), vrel, out);
+        apply_step_normal_law(p, step_law(c), vrel, out);
         return true;
     }
     apply_normal_law(p, v ? vrel : nullptr, out);
@@ -487,7 +491,7 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
 
 template <class Emit>
 void BodyContacts::evaluate_friction(const double* v, Emit&& emit) const {
-    if (!v || !implicit_step() || iterates_.size() != candidates_.size()) return;
+    if (!v || iterates_.size() != candidates_.size()) return;  // iterates_: implicit bodies only
     for (const ContactCandidate& c : candidates_) {
         ContactPoint point;
         if (lagged_friction(c, v, point)) emit(c, point);
@@ -792,19 +796,16 @@ void BodyContacts::add_coupling_tangent(const double* x, const double* v, double
     for_each_pair_candidate(other, own_index, [&](const ContactCandidate& c) {
         ContactPoint p;
         if (touching(c, x, v, p)) add(c, p);
-        if (v && implicit_step() && iterates_.size() == candidates_.size() && lagged_friction(c, v, p)) add(c, p);
+        if (v && lagged_friction(c, v, p)) add(c, p);
     });
 }
 
 double BodyContacts::energy(const double* x) const {
-    // In an implicit step, the potential of the step's law (its damping is in the depth).
-    const bool step_law = implicit_step() && step_ > 0.0;
+    // The potential of the step's law (its damping is in the depth); at rest its elastic part.
     double e = 0.0;
     evaluate(x, nullptr, [&](const ContactCandidate& c, const ContactPoint& p) {
         const bool pair = c.kind == ContactCandidate::kNodeFace || c.kind == ContactCandidate::kFaceNode;
-        const double potential = step_law ? hunt_crossley_step_energy(*c.params, hunt_crossley_step_law(*c.params, c.start_depth, step_), p.depth)
-                                          : hunt_crossley_energy(*c.params, p.depth);
-        e += (pair ? 0.5 : 1.0) * p.law_scale * potential;
+        e += (pair ? 0.5 : 1.0) * p.law_scale * hunt_crossley_step_energy(*c.params, step_law(c), p.depth);
     });
     return e;
 }

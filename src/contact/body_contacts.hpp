@@ -123,6 +123,9 @@ private:
     };
     /// True if the body is stepped implicitly (the step's law, lagged friction).
     bool implicit_step() const;
+    /// Candidate c's law over the step (hunt_crossley_step_law from its start depth); the law
+    /// at rest for explicit bodies and static solves (step_ and start_depth are 0 there).
+    StepLaw step_law(const ContactCandidate& c) const;
     /// Candidate c at (x, v) (v null: at rest): true if it touches, with out filled: the
     /// normal law, and for explicit bodies with v their friction.
     bool touching(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const;
@@ -162,7 +165,7 @@ private:
     vec<Aabb> boxes_;              ///< per surface primitive (triangle, or node for springs)
     AabbTree tree_;
     double margin_ = 0.0;          ///< the last refit's margin (m)
-    double step_ = 0.0;            ///< implicit bodies: the step's length (s); 0: at rest
+    double step_ = 0.0;            ///< implicit bodies: the step's length (s); else 0 (at rest)
     vec<Aabb> tet_boxes_;          ///< per tet, for other bodies' nodes (built on first use)
     AabbTree tet_tree_;
     vec<uint32_t> stamp_;          ///< per node: last detection pass that took it

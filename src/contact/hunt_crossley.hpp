@@ -31,12 +31,6 @@ inline NormalForce hunt_crossley(const sh_contact_params& p, double x, double ra
     return out;
 }
 
-/// Potential of the elastic part lambda x^n at depth x: lambda x^(n+1) / (n + 1) (J).
-inline double hunt_crossley_energy(const sh_contact_params& p, double x) {
-    if (!(x > 0.0)) return 0.0;
-    return p.stiffness * std::pow(x, p.exponent + 1.0) / (p.exponent + 1.0);
-}
-
 /// The Hunt-Crossley law over one implicit (backward Euler) step of length h (s): the depth
 /// rate is the step's backward difference (x - x_start) / h, x_start the depth at the step's
 /// start (0 if it did not touch then), so the force F(x) = max(0, x^n (lambda + mu (x -

@@ -94,6 +94,11 @@ public:
     /// under gravity g (N).
     double applied_load(size_t j, const double g[3]) const { return external_force[j] + mass[j / 3] * g[j % 3]; }
 
+    /// Viscous mass damping of node (1/s): Rayleigh alpha plus its own node_damping.
+    double mass_damping(size_t node) const {
+        return settings.damping_mass + (node_damping.empty() ? 0.0 : node_damping[node]);
+    }
+
     /// Replaces node_damping by coefficients[node_count()] (1/s), or clears it for null.
     void set_node_damping(const double* coefficients);
 

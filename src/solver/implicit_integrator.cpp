@@ -33,6 +33,10 @@ constexpr double kArmijo = 1e-4;
 // energy by more than this times the magnitude of its terms at the start.
 constexpr double kEnergyGrowth = 1.0;
 
+// A linearised step with no outside work that raises the mechanical energy by more than this
+// times its terms' magnitude is not accepted: it goes on iterating towards the minimiser.
+constexpr double kLinearisedEnergyGain = 1e-6;
+
 LinearSolverKind solver_kind(sh_linear_solver kind) {
     switch (kind) {
         case SH_LINEAR_SOLVER_CHOLMOD: return LinearSolverKind::Cholmod;
@@ -110,11 +114,9 @@ namespace {
 // Per free DOF of body: m (1 + dt (alpha + c_node)), the mass part of the step's matrix.
 void fill_mass_diagonal(const Body& body, ImplicitState& state, double dt) {
     const vec<int32_t>& global = state.system.dof_to_global();
-    const bool per_node = !body.node_damping.empty();
     for (size_t d = 0; d < global.size(); ++d) {
         const size_t node = static_cast<size_t>(global[d]) / 3;
-        const double c = body.settings.damping_mass + (per_node ? body.node_damping[node] : 0.0);
-        state.diagonal[d] = body.mass[node] * (1.0 + dt * c);
+        state.diagonal[d] = body.mass[node] * (1.0 + dt * body.mass_damping(node));
     }
 }
 
@@ -154,9 +156,11 @@ private:
     bool factorize_and_solve(bool& failed);
     void take_update(double scale);
     bool line_search(double slope, bool fresh);
+    bool iterate(bool& solver_failed);
+    BodyStepResult finish(bool converged, bool solver_failed, bool keep_best);
     BodyStepResult fail(sh_status status, const char* reason);
     double mechanical_energy(bool at_start, double& scale) const;
-    bool energy_ran_away() const;
+    bool energy_rose(double fraction) const;
 
     const NewtonGroup& group_;
     NewtonSystem& ns_;
@@ -177,37 +181,30 @@ private:
     bool work_done_ = false;  // moving tools, other bodies or prescribed nodes work on the bodies
 };
 
-// Kinetic + elastic + contact potential + the applied loads' potential (-x . (f_ext + m g)) of
-// the bodies, at the step's start (x0, v0) or now; scale gets the terms' magnitudes.
+// Kinetic + potential energy (NewtonGroup::potential_energy) of the bodies, at the step's
+// start (x0, v0) or now; scale gets the terms' magnitudes.
 double NewtonStep::mechanical_energy(bool at_start, double& scale) const {
-    double total = 0.0;
-    scale = 0.0;
+    double kinetic = 0.0;
     group_.each([&](const Body& body, const ImplicitState& state, size_t) {
-        const double* x = at_start ? body.workspace.x0.data() : body.x.data();
         const double* v = at_start ? body.workspace.v0.data() : body.v.data();
-        const double elastic = body.elastic_energy(x), field = body.field ? body.field->energy(x) : 0.0;
-        double kinetic = 0.0, loads = 0.0;
         for (const int32_t j : state.system.dof_to_global()) {
             const size_t k = static_cast<size_t>(j);
             kinetic += 0.5 * body.mass[k / 3] * v[k] * v[k];
-            loads -= body.applied_load(k, g_) * x[k];
         }
-        total += kinetic + elastic + field + loads;
-        scale += kinetic + std::fabs(elastic) + field + std::fabs(loads);
     });
-    return total;
+    const double potential = group_.potential_energy(g_, 1.0, at_start, scale);
+    scale += kinetic;
+    return kinetic + potential;
 }
 
-// The runaway guard: with no work done on the bodies from outside (moving tools, other bodies,
-// prescribed motion), a backward Euler step cannot raise their mechanical energy. A step that
-// raised it by more than kEnergyGrowth times its start's scale has gone wrong, whatever its
-// speeds.
-bool NewtonStep::energy_ran_away() const {
+// With no work done on the bodies from outside (moving tools, other bodies, prescribed motion),
+// the minimiser of the step's potential does not raise their mechanical energy: true if the
+// current iterate raised it by more than fraction times its start's scale (or to non-finite).
+bool NewtonStep::energy_rose(double fraction) const {
     if (work_done_) return false;
     double scale = 0.0;
     const double energy = mechanical_energy(false, scale);
-    const double allowed = kEnergyGrowth * energy_scale0_ + 1e-12;
-    return !std::isfinite(energy) || energy - energy0_ > allowed;
+    return !std::isfinite(energy) || energy - energy0_ > fraction * energy_scale0_ + 1e-12;
 }
 
 void NewtonStep::begin() {
@@ -257,12 +254,11 @@ void NewtonStep::evaluate() {
         const double field = body.field ? body.field->energy(body.x.data()) + h * body.field->dissipation(body.v.data()) : 0.0;
         phi.value += elastic + field;
         phi.scale += std::fabs(elastic) + std::fabs(field);
-        const bool per_node = !body.node_damping.empty();
         const vec<int32_t>& global = state.system.dof_to_global();
         for (size_t d = 0; d < global.size(); ++d) {
             const size_t j = static_cast<size_t>(global[d]), node = j / 3;
             const double m = body.mass[node], v = body.v[j], dv = v - body.workspace.v0[j];
-            const double c = body.settings.damping_mass + (per_node ? body.node_damping[node] : 0.0);
+            const double c = body.mass_damping(node);
             const double load = body.applied_load(j, g_), fd = damping ? damping[j] : 0.0;
             const double r_d = m * dv + h * m * c * v - h * (f[j] + fd + load);
             ns_.residual[offset + d] = r_d;
@@ -373,93 +369,94 @@ BodyStepResult NewtonStep::fail(sh_status status, const char* reason) {
 BodyStepResult NewtonStep::run(bool keep_best) {
     result_.dt_critical = INFINITY;
     begin();
-    double applied_load = 0.0;  // |f_ext + m g| over the free DOFs (N)
-    group_.each([&](Body& body, ImplicitState& state, size_t) {
-        for (const int32_t j : state.system.dof_to_global()) {
-            const double load = body.applied_load(static_cast<size_t>(j), g_);
-            applied_load += load * load;
-        }
-    });
-    applied_load = std::sqrt(applied_load);
-    const double gravity_norm = std::sqrt(g_[0] * g_[0] + g_[1] * g_[1] + g_[2] * g_[2]);
-
-    // Contacts switch on and off within a step, which a single update cannot follow: a body
-    // in contact iterates.
-    bool in_contact = false;
-    group_.each([&](const Body& body, const ImplicitState&, size_t) { in_contact |= body.field != nullptr; });
-    const int max_iterations = std::max(in_contact ? kContactNewtonIterations : 1, s_.newton_max_iterations);
-    const bool linearised = max_iterations == 1;
+    bool converged = false, solver_failed = false;
     try {
         evaluate();
-    } catch (...) {
-        fail(SH_ERR_INTERNAL, "");
-        throw;
-    }
-    const double residual0 = std::max(r_, dt_ * applied_load);
-    // A linearised step's updates with a kept factorisation go on until both norms are down
-    // by factor_reuse (the max norm keeps a small badly-solved region from hiding in the sum).
-    const double target = s_.factor_reuse * r_, target_max = s_.factor_reuse * r_max_;
-    result_.newton_residual = -1.0;
-    bool converged = residual0 == 0.0;
-    bool solver_failed = false;
-    int iteration = 0;
-    try {
-        while (!converged) {
-            // Converged: the residual is small against the first one or the applied load's
-            // impulse, or down to the round-off of the element forces themselves.
-            if (iteration > 0 && r_ <= std::max(s_.newton_tolerance * residual0, ns_.roundoff_floor)) {
-                converged = true;
-                break;
-            }
-            if (iteration == max_iterations) break;
-            bool failed = false;
-            if (!factorize_and_solve(failed)) {
-                solver_failed = true;
-                break;
-            }
-            group_.each([&](Body& body, ImplicitState& state, size_t offset) {
-                const vec<int32_t>& global = state.system.dof_to_global();
-                for (size_t d = 0; d < global.size(); ++d) ns_.previous_v[offset + d] = body.v[static_cast<size_t>(global[d])];
-            });
-            double slope = 0.0;  // d Phi / d scale along delta, at scale 0
-            for (size_t d = 0; d < ns_.delta.size(); ++d) slope += ns_.residual[d] * ns_.delta[d];
-            const bool fresh = fresh_;
-            if (!(slope < 0.0) || !line_search(slope, fresh)) {
-                    if (!fresh) {  // the kept factorisation is too far from the current tangent
-                    factor_current_ = false;
-                    continue;
-                }
-                // No descent left along Newton's direction: converged if the residual is as
-                // small as asked or down to the forces' round-off, else stalled.
-                converged = r_ <= std::max(s_.newton_tolerance * residual0, ns_.roundoff_floor);
-                break;
-            }
-            if (!fresh) {
-                ++stale_solves_;
-                used_stale = true;
-            }
-            fresh_ = false;
-            factor_current_ = reuse_ && allow_stale_;  // exact Newton (or CG): a tangent per iterate
-            ++result_.newton_iterations;
-            result_.newton_residual = residual0 > 0.0 ? r_ / residual0 : 0.0;
-            if (linearised) {
-                // One update with the tangent at its iterate is the linearised step; updates
-                // with a kept factorisation go on until they are as good as factor_reuse asks.
-                const double floor = ns_.roundoff_floor;
-                if (fresh || (r_ <= std::max(target, floor) && r_max_ <= std::max(target_max, floor))) converged = true;
-                continue;
-            }
-            ++iteration;
-            // Near equilibrium of a stiff body the residual is cancellation noise of large
-            // element forces, so a negligible whole velocity correction also ends the loop.
-            const double speed_scale = std::max({largest_speed_, dt_ * gravity_norm, kSpeedFloor});
-            if (iteration > 1 && largest_change_ <= s_.newton_tolerance * speed_scale) converged = true;
-        }
+        converged = iterate(solver_failed);
     } catch (...) {
         fail(SH_ERR_INTERNAL, "");  // out of memory or an internal error: nothing half done stays
         throw;
     }
-    // The last iterate is the best: the line search never raised the potential.
+    return finish(converged, solver_failed, keep_best);
+}
+
+// The Newton loop from the evaluated start iterate; true if it converged. solver_failed: it
+// stopped because the linear solver failed.
+bool NewtonStep::iterate(bool& solver_failed) {
+    // Contacts switch on and off within a step, which a single update cannot follow: a body
+    // in contact iterates.
+    bool in_contact = false;
+    group_.each([&](const Body& body, const ImplicitState&, size_t) { in_contact |= body.field != nullptr; });
+    int max_iterations = std::max(in_contact ? kContactNewtonIterations : 1, s_.newton_max_iterations);
+    bool linearised = max_iterations == 1;
+    const double residual0 = std::max(r_, dt_ * group_.applied_load_norm(g_));
+    const double gravity_norm = std::sqrt(g_[0] * g_[0] + g_[1] * g_[1] + g_[2] * g_[2]);
+    // A linearised step's updates with a kept factorisation go on until both norms are down
+    // by factor_reuse (the max norm keeps a small badly-solved region from hiding in the sum).
+    const double target = s_.factor_reuse * r_, target_max = s_.factor_reuse * r_max_;
+    const auto small = [&] { return r_ <= std::max(s_.newton_tolerance * residual0, ns_.roundoff_floor); };
+    result_.newton_residual = -1.0;
+    if (residual0 == 0.0) return true;
+    bool towards_minimiser = false;  // a linearised step that went on iterating (see below)
+    for (int iteration = 0;;) {
+        // Converged: the residual is small against the first one or the applied load's
+        // impulse, or down to the round-off of the element forces themselves.
+        if (iteration > 0 && small()) return true;
+        // A linearised step asked for no more than its lowest potential so far.
+        if (iteration == max_iterations) return towards_minimiser;
+        bool failed = false;
+        if (!factorize_and_solve(failed)) {
+            solver_failed = true;
+            return false;
+        }
+        group_.each([&](Body& body, ImplicitState& state, size_t offset) {
+            const vec<int32_t>& global = state.system.dof_to_global();
+            for (size_t d = 0; d < global.size(); ++d) ns_.previous_v[offset + d] = body.v[static_cast<size_t>(global[d])];
+        });
+        double slope = 0.0;  // d Phi / d scale along delta, at scale 0
+        for (size_t d = 0; d < ns_.delta.size(); ++d) slope += ns_.residual[d] * ns_.delta[d];
+        const bool fresh = fresh_;
+        if (!(slope < 0.0) || !line_search(slope, fresh)) {
+            if (!fresh) {  // the kept factorisation is too far from the current tangent
+                factor_current_ = false;
+                continue;
+            }
+            // No descent left along Newton's direction: converged if the residual is as small
+            // as asked or down to the forces' round-off, else stalled.
+            return small();
+        }
+        if (!fresh) {
+            ++stale_solves_;
+            used_stale = true;
+        }
+        fresh_ = false;
+        factor_current_ = reuse_ && allow_stale_;  // exact Newton (or CG): a tangent per iterate
+        ++result_.newton_iterations;
+        result_.newton_residual = residual0 > 0.0 ? r_ / residual0 : 0.0;
+        if (linearised) {
+            // One update with the tangent at its iterate is the linearised step; updates with
+            // a kept factorisation go on until they are as good as factor_reuse asks.
+            const double floor = ns_.roundoff_floor;
+            if (!fresh && !(r_ <= std::max(target, floor) && r_max_ <= std::max(target_max, floor))) continue;
+            if (!energy_rose(kLinearisedEnergyGain)) return true;
+            // One update gained energy from nothing (large rotations, elements near inversion):
+            // iterate towards the step's minimiser instead, as far as the iterations allow.
+            linearised = false;
+            towards_minimiser = true;
+            max_iterations = kContactNewtonIterations;
+            continue;
+        }
+        ++iteration;
+        // Near equilibrium of a stiff body the residual is cancellation noise of large
+        // element forces, so a negligible whole velocity correction also ends the loop.
+        const double speed_scale = std::max({largest_speed_, dt_ * gravity_norm, kSpeedFloor});
+        if (iteration > 1 && largest_change_ <= s_.newton_tolerance * speed_scale) return true;
+    }
+}
+
+// The step's outcome: converged, or (keep_best, after some progress) its last iterate, the
+// lowest potential the line search reached; otherwise restored with the reason.
+BodyStepResult NewtonStep::finish(bool converged, bool solver_failed, bool keep_best) {
     const bool progressed = result_.newton_iterations > 0;
     if (!converged && !(keep_best && progressed)) {
         if (solver_failed && result_.status == SH_ERR_SOLVER)
@@ -476,8 +473,12 @@ BodyStepResult NewtonStep::run(bool keep_best) {
         sane = sane && body_state_is_sane(body);
     });
     if (!sane) return fail(SH_ERR_UNSTABLE, kRolledBackReason);
-    if (energy_ran_away())
-        return fail(SH_ERR_UNSTABLE, "the mechanical energy grew with no work done on the body (runaway); rolled back");
+    if (energy_rose(kEnergyGrowth)) {
+        // The last attempt keeps its finite iterate, as one that did not converge.
+        if (!keep_best)
+            return fail(SH_ERR_UNSTABLE, "the mechanical energy grew with no work done on the body (runaway); rolled back");
+        result_.not_converged = true;
+    }
     return result_;
 }
 

@@ -2,9 +2,11 @@
 // the same way whether a body is alone or several are coupled.
 #pragma once
 
+#include "model/external_field.hpp"
 #include "solver/coupled_system.hpp"
 #include "solver/implicit_integrator.hpp"
 
+#include <cmath>
 #include <cstddef>
 
 namespace sh {
@@ -44,6 +46,38 @@ struct NewtonGroup {
     }
 
     uint64_t matrix_version() const { return coupled ? coupled->matrix_version() : body->matrix_version; }
+
+    /// |f_ext + m g| over the free DOFs (N).
+    double applied_load_norm(const double g[3]) const {
+        double sum = 0.0;
+        each([&](const Body& b, const ImplicitState& s, size_t) {
+            for (const int32_t j : s.system.dof_to_global()) {
+                const double load = b.applied_load(static_cast<size_t>(j), g);
+                sum += load * load;
+            }
+        });
+        return std::sqrt(sum);
+    }
+
+    /// The bodies' potential energy at their positions (at_start: the step's start,
+    /// workspace.x0): elastic energy, the fields' potential, minus load_factor times the work
+    /// of f_ext + m g over the free DOFs (J). scale gets the terms' magnitudes.
+    double potential_energy(const double g[3], double load_factor, bool at_start, double& scale) const {
+        double total = 0.0;
+        scale = 0.0;
+        each([&](const Body& b, const ImplicitState& s, size_t) {
+            const double* x = at_start ? b.workspace.x0.data() : b.x.data();
+            double work = 0.0;
+            for (const int32_t j : s.system.dof_to_global()) {
+                const size_t k = static_cast<size_t>(j);
+                work += b.applied_load(k, g) * x[k];
+            }
+            const double elastic = b.elastic_energy(x), field = b.field ? b.field->energy(x) : 0.0;
+            total += elastic + field - load_factor * work;
+            scale += std::fabs(elastic) + std::fabs(field) + std::fabs(load_factor * work);
+        });
+        return total;
+    }
 };
 
 }  // namespace sh

@@ -62,22 +62,6 @@ double out_of_balance(const NewtonGroup& group, const double g[3], double load_f
     return std::sqrt(s);
 }
 
-// Potential energy: elastic energy and the fields' potential minus the work of the applied
-// loads.
-double potential(const NewtonGroup& group, const double g[3], double load_factor) {
-    double total = 0.0;
-    group.each([&](const Body& body, const ImplicitState& state, size_t) {
-        double work = 0.0;
-        for (const int32_t j : state.system.dof_to_global()) {
-            const size_t k = static_cast<size_t>(j);
-            work += body.applied_load(k, g) * body.x[k];
-        }
-        const double field = body.field ? body.field->energy(body.x.data()) : 0.0;
-        total += body.elastic_energy(body.x.data()) + field - load_factor * work;
-    });
-    return total;
-}
-
 // Newton-Raphson with line search for the group's bodies, their states prepared.
 void solve_group(const NewtonGroup& group, const double g[3], const sh_static_def& def, sh_static_report& report) {
     NewtonSystem& ns = group.newton;
@@ -90,14 +74,8 @@ void solve_group(const NewtonGroup& group, const double g[3], const sh_static_de
     vec<double>& residual = ns.residual;
     vec<double>& step = ns.delta;
     // Scale of the residual: the full applied load, or 1 N if nothing is applied.
-    double load_norm = 0.0;
-    group.each([&](const Body& body, const ImplicitState& state, size_t) {
-        for (const int32_t j : state.system.dof_to_global()) {
-            const double load = body.applied_load(static_cast<size_t>(j), g);
-            load_norm += load * load;
-        }
-    });
-    load_norm = load_norm > 0.0 ? std::sqrt(load_norm) : 1.0;
+    double load_norm = group.applied_load_norm(g);
+    if (!(load_norm > 0.0)) load_norm = 1.0;
 
     for (int32_t load_step = 1; load_step <= def.load_steps; ++load_step) {
         const double factor = static_cast<double>(load_step) / def.load_steps;
@@ -114,7 +92,8 @@ void solve_group(const NewtonGroup& group, const double g[3], const sh_static_de
             ns.solver->solve(ns.system, residual.data(), step.data());
             double slope = 0.0;  // d potential / d alpha at alpha = 0
             for (size_t d = 0; d < residual.size(); ++d) slope -= residual[d] * step[d];
-            const double energy0 = potential(group, g, factor), r0 = r;
+            double scale = 0.0;
+            const double energy0 = group.potential_energy(g, factor, false, scale), r0 = r;
             group.each([](Body& body, ImplicitState&, size_t) {
                 std::copy(body.x.begin(), body.x.end(), body.workspace.xs.begin());
             });
@@ -129,7 +108,7 @@ void solve_group(const NewtonGroup& group, const double g[3], const sh_static_de
                     }
                 });
                 r = out_of_balance(group, g, factor, residual) / load_norm;
-                const double energy = potential(group, g, factor);
+                const double energy = group.potential_energy(g, factor, false, scale);
                 accepted = (std::isfinite(energy) && energy <= energy0 + 1e-4 * alpha * slope) || r < r0;
             }
             if (!accepted) {  // no step helped: stay where the iteration was

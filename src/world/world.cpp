@@ -322,7 +322,6 @@ void World::step(double dt, sh_step_report* report) {
     r.dt_critical = INFINITY;
     for (HapticContext* haptic : haptics_) haptic->before_step(*this);
     r.contact_substeps = begin_colliders(dt);
-    save_step_start();
     try {
         run_attempts(dt, r);
     } catch (...) {
@@ -378,14 +377,9 @@ int32_t World::begin_colliders(double dt) {
     return static_cast<int32_t>(std::min(substeps, kMaxContactSubsteps));
 }
 
-void World::save_step_start() {
-    for (Slot& slot : slots_) {
-        if (!slot.body) continue;
-        slot.saved.assign(slot.body->x.begin(), slot.body->x.end());
-        slot.saved.insert(slot.saved.end(), slot.body->v.begin(), slot.body->v.end());
-        slot.failed = false;
-        slot.keep_best = false;
-    }
+void World::save_step_start(Slot& slot) {
+    slot.saved.assign(slot.body->x.begin(), slot.body->x.end());
+    slot.saved.insert(slot.saved.end(), slot.body->v.begin(), slot.body->v.end());
 }
 
 void World::restore_step_start(Slot& slot) {
@@ -397,13 +391,19 @@ void World::restore_step_start(Slot& slot) {
 // The step as attempts of 1, 2, 4, ... times the contact sub-steps: a body whose attempt
 // failed goes back to the step's start and, if it may (an implicit body sub-stepping within
 // its max_substeps), takes part in the next attempt, whose last allowed one keeps its best
-// iterate; the others' failures are final.
+// iterate; the others' failures are final. A body that fails an attempt of one sub-step is
+// already back at the step's start (every integrator restores its own start on failure), so
+// the start is copied only for attempts of more sub-steps.
 void World::run_attempts(double dt, sh_step_report& r) {
     const int32_t base = r.contact_substeps;
     skip_.assign(slots_.size(), 0);
+    for (Slot& slot : slots_) {
+        slot.failed = false;
+        if (slot.body && base > 1) save_step_start(slot);
+    }
     for (int32_t factor = 1;; factor *= 2) {
         for (Slot& slot : slots_)
-            if (slot.body) slot.keep_best = 2 * factor > retry_limit(*slot.body);
+            if (slot.body) slot.keep_best = sub_steps_on_failure(*slot.body) && 2 * factor > retry_limit(*slot.body);
         run_substeps(dt, base * factor, r);
         bool retry = false;
         for (size_t index = 0; index < slots_.size(); ++index) {
@@ -411,8 +411,9 @@ void World::run_attempts(double dt, sh_step_report& r) {
             if (!slot.body) continue;
             skip_[index] = 1;  // done, unless it retries
             if (!slot.failed) continue;
-            restore_step_start(slot);
+            if (base * factor > 1) restore_step_start(slot);
             if (2 * factor > retry_limit(*slot.body)) continue;  // final: reported by step()
+            if (base * factor == 1) save_step_start(slot);
             slot.failed = false;
             skip_[index] = 0;
             retry = true;
@@ -423,10 +424,13 @@ void World::run_attempts(double dt, sh_step_report& r) {
     }
 }
 
-int32_t World::retry_limit(const Body& body) {
+bool World::sub_steps_on_failure(const Body& body) {
     const IntegrationSettings& s = body.settings;
-    if (s.integrator != SH_INTEGRATOR_IMPLICIT_EULER || s.on_unstable != SH_UNSTABLE_SUBSTEP) return 1;
-    return s.implicit.max_substeps;
+    return s.integrator == SH_INTEGRATOR_IMPLICIT_EULER && s.on_unstable == SH_UNSTABLE_SUBSTEP;
+}
+
+int32_t World::retry_limit(const Body& body) {
+    return sub_steps_on_failure(body) ? body.settings.implicit.max_substeps : 1;
 }
 
 // substeps equal sub-steps of the bodies not in skip_, each tool moving its share of the step

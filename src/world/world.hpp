@@ -88,7 +88,8 @@ private:
         ImplicitState* implicit = nullptr;  ///< built on the first implicit step
         StepDoubling* doubling = nullptr;   ///< with error_estimate_ only
         BodyContacts* contacts = nullptr;   ///< built on the first step with contact
-        vec<double> saved;                  ///< x then v at the step's start
+        vec<double> saved;                  ///< x then v at the step's start, for attempts
+                                            ///< of more than one sub-step
         BodyStepResult failure;             ///< why the body's last attempt failed
         bool failed = false;                ///< its last attempt in this step failed
         bool keep_best = false;             ///< this attempt is its last: keep the best iterate
@@ -107,12 +108,15 @@ private:
     bool has_contact() const { return collider_count_ > 0 || !pairs_.empty(); }
     /// Starts every collider's step of dt; returns the contact sub-steps it needs.
     int32_t begin_colliders(double dt);
-    /// Saves every body's x and v and clears its attempt flags.
-    void save_step_start();
+    /// Saves slot's body's x and v (the step's start) in slot.saved.
+    void save_step_start(Slot& slot);
     /// Puts slot's body back to the step's start.
     void restore_step_start(Slot& slot);
     /// Runs the step's attempts (see world.cpp).
     void run_attempts(double dt, sh_step_report& r);
+    /// True if a failed step of body is retried in sub-steps and its last attempt keeps its
+    /// best iterate (an implicit body with policy SH_UNSTABLE_SUBSTEP).
+    static bool sub_steps_on_failure(const Body& body);
     /// How many sub-steps (times the contact sub-steps) a step of body may be retried in.
     static int32_t retry_limit(const Body& body);
     /// Steps the bodies not in skip_ through substeps equal sub-steps of dt.

@@ -11,8 +11,8 @@ from conftest import compile_c, run_python
 from softhap import _lib
 
 
-def test_version_is_0_5_0():
-    # SH_VERSION of include/softhap/softhap.h: 0 * 1000000 + 5 * 1000 + 0.
+def test_version_is_0_6_0():
+    # SH_VERSION of include/softhap/softhap.h: 0 * 1000000 + 6 * 1000 + 0.
     assert softhap.SH_VERSION == 6000
     assert softhap.version() == 6000
     assert softhap.__version__ == "0.6.0"

@@ -653,32 +653,43 @@ bool Shape::penetrate_point(const Pose& pose, const double x[3], Penetration& ou
     return true;
 }
 
-namespace {
+bool Shape::penetrate_triangle(const Pose& pose, const double a[3], const double b[3],
+                               const double c[3], Penetration& out, double bary[3]) const {
+    if (kind_ == SH_SHAPE_PLANE) return false;
+    const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double ac[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double bc[3] = {c[0] - b[0], c[1] - b[1], c[2] - b[2]};
+    double n[3];
+    cross3(ab, ac, n);
+    const double area2 = norm3(n);
+    const double edge2 = std::max({dot3(ab, ab), dot3(ac, ac), dot3(bc, bc)});
+    if (!(area2 > 1e-14 * edge2)) return false;  // zero area (or not finite)
+    for (int k = 0; k < 3; ++k) n[k] /= area2;
 
-// Barycentric weights w of point q in the plane of triangle (a, b, c) (unit normal n, area2 =
-// |(b - a) x (c - a)|) from signed sub-triangle areas, if q lies inside it. On an edge (to
-// round-off) q belongs to one of the two triangles that share it: the one that runs along the
-// edge from its lexicographically smaller end (the other runs along it the other way), so that
-// a tool on the edge between two faces is held once.
-// Barycentric weights w of point q in the plane of triangle (a, b, c) (unit normal n, area2 =
-// |(b - a) x (c - a)|), from signed sub-triangle areas: negative outside it.
-void plane_barycentric(const double q[3], const double a[3], const double b[3], const double c[3], const double n[3],
-                       double area2, double w[3]) {
+    const double minus_n[3] = {-n[0], -n[1], -n[2]};
+    double s[3];
+    support(pose, minus_n, s);
+    const double as[3] = {a[0] - s[0], a[1] - s[1], a[2] - s[2]};
+    const double depth = dot3(n, as);
+    if (!(depth > 0.0)) return false;
+    const double centre[3] = {pose.p[0] - a[0], pose.p[1] - a[1], pose.p[2] - a[2]};
+    if (!(dot3(n, centre) > 0.0)) return false;  // the shape's centre must be on the outer side
+
+    const double q[3] = {s[0] + depth * n[0], s[1] + depth * n[1], s[2] + depth * n[2]};
+    // Barycentric weights from signed sub-triangle areas (robust, no normal-equation solve).
     const double qa[3] = {a[0] - q[0], a[1] - q[1], a[2] - q[2]};
     const double qb[3] = {b[0] - q[0], b[1] - q[1], b[2] - q[2]};
     const double qc[3] = {c[0] - q[0], c[1] - q[1], c[2] - q[2]};
-    double t[3];
+    double t[3], w[3];
     cross3(qb, qc, t);
     w[0] = dot3(n, t) / area2;
     cross3(qc, qa, t);
     w[1] = dot3(n, t) / area2;
     cross3(qa, qb, t);
     w[2] = dot3(n, t) / area2;
-}
-
-bool owned_barycentric(const double q[3], const double a[3], const double b[3], const double c[3], const double n[3],
-                       double area2, double w[3]) {
-    plane_barycentric(q, a, b, c, n, area2, w);
+    // On an edge (to round-off) the point belongs to one of the two triangles that share it:
+    // to the one that runs along the edge from its lexicographically smaller end (the other
+    // runs along it the other way), so that a tool on the edge between two faces is held once.
     const double tolerance = 1e-12;
     const double* corner[3] = {a, b, c};
     for (int k = 0; k < 3; ++k) {
@@ -695,102 +706,14 @@ bool owned_barycentric(const double q[3], const double a[3], const double b[3], 
         sum += w[k];
     }
     if (!(sum > 0.0) || !std::isfinite(sum)) return false;
-    for (int k = 0; k < 3; ++k) w[k] /= sum;
-    return true;
-}
 
-// Unit normal n of triangle (a, b, c), (b - a) x (c - a) normalised; area2 gets its length.
-// False if the triangle has no area against its longest edge (or is not finite).
-bool triangle_normal(const double a[3], const double b[3], const double c[3], double n[3], double& area2) {
-    const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double ac[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double bc[3] = {c[0] - b[0], c[1] - b[1], c[2] - b[2]};
-    cross3(ab, ac, n);
-    area2 = norm3(n);
-    const double edge2 = std::max({dot3(ab, ab), dot3(ac, ac), dot3(bc, bc)});
-    if (!(area2 > 1e-14 * edge2)) return false;
-    for (int k = 0; k < 3; ++k) n[k] /= area2;
-    return true;
-}
-
-// Least cosine between a lowered triangle's normal and its own (about 84 degrees): beyond, the
-// lowering is as large as the triangle and its nodes' contacts carry the tool.
-constexpr double kLeastTiltCosine = 0.1;
-
-}  // namespace
-
-bool Shape::penetrate_triangle(const Pose& pose, const double a[3], const double b[3], const double c[3],
-                               const double lowered[3], TrianglePenetration& out) const {
-    if (kind_ == SH_SHAPE_PLANE) return false;
-    double n[3], area2 = 0.0;
-    if (!triangle_normal(a, b, c, n, area2)) return false;
-    const double centre[3] = {pose.p[0] - a[0], pose.p[1] - a[1], pose.p[2] - a[2]};
-    if (!(dot3(n, centre) > 0.0)) return false;  // the shape's centre must be on the outer side
-    // The triangle owns the shape's deepest point below its own plane (its support along -n)
-    // if that point's foot falls inside it: the same partition between neighbours whatever
-    // their nodes' lowerings.
-    double s[3], w[3];
-    const double minus_n[3] = {-n[0], -n[1], -n[2]};
-    support(pose, minus_n, s);
-    double height = dot3(n, a) - dot3(n, s);
-    double q[3] = {s[0] + height * n[0], s[1] + height * n[1], s[2] + height * n[2]};
-    if (!owned_barycentric(q, a, b, c, n, area2, w)) return false;
-    // Its depth: the shape's deepest point s' below the lowered triangle's plane (extended
-    // beyond the triangle), its support along -n', the lowered plane's inward normal.
-    double low[3][3], tilted[3], tilted_area2 = 0.0;
-    const double* corner[3] = {a, b, c};
-    for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k) low[i][k] = corner[i][k] - lowered[i] * n[k];
-    if (!triangle_normal(low[0], low[1], low[2], tilted, tilted_area2)) return false;
-    if (!(dot3(tilted, n) > kLeastTiltCosine)) return false;
-    if (lowered[0] != 0.0 || lowered[1] != 0.0 || lowered[2] != 0.0) {
-        const double minus_tilted[3] = {-tilted[0], -tilted[1], -tilted[2]};
-        support(pose, minus_tilted, s);
-        height = dot3(n, a) - dot3(n, s);
-        for (int k = 0; k < 3; ++k) q[k] = s[k] + height * n[k];
-        plane_barycentric(q, a, b, c, n, area2, w);
-    }
-    const double depth = height - (w[0] * lowered[0] + w[1] * lowered[1] + w[2] * lowered[2]);
-    if (!(depth > 0.0) || !std::isfinite(depth)) return false;
     out.depth = depth;
-    out.height = height;
-    out.area2 = area2;
     for (int k = 0; k < 3; ++k) {
-        out.normal[k] = n[k];
-        out.tilted[k] = tilted[k];
+        out.normal[k] = -n[k];
         out.point[k] = q[k];
-        out.bary[k] = w[k];
+        bary[k] = w[k] / sum;
     }
     return true;
-}
-
-// The overlap over the directions across an edge is least where two support points of the
-// shape are equally deep (a box's or a capsule's edge across the surface edge) or where one's
-// overlap is stationary. The point the contact acts through is the combination of the supports
-// on either side of that direction at which the overlap is stationary, (a - s) . dm/dangle = 0
-// (the minimax's envelope): the closest points of the two edges, not whichever support the
-// query returned.
-template <class Direction>
-void Shape::stationary_support(const Pose& pose, const double a[3], double angle, double range, Direction&& direction,
-                               double s[3]) const {
-    const double delta = 1e-6 * range;
-    double m_lo[3], m_hi[3], s_lo[3], s_hi[3], turn[3];
-    direction(angle - delta, m_lo);
-    direction(angle + delta, m_hi);
-    for (int k = 0; k < 3; ++k) {
-        turn[k] = m_hi[k] - m_lo[k];
-        m_lo[k] = -m_lo[k];
-        m_hi[k] = -m_hi[k];
-    }
-    support(pose, m_lo, s_lo);
-    support(pose, m_hi, s_hi);
-    double gap[3], a_hi[3];
-    sub3(s_lo, s_hi, gap);
-    sub3(a, s_hi, a_hi);
-    const double along = dot3(gap, turn);
-    if (!(std::fabs(along) > 0.0)) return;  // one support on both sides: s is stationary
-    const double mu = std::min(1.0, std::max(0.0, dot3(a_hi, turn) / along));
-    for (int k = 0; k < 3; ++k) s[k] = s_hi[k] + mu * gap[k];
 }
 
 bool Shape::penetrate_edge(const Pose& pose, const double a[3], const double b[3], const double n1[3],
@@ -856,7 +779,6 @@ bool Shape::penetrate_edge(const Pose& pose, const double a[3], const double b[3
     for (int k = 0; k < 3; ++k) minus_m[k] = -m[k];
     support(pose, minus_m, s);
     const double depth = dot3(m, a) - dot3(m, s);
-    if (kind_ != SH_SHAPE_SPHERE) stationary_support(pose, a, angle, range, direction, s);
     if (!(depth > 0.0)) return false;
     const double centre[3] = {pose.p[0] - a[0], pose.p[1] - a[1], pose.p[2] - a[2]};
     if (!(dot3(m, centre) > 0.0)) return false;  // the shape's centre must be on the outer side

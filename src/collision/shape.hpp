@@ -16,17 +16,6 @@ struct Penetration {
     double point[3] = {};   ///< the touched point on the body (world)
 };
 
-/// Where a shape reaches through a (lowered) surface triangle: see Shape::penetrate_triangle.
-struct TrianglePenetration {
-    double depth = 0.0;      ///< height of the lowered triangle over the shape's deepest point (m)
-    double height = 0.0;     ///< height of the triangle itself over that point, along normal (m)
-    double normal[3] = {};   ///< the triangle's unit outward normal n
-    double tilted[3] = {};   ///< the lowered triangle's unit outward normal n'
-    double area2 = 0.0;      ///< |(b - a) x (c - a)| (m^2)
-    double point[3] = {};    ///< the deepest point's projection on the triangle along n (world)
-    double bary[3] = {};     ///< its barycentric weights (each >= 0, sum 1)
-};
-
 /// A rigid shape in its local frame. Sphere and capsule are centred at the origin, the capsule
 /// along local z; the box is centred with half_extents; a convex hull's points are given in the
 /// local frame; a plane is the half-space below the plane z = 0 of its local frame (its
@@ -56,17 +45,15 @@ public:
     /// depth, the outward normal at the nearest surface point and out.point = x.
     bool penetrate_point(const Pose& pose, const double x[3], Penetration& out) const;
 
-    /// True if the shape at pose reaches below the triangle (a, b, c) with its corners lowered
-    /// by lowered[k] >= 0 (m) along its inward normal, over the triangle itself: the shape's
-    /// deepest point s below the lowered triangle's plane (its support along the lowered plane's
-    /// inward normal) lies under the triangle (its projection along the triangle's normal n,
-    /// outward (b - a) x (c - a), falls inside it) at a height over s, minus the interpolated
-    /// lowering there, > 0; and the shape's centre (pose.p) is on the outer side. With no
-    /// lowering this is the shape's overlap with the triangle's plane over the triangle. A point
-    /// on an edge belongs to one of the two triangles that share it. Zero-area triangles,
-    /// lowerings that tilt the plane by more than 84 degrees, and planes give false.
+    /// True if the shape at pose reaches through the triangle (a, b, c) from its outer side:
+    /// the shape's deepest point below the triangle's plane (outward normal (b - a) x (c - a))
+    /// projects inside the triangle and lies depth > 0 below it, with the shape's centre
+    /// (pose.p) on the outer side. Then out.normal is minus the triangle's unit outward normal
+    /// (the push that moves the triangle out of the shape), out.point the deepest point's
+    /// projection on the triangle and bary its barycentric weights (each >= 0, sum 1).
+    /// Zero-area triangles and planes give false.
     bool penetrate_triangle(const Pose& pose, const double a[3], const double b[3], const double c[3],
-                            const double lowered[3], TrianglePenetration& out) const;
+                            Penetration& out, double bary[3]) const;
 
     /// True if the shape at pose reaches through the edge (a, b) where two surface triangles
     /// with unit outward normals n1 and n2 meet in a convex dihedral, in the edge's own region:
@@ -90,11 +77,6 @@ private:
     static constexpr int kMaxDirections = 17;  ///< convex: sampled directions (see shape.cpp)
 
     void init_convex(const sh_shape& def);
-    /// penetrate_edge: the contact point s where the overlap over the directions across the
-    /// edge is least, at angle of range (see shape.cpp).
-    template <class Direction>
-    void stationary_support(const Pose& pose, const double a[3], double angle, double range, Direction&& direction,
-                            double s[3]) const;
     /// Convex: index of the point farthest along local direction d.
     int convex_support_index(const double d[3]) const;
     /// Convex: penetration of local point xl (depth, local outward normal nl).

@@ -122,7 +122,7 @@ BodyContacts::BodyContacts(const Body& body) : body_(body) {
     edge_neighbor_.assign(tris.size(), -1);
     pair_triangles_across_edges(tris.data(), tris.size() / 3, edge_neighbor_.data());
     stamp_.assign(n, 0);
-    node_depth_.assign(n, NodeDepth{});
+    node_depth_.assign(n, 0.0);
 }
 
 void BodyContacts::clear() {
@@ -425,17 +425,26 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
             for (int k = 0; k < 3; ++k) out.gradient[a][k] = weights[a] * out.normal[k];
         }
     };
+    // A tool between the nodes of a face or an edge: once one of them (or, for an edge, a node
+    // of the two triangles that meet there, whose contacts take over at either side) touches
+    // the same collider, the node contacts carry it (their constraint is what the mesh can
+    // resolve).
+    auto node_touches = [&](const int32_t* nodes, int count) {
+        for (int k = 0; k < count; ++k)
+            if (node_depth_[static_cast<size_t>(nodes[k])] > 0.0) return true;
+        return false;
+    };
     const double one = 1.0;
     switch (c.kind) {
         case ContactCandidate::kNodeShape:
             if (!node_shape_contact(*c.collider, x, c.node, out)) return false;
             break;
         case ContactCandidate::kFaceShape:
-            if (!face_shape_contact(*c.collider, x, c.face, node_depth_.data(), out)) return false;
+            if (!face_shape_contact(*c.collider, x, c.face, out) || node_touches(c.face, 3)) return false;
             break;
         case ContactCandidate::kEdgeShape: {
             const int32_t edge[4] = {c.face[0], c.face[1], c.face[2], c.node};
-            if (!edge_shape_contact(*c.collider, x, edge, node_depth_.data(), out)) return false;
+            if (!edge_shape_contact(*c.collider, x, edge, out) || node_touches(edge, 4)) return false;
             break;
         }
         case ContactCandidate::kNodeFace:
@@ -473,8 +482,7 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
         apply_step_normal_law(p, step_law(c), vrel, out);
         return true;
     }
-    const double rate = !v ? 0.0 : c.collider ? depth_rate(*c.collider, out, v) : -dot3(out.normal, vrel);
-    apply_normal_law(p, v ? vrel : nullptr, rate, out);
+    apply_normal_law(p, v ? vrel : nullptr, out);
     // Explicit bodies evaluate forces at the (sub)step's start: the friction there is
     // proportional to the normal force there.
     if (v && out.normal_force > 0.0 && p.static_friction > 0.0) apply_friction(p, out.normal_force, out);
@@ -500,12 +508,12 @@ void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& 
                 emit(c, static_cast<const ContactPoint*>(nullptr));
                 continue;
             }
-            if (c.kind == ContactCandidate::kNodeShape) node_depth_[static_cast<size_t>(c.node)] = node_depth_of(*c.collider, point);
+            if (c.kind == ContactCandidate::kNodeShape) node_depth_[static_cast<size_t>(c.node)] = point.depth;
             emit(c, &point);
         }
         for (int32_t i = group.begin; i < group.end; ++i) {
             const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
-            if (c.kind == ContactCandidate::kNodeShape) node_depth_[static_cast<size_t>(c.node)] = NodeDepth{};
+            if (c.kind == ContactCandidate::kNodeShape) node_depth_[static_cast<size_t>(c.node)] = 0.0;
         }
     }
 }

@@ -172,7 +172,7 @@ private:
     uint32_t pass_ = 0;
     vec<ContactCandidate> candidates_;
     vec<Group> groups_;
-    mutable vec<NodeDepth> node_depth_; ///< per node: its contact with the current group's collider
+    mutable vec<double> node_depth_; ///< per node: its depth in the current group's collider
     vec<double> keys_;               ///< scratch for keep_deepest
     mutable double evaluation_seconds_ = 0.0;
     /// Explicit bodies: a friction contact as the (sub)step's first add_forces found it, for

@@ -14,9 +14,8 @@ struct ContactPoint {
     int count;               ///< 1, 2 (kEdgeShape) or 3
     double weights[3];       ///< own nodes' shares of the node side's motion and friction (sign
                              ///< included: kFaceNode's own face is the far side)
-    double gradient[3][3];   ///< per own node: -d depth / d x (the normal force on it is the
-                             ///< normal force times this); its weight times the normal for node
-                             ///< and body-pair contacts
+    double gradient[3][3];   ///< per own node: -d depth / d x, its weight times the normal (the
+                             ///< normal force on it is the normal force times this)
     double node_force[3][3]; ///< per own node: the force it feels (N)
     double stiffness;        ///< dFn/dx (N/m)
     double damping;          ///< dFn/dx' (N s/m)

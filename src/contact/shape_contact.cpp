@@ -40,162 +40,45 @@ bool node_shape_contact(const Collider& collider, const double* x, int32_t node,
     return true;
 }
 
-namespace {
-
-// Share of a collider's inner radius over which a node's lowering reaches its depth's slope.
-constexpr double kLoweringScale = 0.1;
-
-// The lowering of node nodes[node] (0 without nodes).
-inline double node_lowering(const NodeDepth* nodes, int32_t node) {
-    return nodes ? nodes[static_cast<size_t>(node)].lowering : 0.0;
-}
-
-// Adds scale times node nodes[node]'s push times its lowering's slope to g: minus the
-// lowering's gradient.
-inline void add_node_push(const NodeDepth* nodes, int32_t node, double scale, double g[3]) {
-    if (!nodes || !(nodes[static_cast<size_t>(node)].slope > 0.0)) return;
-    const NodeDepth& d = nodes[static_cast<size_t>(node)];
-    for (int k = 0; k < 3; ++k) g[k] += scale * d.slope * d.normal[k];
-}
-
-}  // namespace
-
-NodeDepth node_depth_of(const Collider& collider, const ContactPoint& p) {
-    NodeDepth d;
-    d.depth = p.depth;
-    for (int k = 0; k < 3; ++k) d.normal[k] = p.normal[k];
-    const double delta = kLoweringScale * collider.shape.inner_radius();
-    // Below delta the cubic 2 d^2 / delta - d^3 / delta^2 (value and slope 0 at 0, d and 1 at
-    // delta, never above d); beyond it the depth itself. A plane has no faces to lower.
-    const double r = std::isfinite(delta) && delta > 0.0 ? p.depth / delta : INFINITY;
-    d.lowering = r < 1.0 ? p.depth * r * (2.0 - r) : p.depth;
-    d.slope = r < 1.0 ? r * (4.0 - 3.0 * r) : 1.0;
-    return d;
-}
-
-bool face_shape_contact(const Collider& collider, const double* x, const int32_t face[3], const NodeDepth* nodes,
-                        ContactPoint& out) {
-    const double* corner[3] = {at(x, face[0]), at(x, face[1]), at(x, face[2])};
-    const double lowered[3] = {node_lowering(nodes, face[0]), node_lowering(nodes, face[1]), node_lowering(nodes, face[2])};
-    TrianglePenetration pen;
-    if (!collider.shape.penetrate_triangle(collider.pose, corner[0], corner[1], corner[2], lowered, pen)) return false;
-    const double* n = pen.normal;
-    const double* nt = pen.tilted;
-    const double cosine = dot3(n, nt);
-    // The depth e = H - sum_j w_j l_j: H the triangle's height over the collider's deepest point
-    // s' (along n), l_j the nodes' lowerings, w the weights of s''s foot. As a maximum over the
-    // triangle (s' is where the collider reaches deepest below the lowered plane), its gradient
-    // holds w fixed (envelope theorem): dH/dx_j = (w_j n' + H (e_j x t) / area2) / (n'.n), t the
-    // part of n' across n and e_j the edge opposite node j (the second term is n's turning),
-    // and -w_j dl_j/dx_j = w_j times node j's lowering slope times its push.
-    double across[3];
-    for (int k = 0; k < 3; ++k) across[k] = nt[k] - cosine * n[k];
-    double opposite[3][3];
-    for (int j = 0; j < 3; ++j) sub3(corner[(j + 2) % 3], corner[(j + 1) % 3], opposite[j]);
-    out.depth = pen.depth;
-    out.count = 3;
-    out.law_scale = 1.0;
-    for (int k = 0; k < 3; ++k) {
-        out.normal[k] = -nt[k];
-        out.point[k] = pen.point[k];
-    }
-    for (int j = 0; j < 3; ++j) {
-        double turn[3], d_depth[3];
-        cross3(opposite[j], across, turn);
-        for (int k = 0; k < 3; ++k) d_depth[k] = (pen.bary[j] * nt[k] + pen.height * turn[k] / pen.area2) / cosine;
-        add_node_push(nodes, face[j], pen.bary[j], d_depth);
-        out.nodes[j] = face[j];
-        out.weights[j] = pen.bary[j];
-        for (int k = 0; k < 3; ++k) out.gradient[j][k] = -d_depth[k];
-    }
+bool face_shape_contact(const Collider& collider, const double* x, const int32_t face[3], ContactPoint& out) {
+    Penetration pen;
+    double w[3];
+    if (!collider.shape.penetrate_triangle(collider.pose, at(x, face[0]), at(x, face[1]), at(x, face[2]), pen, w))
+        return false;
+    set_geometry(pen, 3, face, w, out);
     return true;
 }
 
-namespace {
-
-// Unit outward normals n1 of own triangle (a, b, c) and n2 of the one across (b, a, d), if the
-// edge (a, b) between them is convex: d lies behind own triangle's plane.
-bool convex_edge_normals(const double* a, const double* b, const double* c, const double* d, double n1[3],
-                         double n2[3]) {
-    double ab[3], ac[3], ad[3];
+bool edge_shape_contact(const Collider& collider, const double* x, const int32_t edge[4], ContactPoint& out) {
+    const double *a = at(x, edge[0]), *b = at(x, edge[1]);
+    double ab[3], ac[3], ad[3], n1[3], n2[3];
     sub3(b, a, ab);
-    sub3(c, a, ac);
-    sub3(d, a, ad);
-    cross3(ab, ac, n1);
-    cross3(ad, ab, n2);
+    sub3(at(x, edge[2]), a, ac);
+    sub3(at(x, edge[3]), a, ad);
+    cross3(ab, ac, n1);  // own triangle (a, b, c), outward
+    cross3(ad, ab, n2);  // the one across, (b, a, d), outward
     const double l1 = norm3(n1), l2 = norm3(n2);
     if (!(l1 > 0.0 && l2 > 0.0)) return false;
     for (int k = 0; k < 3; ++k) {
         n1[k] /= l1;
         n2[k] /= l2;
     }
-    return dot3(n1, ad) < -1e-9 * std::sqrt(dot3(ab, ab) * dot3(ad, ad));
-}
-
-}  // namespace
-
-bool edge_shape_contact(const Collider& collider, const double* x, const int32_t edge[4], const NodeDepth* nodes,
-                        ContactPoint& out) {
-    const double *a = at(x, edge[0]), *b = at(x, edge[1]);
-    double n1[3], n2[3];
-    if (!convex_edge_normals(a, b, at(x, edge[2]), at(x, edge[3]), n1, n2)) return false;
+    // Convex there: the node across lies behind own triangle's plane.
+    if (!(dot3(n1, ad) < -1e-9 * std::sqrt(dot3(ab, ab) * dot3(ad, ad)))) return false;
     Penetration pen;
     double t = 0.0;
     if (!collider.shape.penetrate_edge(collider.pose, a, b, n1, n2, pen, t)) return false;
-    // The edge's depth D has gradient ((1 - t) m, t m), m = -pen.normal, t where the collider
-    // touches the edge (exact: the overlap is least over the directions across the edge). The
-    // nodes carry their lowerings interpolated at c, the foot of the collider's centre on the
-    // edge's line (clamped to the edge): a smooth share whose gradient holds the centre fixed,
-    // dc/da = ((2c - 1) (b - a) - (p - a)) / L^2, dc/db = ((p - a) - 2c (b - a)) / L^2.
-    const double da = node_lowering(nodes, edge[0]), db = node_lowering(nodes, edge[1]);
-    double ab[3], ap[3];
-    sub3(b, a, ab);
-    sub3(collider.pose.p, a, ap);
-    const double length2 = dot3(ab, ab);
-    const double foot = dot3(ap, ab) / length2;
-    const double c = std::min(1.0, std::max(0.0, foot));
-    const double depth = pen.depth - (1.0 - c) * da - c * db;
-    if (!(depth > 0.0)) return false;
-    const bool inside = foot > 0.0 && foot < 1.0;
     const double w[2] = {1.0 - t, t};
-    double d_depth[2][3];
-    for (int k = 0; k < 3; ++k) {
-        const double dc_da = inside ? ((2.0 * c - 1.0) * ab[k] - ap[k]) / length2 : 0.0;
-        const double dc_db = inside ? (ap[k] - 2.0 * c * ab[k]) / length2 : 0.0;
-        d_depth[0][k] = -w[0] * pen.normal[k] - (db - da) * dc_da;
-        d_depth[1][k] = -w[1] * pen.normal[k] - (db - da) * dc_db;
-    }
-    const double share[2] = {1.0 - c, c};
-    for (int j = 0; j < 2; ++j) add_node_push(nodes, edge[j], share[j], d_depth[j]);
-    out.depth = depth;
-    out.count = 2;
-    for (int k = 0; k < 3; ++k) {
-        out.normal[k] = pen.normal[k];
-        out.point[k] = pen.point[k];
-    }
-    for (int j = 0; j < 2; ++j) {
-        out.nodes[j] = edge[j];
-        out.weights[j] = w[j];
-        for (int k = 0; k < 3; ++k) out.gradient[j][k] = -d_depth[j][k];
-    }
-    // Where the edge's region meets a face's (the least overlap at n1 or n2), the edge's depth
-    // is the face's: the whole law on both sides keeps the potential continuous across it.
-    out.law_scale = 1.0;
+    set_geometry(pen, 2, edge, w, out);
+    // The edge's region (the directions between n1 and n2) closes as the edge flattens, and
+    // past flat the two faces' regions overlap instead (each takes the tool, see
+    // penetrate_triangle): its law ramps in with the dihedral angle up to kFullEdgeAngle, so
+    // that an edge that folds through flat under load (the faces of a dent) changes the force
+    // continuously. A sharp edge has the whole law.
+    double fold[3];
+    cross3(n1, n2, fold);
+    out.law_scale = std::min(1.0, std::atan2(norm3(fold), dot3(n1, n2)) / kFullEdgeAngle);
     return true;
-}
-
-double depth_rate(const Collider& collider, const ContactPoint& out, const double* v) {
-    // d depth/dt = sum_j (d depth/dx_j) . (v_j - v_c): moving the body and the collider
-    // together leaves the depth as it is.
-    double vc[3];
-    collider.point_velocity(out.point, vc);
-    double rate = 0.0;
-    for (int a = 0; a < out.count; ++a) {
-        double dv[3];
-        sub3(at(v, out.nodes[a]), vc, dv);
-        rate -= dot3(out.gradient[a], dv);
-    }
-    return rate;
 }
 
 void velocity_against_collider(const Collider& collider, const ContactPoint& out, const double* v, double vrel[3]) {
@@ -226,8 +109,9 @@ void set_normal_force(const NormalForce& fn, const double* vrel, ContactPoint& o
 
 }  // namespace
 
-void apply_normal_law(const sh_contact_params& p, const double* vrel, double rate, ContactPoint& out) {
-    set_normal_force(hunt_crossley(p, out.depth, rate), vrel, out);
+void apply_normal_law(const sh_contact_params& p, const double* vrel, ContactPoint& out) {
+    const double normal_speed = vrel ? dot3(out.normal, vrel) : 0.0;
+    set_normal_force(hunt_crossley(p, out.depth, -normal_speed), vrel, out);
 }
 
 void apply_step_normal_law(const sh_contact_params& p, const StepLaw& law, const double* vrel, ContactPoint& out) {

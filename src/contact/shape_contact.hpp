@@ -15,60 +15,28 @@
 
 namespace sh {
 
-/// A node's contact with one collider, as the node contacts found it: what the face and edge
-/// contacts next to it leave to it.
-struct NodeDepth {
-    double depth = 0.0;     ///< m; 0 if the node does not touch
-    double lowering = 0.0;  ///< how far its faces and edges are lowered (m): node_lowering
-    double slope = 0.0;     ///< d lowering / d depth
-    double normal[3] = {};  ///< unit push on the node (the collider's outward normal there)
-};
-
-/// The NodeDepth of a node contact p with collider.
-NodeDepth node_depth_of(const Collider& collider, const ContactPoint& p);
-
-// One collider's contact potential over a body's surface is the sum of a term per touching
-// node, surface triangle and convex surface edge, each Hunt-Crossley's potential of its own
-// depth: a node's is its depth in the collider; a triangle's is the collider's depth below the
-// triangle lowered by its nodes' depths (what the node contacts leave over the triangle); an
-// edge's is its depth minus its nodes' lowerings interpolated at the touching point. A
-// node's lowering grows smoothly from zero (d^2 / 2 delta up to delta, then d - delta / 2,
-// delta a tenth of the collider's inner radius), so that the force stays continuous as a node
-// enters the collider and no node is pulled into it by its faces. A tool
-// between nodes is held by the triangle or edge it touches, and as a node reaches it the
-// node's term takes over continuously; a tool covering many nodes is held by them, the
-// triangles adding only the curvature the nodes miss.
-
 /// Node `node` (positions x) inside the collider: fills out's depth, normal, point and one
-/// node of weight 1, and depth's gradient. False if it does not touch.
+/// node of weight 1. False if it does not touch.
 bool node_shape_contact(const Collider& collider, const double* x, int32_t node, ContactPoint& out);
 
-/// The collider reaching through the triangle face (positions x) lowered by its nodes'
-/// lowerings (nodes[i] their NodeDepth, by node index; null: none touch): fills out's
-/// depth, normal (the collider's push there), point, the three nodes weighted barycentrically
-/// and the depth's exact gradient. False if it does not.
-bool face_shape_contact(const Collider& collider, const double* x, const int32_t face[3], const NodeDepth* nodes,
-                        ContactPoint& out);
+/// The collider reaching through the triangle face (positions x) between its nodes: fills
+/// out's geometry with the three nodes weighted barycentrically. False if it does not.
+bool face_shape_contact(const Collider& collider, const double* x, const int32_t face[3], ContactPoint& out);
 
 /// The collider on the convex surface edge (edge[0], edge[1]) between own triangle
-/// (edge[0], edge[1], edge[2]) and the one across, (edge[1], edge[0], edge[3]), both outward,
-/// beyond what its two nodes' contacts carry (nodes as for face_shape_contact): fills out's
-/// geometry and gradient with the edge's two nodes, and out.law_scale, the share of the law an
+/// (edge[0], edge[1], edge[2]) and the one across, (edge[1], edge[0], edge[3]), both outward:
+/// fills out's geometry with the edge's two nodes and out.law_scale, the share of the law an
 /// edge flatter than 15 degrees carries. False if the edge is not convex or not touched.
-bool edge_shape_contact(const Collider& collider, const double* x, const int32_t edge[4], const NodeDepth* nodes,
-                        ContactPoint& out);
-
-/// Rate of out's depth (m/s, > 0 deepening) at node velocities v, the collider moving.
-double depth_rate(const Collider& collider, const ContactPoint& out, const double* v);
+bool edge_shape_contact(const Collider& collider, const double* x, const int32_t edge[4], ContactPoint& out);
 
 /// Velocity (m/s) of out's node side (its weighted nodes at velocities v) relative to the
 /// collider's material point at out.point.
 void velocity_against_collider(const Collider& collider, const ContactPoint& out, const double* v, double vrel[3]);
 
 /// Fills out's normal law from its geometry: the Hunt-Crossley force times out.law_scale at
-/// the depth rate `rate` (m/s), its stiffness and damping, out.relative_velocity = vrel (null:
-/// at rest) and node forces of the normal force alone; no friction yet.
-void apply_normal_law(const sh_contact_params& p, const double* vrel, double rate, ContactPoint& out);
+/// the relative velocity vrel (null: at rest), its stiffness and damping, out.relative_velocity,
+/// and node forces of the normal force alone; no friction yet.
+void apply_normal_law(const sh_contact_params& p, const double* vrel, ContactPoint& out);
 
 /// apply_normal_law for a body stepped implicitly: the force of law (hunt_crossley_step_law,
 /// whose damping is in the depth) at out.depth; out.damping is 0.

@@ -20,7 +20,7 @@ struct WorkingArrays {
     double* force;
     double* saved_x;
     double* saved_v;
-    NodeDepth* depth;
+    double* depth;
     FrictionRecord* friction;
 };
 
@@ -35,7 +35,7 @@ void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3
     w.force = arena.take<double>(3 * n);
     w.saved_x = arena.take<double>(3 * n);
     w.saved_v = arena.take<double>(3 * n);
-    w.depth = arena.take<NodeDepth>(n);
+    w.depth = arena.take<double>(n);
     w.friction = arena.take<FrictionRecord>(static_cast<size_t>(capacity.friction_records()));
 }
 

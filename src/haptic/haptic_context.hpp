@@ -6,7 +6,6 @@
 #pragma once
 
 #include "contact/collider.hpp"
-#include "contact/shape_contact.hpp"
 #include "core/memory.hpp"
 #include "haptic/buffer.hpp"
 #include "haptic/force_filter.hpp"
@@ -108,7 +107,7 @@ private:
     double* force_ = nullptr;  ///< 3 per node
     double* saved_x_ = nullptr;
     double* saved_v_ = nullptr;
-    NodeDepth* depth_ = nullptr;  ///< per node: its contact with the tool at this evaluation
+    double* depth_ = nullptr;  ///< per node: its depth in the tool at this evaluation
     FrictionRecord* friction_ = nullptr;  ///< the sub-step's friction contacts
     int32_t friction_capacity_ = 0;
     int32_t friction_count_ = 0;

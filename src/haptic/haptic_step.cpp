@@ -71,21 +71,11 @@ void visit_features_in_box(const Buffer& b, const double* x, const double lo[3],
     }
 }
 
-// The contact of the tool with a feature of visit_features_in_box; a node's contact is
-// recorded in depths (which visit_features_in_box's order fills before the edges and faces
-// that read it).
-bool feature_contact(const Collider& tool, const double* x, const int32_t* nodes, int count, NodeDepth* depths,
-                     ContactPoint& out) {
-    if (count == 4) return edge_shape_contact(tool, x, nodes, depths, out);
-    if (count == 3) return face_shape_contact(tool, x, nodes, depths, out);
-    if (!node_shape_contact(tool, x, nodes[0], out)) return false;
-    depths[nodes[0]] = node_depth_of(tool, out);
-    return true;
-}
-
-// Clears the depths of b's surface nodes.
-void clear_depths(const Buffer& b, NodeDepth* depths) {
-    for (int32_t s = 0; s < b.surface_node_count; ++s) depths[b.surface_nodes[s]] = NodeDepth{};
+// The contact of the tool with a feature of visit_features_in_box.
+bool feature_contact(const Collider& tool, const double* x, const int32_t* nodes, int count, ContactPoint& out) {
+    if (count == 1) return node_shape_contact(tool, x, nodes[0], out);
+    if (count == 4) return edge_shape_contact(tool, x, nodes, out);
+    return face_shape_contact(tool, x, nodes, out);
 }
 
 }  // namespace
@@ -145,10 +135,9 @@ double HapticContext::substep_limit(const Buffer& b, const double* x, const doub
             k[1] = std::max(k[1], fn.damping);
         }
     };
-    clear_depths(b, depth_);
     visit_features_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count) {
         ContactPoint p;
-        const bool touching = feature_contact(tool_, x, nodes, count, depth_, p);
+        const bool touching = feature_contact(tool_, x, nodes, count, p);
         reach(nodes, count == 4 ? 2 : count, touching, p.depth);
     });
     const double omega_fem = b.dt_stable > 0.0 && std::isfinite(b.dt_stable) ? 2.0 / b.dt_stable : 0.0;
@@ -170,7 +159,7 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
     auto act = [&](ContactPoint& p) {
         double vrel[3];
         velocity_against_collider(tool_, p, v, vrel);
-        apply_normal_law(law, vrel, depth_rate(tool_, p, v), p);
+        apply_normal_law(law, vrel, p);
         for (int a = 0; a < p.count; ++a)
             for (int k = 0; k < 3; ++k) at(f, p.nodes[a])[k] += p.node_force[a][k];
         add_reaction(p, x, tool_.pose.p, force, torque);
@@ -184,12 +173,16 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         p.friction_normal = p.normal_force;
         friction_[friction_count_++] = friction_record(p, law, v);
     };
-    // The contact potential of contact/shape_contact.hpp: nodes first, then the edges and
-    // triangles with what their nodes leave.
-    clear_depths(b, depth_);
+    for (int32_t s = 0; s < b.surface_node_count; ++s) depth_[b.surface_nodes[s]] = 0.0;
+    // Nodes first; a tool between nodes: edges and triangles act while none of their nodes
+    // touches.
     visit_features_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count) {
+        for (int a = 0; a < count && count > 1; ++a)
+            if (depth_[nodes[a]] > 0.0) return;
         ContactPoint p;
-        if (feature_contact(tool_, x, nodes, count, depth_, p)) act(p);
+        if (!feature_contact(tool_, x, nodes, count, p)) return;
+        if (count == 1) depth_[nodes[0]] = p.depth;
+        act(p);
     });
 }
 

@@ -1,0 +1,272 @@
+"""Contact that holds on real organ meshes: five scenes a new user runs first, at 60 Hz (the membrane
+at 1 ms) with implicit Euler, checked against what the physics requires rather than against
+recorded numbers.
+
+The liver is SOFA's liver2 scaled to 21 cm with its lowest 1.5 cm fixed (hanging_liver: 3 kPa,
+nu 0.45, 1000 kg/m^3). The tool scenes run without gravity, so that the tool force is the
+contact alone (under gravity this soft liver collapses: that is the energy scene). A 1 cm sphere
+(contact 1e3 N/m^1.5, n 1.5) presses 1.5 cm into the top above the fixed base, where the organ
+is squeezed rather than bent. The press triangle's three nodes pushed straight down (static
+solves, no contact) meet a reaction that grows steadily: at 4, 8, 12 and 16 mm 0.30, 0.58, 0.85
+and 1.10 N for corotational, 0.31, 0.64, 0.99 and 1.35 N for neo-Hookean, 0.28, 0.49, 0.64 and
+0.70 N for StVK (which softens in compression: hence 1.5 cm, not 2), a fifth of it sideways. The
+contact's depth (F / lambda)^(2/3) plus the organ's travel under F make the tool's 1.5 cm at
+F = 0.51 (StVK) to 0.62 N (neo-Hookean); with a 10x stiffer law, which held the tool in version
+0.6.0, this two-spring estimate gives 0.91, 1.06 and 0.66 N where the press reached 0.89, 1.06
+and 0.59 N (corotational, neo-Hookean, StVK). The tool has friction 0.5, enough to hold the
+sideways part: a frictionless sphere on this coarse, tilting top lets the organ slide out from
+under it, and the force falls (by a third with a 100x stiffer law) even when the contact holds.
+"""
+
+import numpy as np
+import pytest
+
+import softhap
+from test_contact import box_mesh
+from test_implicit_robust import hanging_liver
+
+HZ60 = 1.0 / 60.0
+
+# A tool as small as the coarse mesh's elements still sinks between its nodes once a node
+# touches it (README, Limits): these scenes fail on that today. strict: when contact holds,
+# they pass and the marker must go.
+SINKS_BETWEEN_NODES = pytest.mark.xfail(
+    strict=True, reason="a small tool sinks between a coarse mesh's nodes once one touches it (README Limits)")
+
+
+def press_triangle(mesh):
+    """Centroid and unit normal of the nearly level top triangle (normal z > 0.98) nearest, in
+    plan, to the fixed base's centroid."""
+    x, tri = mesh.nodes, mesh.surface_triangles
+    a, b, c = x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]]
+    normal = np.cross(b - a, c - a)
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    centroid = (a + b + c) / 3
+    base = x[x[:, 2] < x[:, 2].min() + 0.015].mean(axis=0)
+    level = np.flatnonzero(normal[:, 2] > 0.98)
+    best = level[np.argmin(np.linalg.norm(centroid[level, :2] - base[:2], axis=1))]
+    return centroid[best], normal[best]
+
+
+def largest_fall(forces):
+    """Largest fall of a force below its running maximum."""
+    forces = np.asarray(forces)
+    return (np.maximum.accumulate(forces) - forces).max()
+
+
+def liver_and_tool(world, meshes, model, radius):
+    body = hanging_liver(world, meshes, model)
+    mesh = softhap.Mesh.load(str(meshes / "liver2.msh")).transform(0.1)
+    centroid, normal = press_triangle(mesh)
+    top = centroid + (0.0, 0.0, radius / normal[2])
+    tool = world.add_tool("sphere", radius=radius, position=top, stiffness=1e3, exponent=1.5,
+                          friction=0.5)
+    return body, tool, top
+
+
+DEPTH = 0.015  # 1.5 cm in 1 s (60 steps at 60 Hz), then held 1 s
+
+
+def pose_at(top, t):
+    return top - (0.0, 0.0, DEPTH * min(1.0, t))
+
+
+@SINKS_BETWEEN_NODES
+@pytest.mark.parametrize("model", ["corotational", "stvk", "neohookean"])
+def test_palpation_force_grows_while_pressing_and_holds(meshes, model):
+    with softhap.World(gravity=(0, 0, 0)) as world:
+        _, tool, top = liver_and_tool(world, meshes, model, 0.01)
+        forces = []
+        for i in range(120):
+            tool.set_pose(pose_at(top, (i + 1) / 60))
+            world.step(HZ60)  # raises on a failed step
+            forces.append(np.linalg.norm(tool.force))
+        press, hold = np.array(forces[:60]), np.array(forces[60:])
+        # A few steps may keep their best iterate, not a stream of them.
+        assert world.warnings["SH_WARN_NOT_CONVERGED"] <= 3
+        # A quasi-static press (1 s, far slower than the organ's waves) into a body whose
+        # reaction grows with depth: the force grows with depth (5 % of the peak for contacts
+        # moving between surface features).
+        assert largest_fall(press) <= 0.05 * press.max()
+        # The two-spring estimate of the module docstring: 0.51-0.62 N, 10 % high for StVK with
+        # the stiffer law (0.6.0 lost the tool after 0.25 N at 7 mm).
+        assert press[-1] >= 0.35
+        # Held still, the organ settles under the tool and the force holds (80 %: its rebound
+        # after the sudden stop; 2-3 % with the 10x stiffer law).
+        assert hold.min() >= 0.8 * press[-1]
+
+
+def test_collapsing_liver_never_gains_energy(meshes):
+    # Backward Euler dissipates: with no work done from outside after the first step, total
+    # energy (kinetic + elastic + gravitational) never rises above the first step's end by more
+    # than 1 % of the energy in motion (as in test_implicit_robust.py, here 60 steps).
+    with softhap.World(gravity=(0, 0, -9.81)) as world:
+        body = hanging_liver(world, meshes, "neohookean")
+        totals, largest, reach = [], 0.0, 0.0
+        for _ in range(60):
+            report = world.step(HZ60)  # raises on a failed step
+            totals.append(report.kinetic_energy + report.elastic_energy + report.potential_energy)
+            largest = max(largest, report.kinetic_energy + report.elastic_energy)
+            assert "SH_WARN_NOT_CONVERGED" not in report.warnings
+            positions = body.positions
+            assert np.all(np.isfinite(positions))
+            reach = max(reach, np.linalg.norm(positions, axis=1).max())
+        assert largest > 0.1  # it collapses (2.4 J in motion)
+        assert max(totals) - totals[0] <= 0.01 * largest
+        # No explosion: the 21 cm organ (its farthest node 14 cm from the origin) swings and
+        # stretches below its base to 50 cm; metres would be a runaway.
+        assert reach < 1.0
+
+
+# ------------------------------------------------------------------------------------------
+# A thin membrane and a small fast sphere
+
+
+MEMBRANE = (0.04, 0.04, 0.002)  # 4 cm x 4 cm x 2 mm, 20 x 20 x 2 boxes of 2 x 2 x 1 mm
+
+
+@SINKS_BETWEEN_NODES
+@pytest.mark.parametrize("xy", [(0.0207, 0.0193), (0.02, 0.02)], ids=["mid-triangle", "on-node"])
+def test_small_fast_sphere_never_passes_through_a_membrane(xy):
+    mesh = box_mesh(MEMBRANE, (20, 20, 2))
+    x = mesh.nodes
+    radius, cell = 1e-3, 0.002
+    with softhap.World(gravity=(0, 0, 0)) as world:
+        body = world.add_fem_body(mesh, model="corotational", young=1e5, integrator="implicit_euler")
+        rim = (np.isclose(x[:, 0], 0) | np.isclose(x[:, 0], MEMBRANE[0])
+               | np.isclose(x[:, 1], 0) | np.isclose(x[:, 1], MEMBRANE[1]))
+        body.fix_nodes(np.flatnonzero(rim))
+        # The bottom corners of the box under the sphere (the membrane moves mostly vertically).
+        corner = np.floor(np.asarray(xy) / cell + 1e-9) * cell
+        under = [int(np.argmin(np.linalg.norm(x - (corner[0] + dx, corner[1] + dy, 0.0), axis=1)))
+                 for dx in (0, cell) for dy in (0, cell)]
+        touch = MEMBRANE[2] + radius
+        tool = world.add_tool("sphere", radius=radius, position=(xy[0], xy[1], touch))
+        for i in range(10):  # 1 mm per 1 ms step for 5 steps, then held 5 steps
+            centre = touch - 1e-3 * min(i + 1, 5)
+            tool.set_pose((xy[0], xy[1], centre))
+            world.step(1e-3)  # raises on a failed step
+            # A sphere held out of the membrane has its centre above the membrane's top, so
+            # above its bottom; below the bottom it went through.
+            assert centre > body.positions[under, 2].mean(), "through at step %d" % i
+            if i == 4:
+                # Still pushing at 1 m/s: the membrane resists (0.23-0.24 N with contact laws 3
+                # to 100x stiffer, which held here; 0.24 N is 0.83 mm deep in this law, less
+                # than the radius).
+                assert tool.force[2] > 0.05
+
+
+# ------------------------------------------------------------------------------------------
+# Hertz: a sphere pressed quasi-statically into a linear block
+
+
+def graded_positions(h, core, growth, length):
+    """0 = p[0] < ... = length: cells of about h over core, then growing by a ratio <= growth
+    (bisected so that they end at length); tests/test_hertz.c's graded_positions."""
+    core_cells = int(np.ceil(core / h - 1e-9))
+    positions = list(np.linspace(0.0, core, core_cells + 1))
+    hc, rest = core / core_cells, length - core
+    count, total, term = 1, hc * growth, hc * growth
+    while total < rest:
+        term *= growth
+        total += term
+        count += 1
+    lo, hi = 1.0, growth
+    for _ in range(200):
+        q = 0.5 * (lo + hi)
+        lo, hi = (q, hi) if sum(hc * q**k for k in range(1, count + 1)) < rest else (lo, q)
+    for k in range(1, count + 1):
+        positions.append(length if k == count else positions[-1] + hc * q**k)
+    return np.array(positions)
+
+
+def grid_mesh(xs, ys, zs):
+    """box_mesh's Kuhn split on the grid of node planes xs, ys, zs (uneven: graded)."""
+    ny, nz = len(ys) - 1, len(zs) - 1
+    nodes = np.array(np.meshgrid(xs, ys, zs, indexing="ij")).reshape(3, -1).T
+    boxes = [np.arange(len(planes) - 1) for planes in (xs, ys, zs)]
+    cells = np.array(np.meshgrid(*boxes, indexing="ij")).reshape(3, -1)
+    tets = []
+    for path in [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]:
+        corner = cells.copy()
+        tet = [(corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2]]
+        for axis in path:
+            corner[axis] += 1
+            tet.append((corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2])
+        tets.append(np.stack(tet, axis=1))
+    return softhap.Mesh(nodes, np.concatenate(tets))
+
+
+def test_quasi_static_press_of_a_block_follows_hertz_and_the_static_solve():
+    young, poisson, radius = 1e4, 0.3, 0.01
+    # 60 x 60 x 30 mm, 1 mm cells over the contact (radius sqrt(R d) = 2.8 mm), growth <= 1.7:
+    # 9216 tets.
+    side = graded_positions(1e-3, 3e-3, 1.7, 0.03)
+    xs = np.concatenate([-side[::-1], side[1:]])
+    mesh = grid_mesh(xs, xs, -graded_positions(1e-3, 1e-3, 1.7, 0.03)[::-1])
+    with softhap.World(gravity=(0, 0, 0)) as world:
+        body = world.add_fem_body(mesh, model="linear", young=young, poisson=poisson,
+                                  integrator="implicit_euler", damping_mass=200.0)
+        body.fix_nodes(np.flatnonzero(np.isclose(mesh.nodes[:, 2], -0.03)))
+        tool = world.add_tool("sphere", radius=radius, position=(0, 0, radius))
+        depths = 1e-4 * np.minimum(np.arange(1, 13), 8)  # 0.1 mm per 0.05 s step to 0.8 mm, held
+        forces = []
+        for d in depths:
+            tool.set_pose((0, 0, radius - d))
+            world.step(0.05)  # raises on a failed step
+            forces.append(tool.force[2])
+        assert np.all(np.diff(forces[:8]) > 0)  # deeper, harder: F ~ d^1.5
+        # Hertz's half-space: F = 4/3 E* sqrt(R) d^1.5, E* = E / (1 - nu^2). Coarse linear tets
+        # and a finite block on a fixed bottom are stiffer (test_hertz.c: 1.09-1.23 by block
+        # size on finer meshes; this mesh 0.99-1.18).
+        hertz = 4.0 / 3.0 * young / (1 - poisson**2) * np.sqrt(radius) * depths**1.5
+        np.testing.assert_array_less(np.abs(np.array(forces) / hertz - 1), 0.25)
+        # Quasi-static: held 0.2 s (four steps, heavily damped), the press has reached the
+        # static equilibrium of the same pose.
+        world.solve_static()
+        assert forces[-1] == pytest.approx(tool.force[2], rel=0.02)
+
+
+# ------------------------------------------------------------------------------------------
+# Haptic rendering of the press: 1 kHz device ticks, the full model at 60 Hz
+
+
+@SINKS_BETWEEN_NODES
+@pytest.mark.parametrize("radius", [0.01, 0.003], ids=["sphere-1cm", "probe-3mm"])
+def test_haptic_press_renders_a_smooth_force_and_the_model_holds_the_tool(meshes, radius):
+    with softhap.World(gravity=(0, 0, 0)) as world:
+        _, tool, top = liver_and_tool(world, meshes, "corotational", radius)
+        haptic = world.add_haptic(tool, dt=1e-3)
+        rendered, full, faults = [], [], set()
+        steps = 0
+        for k in range(1, 2001):
+            pose = pose_at(top, k * 1e-3)
+            tool.set_pose(pose)
+            result = haptic.step(pose)
+            rendered.append(np.linalg.norm(result.force))
+            faults |= result.faults
+            if k * 1e-3 >= (steps + 1) * HZ60 - 1e-12:  # 16 or 17 ticks per full-model step
+                world.step(HZ60)  # raises on a failed step
+                steps += 1
+                full.append(np.linalg.norm(tool.force))
+        assert steps == 120 and not faults
+        assert world.warnings["SH_WARN_NOT_CONVERGED"] <= 3
+        # The device moves 1/1000 of the press per tick: the rendered force changes by about
+        # 0.1 % of its peak per tick (0.6 % at most, 60 Hz buffer changes included, while the
+        # contact held). When the device stops dead the buffer relaxes, by about
+        # (dF/dx) v dt = 1.5 F v dt / x per tick: 0.3 % of F with this law 7 mm deep, 1.1 % for
+        # a 10x stiffer law 2 mm deep (measured with it: 1.6 % for the sphere, 1.9 % for the
+        # probe). 2 % bounds a jump.
+        rendered = np.array(rendered)
+        assert np.abs(np.diff(rendered)).max() <= 0.02 * rendered.max()
+        # The full model, pressed slowly into a body whose reaction grows with depth: its force
+        # grows while the tool goes deeper, whatever the tool's size, to the palpation test's
+        # 0.35 N at least (the same contact law on the same triangle), and holds.
+        press = np.array(full[:60])
+        assert largest_fall(press) <= 0.05 * press.max()
+        assert press[-1] >= 0.35
+        assert min(full[60:]) >= 0.8 * press[-1]
+        # Held 1 s, the buffer (the full model's own tets and law, its rim following the full
+        # model) settles where the full model does (test_haptic.py: within 0.2 % for a whole
+        # block); 25 % for a buffer of few coarse tets.
+        assert rendered[-1] == pytest.approx(full[-1], rel=0.25)

@@ -109,12 +109,12 @@ void compute_accelerations(const Body& body, const double* x, const double* v, c
     std::fill(a, a + 3 * n, 0.0);
     body.add_internal_forces(x, v, a);
     if (body.field) body.field->add_forces(x, v, a);
-    const double alpha = body.settings.damping_mass;
-    const bool per_node = !body.node_damping.empty();
     const double* inv_mass = body.inverse_mass.data();
     const double* fe = body.external_force.data();
     size_t i = 0;
 #if defined(__AVX512F__)
+    const double alpha = body.settings.damping_mass;
+    const bool per_node = !body.node_damping.empty();
     const __m512d gv[3] = {spread_gravity(g, 0), spread_gravity(g, 1), spread_gravity(g, 2)};
     const __m512d zero = _mm512_setzero_pd(), alpha_v = _mm512_set1_pd(alpha);
     for (; i + 8 <= n; i += 8) {
@@ -131,7 +131,7 @@ void compute_accelerations(const Body& body, const double* x, const double* v, c
 #endif
     for (; i < n; ++i) {
         const double inv_m = inv_mass[i];
-        const double c = alpha + (per_node ? body.node_damping[i] : 0.0);
+        const double c = body.mass_damping(i);
         for (int k = 0; k < 3; ++k) {
             const size_t j = 3 * i + k;
             a[j] = inv_m > 0.0 ? (a[j] + fe[j]) * inv_m + g[k] - c * v[j] : 0.0;

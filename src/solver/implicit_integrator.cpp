@@ -35,7 +35,9 @@ constexpr double kEnergyGrowth = 1.0;
 
 // A linearised step with no outside work that raises the mechanical energy by more than this
 // times its terms' magnitude is not accepted: it goes on iterating towards the minimiser.
+// Stricter than the runaway guard, which an iterate it accepted therefore passes too.
 constexpr double kLinearisedEnergyGain = 1e-6;
+static_assert(kLinearisedEnergyGain <= kEnergyGrowth, "an accepted linearised update must pass the runaway guard");
 
 LinearSolverKind solver_kind(sh_linear_solver kind) {
     switch (kind) {
@@ -179,6 +181,7 @@ private:
     double largest_change_ = 0.0, largest_speed_ = 0.0;  // of the last update taken
     double energy0_ = 0.0, energy_scale0_ = 0.0;  // mechanical energy at the start, its scale
     bool work_done_ = false;  // moving tools, other bodies or prescribed nodes work on the bodies
+    bool energy_checked_ = false;  // the final iterate passed the linearised energy check
 };
 
 // Kinetic + potential energy (NewtonGroup::potential_energy) of the bodies, at the step's
@@ -209,6 +212,7 @@ bool NewtonStep::energy_rose(double fraction) const {
 
 void NewtonStep::begin() {
     work_done_ = false;
+    energy_checked_ = false;
     group_.each([&](Body& body, ImplicitState&, size_t) {
         save_start_state(body);
         begin_kinematic_motion(body, dt_);
@@ -438,7 +442,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
             // a kept factorisation go on until they are as good as factor_reuse asks.
             const double floor = ns_.roundoff_floor;
             if (!fresh && !(r_ <= std::max(target, floor) && r_max_ <= std::max(target_max, floor))) continue;
-            if (!energy_rose(kLinearisedEnergyGain)) return true;
+            if (!energy_rose(kLinearisedEnergyGain)) return energy_checked_ = true;
             // One update gained energy from nothing (large rotations, elements near inversion):
             // iterate towards the step's minimiser instead, as far as the iterations allow.
             linearised = false;
@@ -473,7 +477,7 @@ BodyStepResult NewtonStep::finish(bool converged, bool solver_failed, bool keep_
         sane = sane && body_state_is_sane(body);
     });
     if (!sane) return fail(SH_ERR_UNSTABLE, kRolledBackReason);
-    if (energy_rose(kEnergyGrowth)) {
+    if (!energy_checked_ && energy_rose(kEnergyGrowth)) {
         // The last attempt keeps its finite iterate, as one that did not converge.
         if (!keep_best)
             return fail(SH_ERR_UNSTABLE, "the mechanical energy grew with no work done on the body (runaway); rolled back");

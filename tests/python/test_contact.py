@@ -22,27 +22,27 @@ needs_ccd = pytest.mark.skipif(
 
 
 def box_mesh(size, cells, origin=(0.0, 0.0, 0.0)):
-    """A box [origin, origin + size] split into cells[0] x cells[1] x cells[2] cubes of six
-    tetrahedra each (Kuhn split along each cube's main diagonal, conforming between cubes)."""
-    nx, ny, nz = cells
-    axes = [origin[k] + np.linspace(0.0, size[k], cells[k] + 1) for k in range(3)]
-    nodes = np.array([[x, y, z] for x in axes[0] for y in axes[1] for z in axes[2]])
+    """A box [origin, origin + size] of cells[0] x cells[1] x cells[2] equal cubes (grid_mesh)."""
+    return grid_mesh(*[origin[k] + np.linspace(0.0, size[k], cells[k] + 1) for k in range(3)])
 
-    def index(i, j, k):
-        return (i * (ny + 1) + j) * (nz + 1) + k
 
+def grid_mesh(xs, ys, zs):
+    """The grid of node planes xs, ys, zs (uneven spacing allowed) split into cubes of six
+    tetrahedra each (Kuhn split along each cube's main diagonal, conforming between cubes);
+    nodes x-major, tets cube by cube."""
+    ny, nz = len(ys) - 1, len(zs) - 1
+    nodes = np.array(np.meshgrid(xs, ys, zs, indexing="ij")).reshape(3, -1).T
+    boxes = [np.arange(len(planes) - 1) for planes in (xs, ys, zs)]
+    cells = np.array(np.meshgrid(*boxes, indexing="ij")).reshape(3, -1)
     tets = []
-    for i in range(nx):
-        for j in range(ny):
-            for k in range(nz):
-                for path in [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]:
-                    corner = [i, j, k]
-                    tet = [index(*corner)]
-                    for axis in path:
-                        corner[axis] += 1
-                        tet.append(index(*corner))
-                    tets.append(tet)
-    return softhap.Mesh(nodes, tets)
+    for path in [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]:
+        corner = cells.copy()
+        tet = [(corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2]]
+        for axis in path:
+            corner[axis] += 1
+            tet.append((corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2])
+        tets.append(np.stack(tet, axis=1))
+    return softhap.Mesh(nodes, np.stack(tets, axis=1).reshape(-1, 4))
 
 
 def fixed_point(world, position):

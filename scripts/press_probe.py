@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""Press a sphere into the top of a tetrahedral mesh, as a new user would, and print the force.
+
+    python3 scripts/press_probe.py MESH SIZE RADIUS
+
+MESH is a file under ../shared/meshes (or a path), scaled so that its largest extent is SIZE (m);
+RADIUS is the sphere's (m). Corotational, 5 kPa, nu 0.45, implicit Euler at 60 Hz, no gravity,
+nodes within 1.5 cm of the bottom fixed; the sphere (1e3 N/m^1.5, n = 1.5) starts touching the
+highest node and presses 1.5 cm down in 1 s, then holds 0.5 s, while a haptic context renders it
+at 1 kHz (16-17 ticks per full step). Prints the mesh's surface edge lengths against the radius,
+the full model's and the rendered force every 10 steps, the step times, the count of
+SH_WARN_NOT_CONVERGED and the largest tick-to-tick change of the rendered force. Needs the
+library (SOFTHAP_LIBRARY) and bindings/python on PYTHONPATH.
+"""
+
+import os
+import sys
+import time
+
+import numpy as np
+
+import softhap
+
+PRESS, PRESS_TIME, HOLD_TIME, STEP = 0.015, 1.0, 0.5, 1.0 / 60.0
+
+
+def load(name, size):
+    path = name if os.path.exists(name) else os.path.join("..", "shared", "meshes", name)
+    mesh = softhap.Mesh.load(path)
+    return mesh.transform(size / np.ptp(mesh.nodes, axis=0).max())
+
+
+def surface_edges(mesh):
+    x, tri = mesh.nodes, mesh.surface_triangles
+    return np.concatenate([np.linalg.norm(x[tri[:, i]] - x[tri[:, (i + 1) % 3]], axis=1) for i in range(3)])
+
+
+def pose(top, t):
+    return top - (0.0, 0.0, PRESS * min(1.0, t / PRESS_TIME))
+
+
+def main(name, size, radius):
+    mesh = load(name, size)
+    x = mesh.nodes
+    edges = surface_edges(mesh)
+    print("%s: %d tets, surface edges median %.1f mm (max %.1f), sphere radius %.1f mm"
+          % (name, len(mesh.tets), 1e3 * np.median(edges), 1e3 * edges.max(), 1e3 * radius))
+    with softhap.World(gravity=(0, 0, 0)) as world:
+        body = world.add_fem_body(mesh, model="corotational", young=5e3, poisson=0.45, integrator="implicit_euler")
+        body.fix_nodes(np.flatnonzero(x[:, 2] < x[:, 2].min() + 0.015))
+        top = x[np.argmax(x[:, 2])] + (0.0, 0.0, radius)
+        tool = world.add_tool("sphere", radius=radius, position=top, stiffness=1e3, exponent=1.5)
+        haptic = world.add_haptic(tool, dt=1e-3)
+        rendered, times = [], []
+        steps = int(round((PRESS_TIME + HOLD_TIME) / STEP))
+        for step in range(steps):
+            ticks = 16 if step % 3 == 0 else 17
+            for tick in range(ticks):
+                rendered.append(np.linalg.norm(haptic.step(pose(top, (step + tick / ticks) * STEP)).force))
+            tool.set_pose(pose(top, (step + 1) * STEP))
+            start = time.perf_counter()
+            world.step(STEP)
+            times.append(1e3 * (time.perf_counter() - start))
+            if step % 10 == 9:
+                print("  t %.2f s  depth %4.1f mm  full %.4f N  rendered %.4f N  contacts %d"
+                      % ((step + 1) * STEP, 1e3 * (top - pose(top, (step + 1) * STEP))[2],
+                         np.linalg.norm(tool.force), rendered[-1], tool.contacts))
+        rendered = np.array(rendered)
+        jump = np.abs(np.diff(rendered)).max() / rendered.max() if rendered.max() > 0 else 0.0
+        print("  steps: median %.1f ms, p99 %.1f ms; SH_WARN_NOT_CONVERGED %d; largest tick-to-tick change %.0f %% of peak"
+              % (np.median(times), np.percentile(times, 99), world.warnings["SH_WARN_NOT_CONVERGED"], 100 * jump))
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 4:
+        sys.exit(__doc__)
+    main(sys.argv[1], float(sys.argv[2]), float(sys.argv[3]))

@@ -29,6 +29,11 @@ constexpr int kContactNewtonIterations = 20;
 constexpr int kMaxHalvings = 30;
 constexpr double kArmijo = 1e-4;
 
+// A Newton direction that cannot lower the potential from an iterate whose residual is within
+// this factor of the forces' estimated round-off counts as converged: the estimate is an order
+// of magnitude, and the residual there is noise rather than a gradient to follow.
+constexpr double kStalledRoundoffFactor = 8.0;
+
 // The runaway guard's bound: a step with no outside work may not raise the bodies' mechanical
 // energy by more than this times the magnitude of its terms at the start.
 constexpr double kEnergyGrowth = 1.0;
@@ -426,8 +431,10 @@ bool NewtonStep::iterate(bool& solver_failed) {
                 continue;
             }
             // No descent left along Newton's direction: converged if the residual is as small
-            // as asked or down to the forces' round-off, else stalled.
-            return small();
+            // as asked or within a few times the forces' round-off estimate (a fresh Newton
+            // direction that cannot lower Phi there shows the residual is that round-off),
+            // else stalled.
+            return small() || r_ <= kStalledRoundoffFactor * ns_.roundoff_floor;
         }
         if (!fresh) {
             ++stale_solves_;

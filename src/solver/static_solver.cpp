@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace sh {
 namespace {
@@ -109,7 +110,13 @@ void solve_group(const NewtonGroup& group, const double g[3], const sh_static_de
                 });
                 r = out_of_balance(group, g, factor, residual) / load_norm;
                 const double energy = group.potential_energy(g, factor, false, scale);
-                accepted = (std::isfinite(energy) && energy <= energy0 + 1e-4 * alpha * slope) || r < r0;
+                // Armijo's decrease, or a smaller residual where the potential is flat to its
+                // round-off; never an iterate that raises the potential (a smaller residual
+                // there can lead the iteration round in a cycle over a kink of the contact
+                // potential).
+                const double flat = 64.0 * std::numeric_limits<double>::epsilon() * scale;
+                accepted = std::isfinite(energy) &&
+                           (energy <= energy0 + 1e-4 * alpha * slope || (r < r0 && energy <= energy0 + flat));
             }
             if (!accepted) {  // no step helped: stay where the iteration was
                 group.each([](Body& body, ImplicitState&, size_t) {

@@ -349,11 +349,10 @@ bool NewtonStep::line_search(double slope, bool fresh) {
     double length = 0.0;
     for (const double d : ns_.delta) length += d * d;
     length = std::sqrt(length);
-    const double sum_roundoff = 64.0 * std::numeric_limits<double>::epsilon() * phi0.scale;
     double scale = 1.0;
     for (int halving = 0; halving <= (fresh ? kMaxHalvings : 0); ++halving, scale *= 0.5) {
         take_update(scale);
-        const double roundoff = sum_roundoff + 4.0 * ns_.roundoff_floor * scale * length;
+        const double roundoff = sum_roundoff(phi0.scale) + 4.0 * ns_.roundoff_floor * scale * length;
         if (!phi_.finite() || phi_.value > phi0.value + kArmijo * scale * slope + roundoff) continue;
         if (fresh) return true;
         const double floor = ns_.roundoff_floor;
@@ -434,7 +433,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
             // as asked or within a few times the forces' round-off estimate (a fresh Newton
             // direction that cannot lower Phi there shows the residual is that round-off),
             // else stalled.
-            return small() || r_ <= kStalledRoundoffFactor * ns_.roundoff_floor;
+            return r_ <= std::max(s_.newton_tolerance * residual0, kStalledRoundoffFactor * ns_.roundoff_floor);
         }
         if (!fresh) {
             ++stale_solves_;

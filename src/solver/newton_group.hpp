@@ -8,8 +8,13 @@
 
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 namespace sh {
+
+/// Round-off (J) of a sum of energy terms whose magnitudes add up to scale: what the Newton
+/// line searches allow a potential to rise by and still count as not raised.
+inline double sum_roundoff(double scale) { return 64.0 * std::numeric_limits<double>::epsilon() * scale; }
 
 /// A body alone, whose own system is the one solved, or the members of a CoupledSystem.
 struct NewtonGroup {

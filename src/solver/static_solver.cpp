@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace sh {
 namespace {
@@ -114,9 +113,8 @@ void solve_group(const NewtonGroup& group, const double g[3], const sh_static_de
                 // round-off; never an iterate that raises the potential (a smaller residual
                 // there can lead the iteration round in a cycle over a kink of the contact
                 // potential).
-                const double flat = 64.0 * std::numeric_limits<double>::epsilon() * scale;
-                accepted = std::isfinite(energy) &&
-                           (energy <= energy0 + 1e-4 * alpha * slope || (r < r0 && energy <= energy0 + flat));
+                accepted = std::isfinite(energy) && (energy <= energy0 + 1e-4 * alpha * slope ||
+                                                     (r < r0 && energy <= energy0 + sum_roundoff(scale)));
             }
             if (!accepted) {  // no step helped: stay where the iteration was
                 group.each([](Body& body, ImplicitState&, size_t) {

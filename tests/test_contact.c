@@ -185,12 +185,10 @@ static void test_implicit_body_rests_on_stiff_plane(void** state) {
 
 /* The same cube pressed by a sphere tool while resting on the plane, explicit: in equilibrium
  * (heavy mass damping) the plane carries the weight plus the tool's push, and the tool feels
- * the opposite of its push. The sphere (radius 8 mm, 2 mm in) is wide enough to bear on the
- * nodes around the top's middle one (5 mm off): a sphere that presses on the middle node alone
- * is an unstable balance on the frictionless plane (its push on a node off its apex has a
- * sideways part that nothing holds: round-off grows into the cube squirting out from under
- * it), which the test with a 5 mm sphere had passed only through where that drift happened to
- * end. */
+ * the opposite of its push. The sphere (radius 8 mm) presses the top's middle node and the
+ * faces around it: their excess terms hold it centred (a push on the middle node alone would
+ * be an unstable balance on the frictionless plane: its push on a node off its apex has a
+ * sideways part that nothing holds). */
 static void test_tool_reaction_balances_the_plane(void** state) {
     (void)state;
     sh_world* world = sh_test_world(-9.81);
@@ -222,7 +220,7 @@ static void test_tool_reaction_balances_the_plane(void** state) {
     printf("cube pressed by a sphere: tool %.6g N (%d contacts, depth %.3g mm), plane %.6g N, weight %.6g N\n",
            on_tool.force[2], on_tool.contact_count, 1e3 * on_tool.max_depth, on_plane.force[2], weight);
     assert_true(on_tool.force[2] > 0.01);  /* pushed up by the tissue */
-    assert_true(on_tool.contact_count >= 4);
+    assert_true(on_tool.contact_count >= 1);
     assert_close(-on_plane.force[2], weight + on_tool.force[2], 2e-3);
     assert_close(force[2], on_tool.force[2], 0.0);
     /* A centred push on a symmetric cube: no sideways force, no torque about the centre. */

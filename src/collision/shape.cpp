@@ -1,5 +1,6 @@
 // Shape: validation, bounds, support mapping and the narrow-phase point and triangle queries of
-// the rigid colliders. Analytic for sphere, capsule, box and plane. A convex hull's point query
+// the rigid colliders. Analytic for sphere, capsule, box and plane. A convex hull of up to
+// kMaxExactHullPoints points answers point queries exactly from its facet planes; a larger one
 // uses libccd's GJK/EPA (sim side only: EPA allocates inside libccd), bounded by a budget of
 // support calls, with MPR and sampled directions as fallbacks; points within ~1e-6 of the
 // hull's size from its surface may be reported outside (libccd's absolute tolerances).
@@ -321,6 +322,7 @@ void Shape::init_convex(const sh_shape& def) {
     // An estimate: the exact thinnest width is attained at a face normal or an edge-edge
     // direction, which the samples may miss, so this may exceed the exact value.
     inner_radius_ = 0.5 * min_width;
+    init_convex_planes();
 }
 
 int Shape::convex_support_index(const double d[3]) const {
@@ -464,6 +466,20 @@ bool Shape::penetrate_convex(const double xl[3], double& depth, double nl[3]) co
     // least slack over the slabs (an upper bound on the depth) is also the fallback answer.
     for (int k = 0; k < 3; ++k)
         if (!(xl[k] > local_lo_[k] && xl[k] < local_hi_[k])) return false;
+    if (exact_planes_) {
+        // A point inside a polytope is as deep as its nearest facet plane: exact, and the same
+        // depth the contact potential's excess terms maximise (simplex_excess.cpp).
+        depth = INFINITY;
+        for (size_t f = 0; f < planes_.size(); f += 4) {
+            const double slack = planes_[f + 3] - dot3(&planes_[f], xl);
+            if (!(slack > 0.0)) return false;
+            if (slack < depth) {
+                depth = slack;
+                for (int k = 0; k < 3; ++k) nl[k] = planes_[f + k];
+            }
+        }
+        return true;
+    }
     double best = INFINITY;
     double best_normal[3] = {1.0, 0.0, 0.0};
     for (int j = 0; j < dir_count_; ++j) {

@@ -16,6 +16,28 @@ struct Penetration {
     double point[3] = {};   ///< the touched point on the body (world)
 };
 
+/// A contact potential psi of the depth d (m): psi(d) (J), psi'(d) (N), psi''(d) (N/m), all
+/// zero for d <= 0; psi' >= 0 and psi convex.
+class DepthPotential {
+public:
+    virtual ~DepthPotential() = default;
+    virtual double energy(double depth) const = 0;
+    virtual double force(double depth) const = 0;
+    virtual double stiffness(double depth) const = 0;
+};
+
+/// Where a shape's contact potential exceeds most, over a surface edge or triangle, the linear
+/// interpolant of its nodes' own potentials (Shape::deepest_excess).
+struct SimplexExcess {
+    double value = 0.0;      ///< max over the simplex of psi(depth(x)) - sum_i w_i psi_i (J)
+    double depth = 0.0;      ///< the shape's depth at the maximiser (m)
+    double weights[3] = {};  ///< the maximiser's barycentric weights (count of them used)
+    double point[3] = {};    ///< the maximiser (world)
+    double normal[3] = {};   ///< unit push out of the shape at the maximiser (world)
+    double push[3] = {};     ///< minus the gradient of psi(depth) at the maximiser for the
+                             ///< simplex moved rigidly (N, world): psi' times the normal
+};
+
 /// A rigid shape in its local frame. Sphere and capsule are centred at the origin, the capsule
 /// along local z; the box is centred with half_extents; a convex hull's points are given in the
 /// local frame; a plane is the half-space below the plane z = 0 of its local frame (its
@@ -68,6 +90,19 @@ public:
     bool penetrate_edge(const Pose& pose, const double a[3], const double b[3], const double n1[3],
                         const double n2[3], Penetration& out, double& t) const;
 
+    /// Maximises psi(depth(x)) - sum_i w_i node_energy[i] over the simplex of `count` (2 or 3)
+    /// world points, x = sum_i w_i points[i], depth(x) the shape's penetration depth at x.
+    /// Sphere: the best of the triangle's interior stationary point (on the ray from the
+    /// centre's foot against the interpolant's slope), its edges' and its corners, to round-off.
+    /// True if the maximum is > 0. The other kinds give false: a plane's depth is linear, so
+    /// its nodes carry all of it; capsules, boxes and convex hulls have no excess yet (see
+    /// simplex_excess.cpp).
+    bool deepest_excess(const Pose& pose, const double* const points[3], const double node_energy[3], int count,
+                        const DepthPotential& psi, SimplexExcess& out) const;
+
+    /// Sphere and capsule radius (m); 0 for the other kinds.
+    double radius() const { return radius_; }
+
     /// From now on, point queries on a convex hull skip libccd's GJK/EPA, which allocates:
     /// MPR and the sampled directions give the depth (an upper bound, exact along the hull
     /// face MPR finds). For the haptic step's own copy of a tool.
@@ -75,8 +110,12 @@ public:
 
 private:
     static constexpr int kMaxDirections = 17;  ///< convex: sampled directions (see shape.cpp)
+    static constexpr int kMaxExactHullPoints = 64;  ///< convex: facets by brute force up to this
 
     void init_convex(const sh_shape& def);
+    /// Convex: planes_ from the points, for hulls of up to kMaxExactHullPoints points (larger
+    /// ones keep libccd's point queries).
+    void init_convex_planes();
     /// Convex: index of the point farthest along local direction d.
     int convex_support_index(const double d[3]) const;
     /// Convex: penetration of local point xl (depth, local outward normal nl).
@@ -87,6 +126,9 @@ private:
     double half_length_ = 0.0;
     double half_extents_[3] = {};
     vec<double> points_;  ///< convex: 3 per point, local frame
+    vec<double> planes_;  ///< convex: facet planes in the local frame, 4 numbers each (outward
+                          ///< unit normal n, offset o: the hull is n . x <= o)
+    bool exact_planes_ = false;  ///< planes_ are the hull's facets (point queries use them)
     double inner_radius_ = 0.0;
     bool allocation_free_ = false;  ///< convex: no GJK/EPA (see use_allocation_free_queries)
     // convex only:

@@ -64,7 +64,11 @@ class PointTangent {
 public:
     PointTangent(const ContactPoint& p, const sh_contact_params& params, double stiffness_scale, double damping_scale,
                  double chord = -1.0)
-        : p_(p), normal_scale_(stiffness_scale * p.stiffness + damping_scale * p.damping), damping_scale_(damping_scale) {
+        : p_(p),
+          // A subtracted term (an edge's excess) is left out: the tangent stays positive
+          // semi-definite, and the line search takes care of the rest.
+          normal_scale_(std::max(0.0, stiffness_scale * p.stiffness + damping_scale * p.damping)),
+          damping_scale_(damping_scale) {
         if (p.friction_normal > 0.0) {
             const double vn = dot3(p.relative_velocity, p.normal);
             for (int k = 0; k < 3; ++k) t_[k] = p.relative_velocity[k] - vn * p.normal[k];
@@ -121,8 +125,13 @@ BodyContacts::BodyContacts(const Body& body) : body_(body) {
     // Each surface edge's two triangles.
     edge_neighbor_.assign(tris.size(), -1);
     pair_triangles_across_edges(tris.data(), tris.size() / 3, edge_neighbor_.data());
+    edge_length_.resize(tris.size());
+    for (size_t i = 0; i < tris.size(); ++i) {
+        double e[3];
+        sub3(at(body.x.data(), tris[i]), at(body.x.data(), tris[i - i % 3 + (i % 3 + 1) % 3]), e);
+        edge_length_[i] = norm3(e);
+    }
     stamp_.assign(n, 0);
-    node_depth_.assign(n, 0.0);
 }
 
 void BodyContacts::clear() {
@@ -184,16 +193,21 @@ bool BodyContacts::detect(Collider& collider, double reach) {
     if (!plane && !tris.empty())
         tree_.query(query, [&](int32_t prim) {
             const int32_t* t = &tris[3 * static_cast<size_t>(prim)];
-            candidates_.push_back({ContactCandidate::kFaceShape, -1, {t[0], t[1], t[2]}, target, nullptr, &collider.params});
-            // Its edges it shares with a triangle of higher index (so each edge once): a tool
-            // straddling a convex edge reaches through neither face's plane over the face.
+            const double* length = &edge_length_[3 * static_cast<size_t>(prim)];
+            const double face_weight = excess_weight(collider, std::max({length[0], length[1], length[2]}));
+            if (face_weight > 0.0) {
+                candidates_.push_back({ContactCandidate::kFaceShape, -1, {t[0], t[1], t[2]}, target, nullptr, &collider.params});
+                candidates_.back().excess_weight = face_weight;
+            }
+            // Its edges, each once: from the triangle of higher index, or from this one where no
+            // single triangle lies across (a border of the surface).
             for (int k = 0; k < 3; ++k) {
                 const int32_t across = edge_neighbor_[3 * static_cast<size_t>(prim) + static_cast<size_t>(k)];
-                if (across <= prim) continue;
-                const int32_t a = t[k], b = t[(k + 1) % 3];
-                const int32_t* u = &tris[3 * static_cast<size_t>(across)];
-                candidates_.push_back({ContactCandidate::kEdgeShape, third_node(u, a, b), {a, b, t[(k + 2) % 3]}, target, nullptr,
+                const double edge_weight = excess_weight(collider, length[k]);
+                if ((across >= 0 && across <= prim) || !(edge_weight > 0.0)) continue;
+                candidates_.push_back({ContactCandidate::kEdgeShape, -1, {t[k], t[(k + 1) % 3], -1}, target, nullptr,
                                        &collider.params});
+                candidates_.back().excess_weight = edge_weight;
             }
         });
     group.end = static_cast<int32_t>(candidates_.size());
@@ -294,10 +308,6 @@ bool BodyContacts::keep_deepest(Group& group, int32_t capacity) {
     vec<ContactCandidate> kept;
     kept.reserve(static_cast<size_t>(capacity));
     for (int32_t i = 0; i < capacity; ++i) kept.push_back(candidates_[static_cast<size_t>(group.begin + order[static_cast<size_t>(i)])]);
-    // Node kinds before face kinds, so that a face sees its nodes' contacts first.
-    std::stable_partition(kept.begin(), kept.end(), [](const ContactCandidate& c) {
-        return c.kind == ContactCandidate::kNodeShape || c.kind == ContactCandidate::kNodeFace;
-    });
     candidates_.resize(static_cast<size_t>(group.begin));
     candidates_.insert(candidates_.end(), kept.begin(), kept.end());
     group.end = static_cast<int32_t>(candidates_.size());
@@ -321,7 +331,7 @@ BodyContacts* BodyContacts::finish_detection(double h) {
         const size_t index = static_cast<size_t>(&c - candidates_.data());
         candidates_[index].start_depth = point->depth;
         if (!friction) return;
-        candidates_[index].friction_normal = point->normal_force;
+        candidates_[index].friction_normal = point->net_normal_force;
         FrictionIterate& r = iterates[index];
         for (int k = 0; k < 3; ++k) {
             r.lag_normal[k] = point->normal[k];
@@ -351,7 +361,9 @@ bool BodyContacts::lagged_friction(const ContactCandidate& c, const double* v, C
     // the gradient of a dissipation potential (dissipation()). A candidate that touched at the
     // start keeps it through the step even at iterates where it has come off: else it would
     // vanish as a node leaves the surface, a jump Newton cannot converge across.
-    if (!(c.friction_normal > 0.0) || iterates_.size() != candidates_.size() || !(c.params->static_friction > 0.0))
+    // An edge's term is subtracted (excess_shape_contact): so is its friction (a negative
+    // normal force), which cancels the faces' share of the same region.
+    if (c.friction_normal == 0.0 || iterates_.size() != candidates_.size() || !(c.params->static_friction > 0.0))
         return false;
     const FrictionIterate& r = iterates_[static_cast<size_t>(&c - candidates_.data())];
     double vrel[3] = {0.0, 0.0, 0.0};
@@ -364,7 +376,7 @@ bool BodyContacts::lagged_friction(const ContactCandidate& c, const double* v, C
         case ContactCandidate::kEdgeShape: {
             double vc[3];
             c.collider->point_velocity(r.lag_point, vc);
-            if (c.kind != ContactCandidate::kNodeShape) {
+            if (c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kEdgeShape) {
                 count = c.kind == ContactCandidate::kFaceShape ? 3 : 2;
                 nodes = c.face;
                 for (int k = 0; k < 3; ++k) weights[k] = r.lag_face[k];
@@ -425,27 +437,23 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
             for (int k = 0; k < 3; ++k) out.gradient[a][k] = weights[a] * out.normal[k];
         }
     };
-    // A tool between the nodes of a face or an edge: once one of them (or, for an edge, a node
-    // of the two triangles that meet there, whose contacts take over at either side) touches
-    // the same collider, the node contacts carry it (their constraint is what the mesh can
-    // resolve).
-    auto node_touches = [&](const int32_t* nodes, int count) {
-        for (int k = 0; k < count; ++k)
-            if (node_depth_[static_cast<size_t>(nodes[k])] > 0.0) return true;
-        return false;
-    };
     const double one = 1.0;
     switch (c.kind) {
         case ContactCandidate::kNodeShape:
             if (!node_shape_contact(*c.collider, x, c.node, out)) return false;
             break;
-        case ContactCandidate::kFaceShape:
-            if (!face_shape_contact(*c.collider, x, c.face, out) || node_touches(c.face, 3)) return false;
-            break;
-        case ContactCandidate::kEdgeShape: {
-            const int32_t edge[4] = {c.face[0], c.face[1], c.face[2], c.node};
-            if (!edge_shape_contact(*c.collider, x, edge, out) || node_touches(edge, 4)) return false;
-            break;
+        case ContactCandidate::kEdgeShape:
+        case ContactCandidate::kFaceShape: {
+            // The law (with its damping in the depth for implicit steps) is part of the
+            // excess's maximisation; explicit bodies scale it by the depth rate after.
+            if (!excess_shape_contact(*c.collider, step_law(c), x, c.face, c.kind == ContactCandidate::kFaceShape ? 3 : 2,
+                                      c.excess_weight, out))
+                return false;
+            if (!v || implicit_step()) return true;
+            velocity_against_collider(*c.collider, out, v, vrel);
+            apply_excess_damping(p, vrel, out);
+            if (out.net_normal_force > 0.0 && p.static_friction > 0.0) apply_friction(p, out.net_normal_force, out);
+            return true;
         }
         case ContactCandidate::kNodeFace:
         case ContactCandidate::kFaceNode: {
@@ -508,12 +516,7 @@ void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& 
                 emit(c, static_cast<const ContactPoint*>(nullptr));
                 continue;
             }
-            if (c.kind == ContactCandidate::kNodeShape) node_depth_[static_cast<size_t>(c.node)] = point.depth;
             emit(c, &point);
-        }
-        for (int32_t i = group.begin; i < group.end; ++i) {
-            const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
-            if (c.kind == ContactCandidate::kNodeShape) node_depth_[static_cast<size_t>(c.node)] = 0.0;
         }
     }
 }
@@ -805,7 +808,8 @@ double BodyContacts::energy(const double* x) const {
     double e = 0.0;
     evaluate(x, nullptr, [&](const ContactCandidate& c, const ContactPoint& p) {
         const bool pair = c.kind == ContactCandidate::kNodeFace || c.kind == ContactCandidate::kFaceNode;
-        e += (pair ? 0.5 : 1.0) * p.law_scale * hunt_crossley_step_energy(*c.params, step_law(c), p.depth);
+        const bool excess = c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kEdgeShape;
+        e += excess ? p.energy : (pair ? 0.5 : 1.0) * p.law_scale * hunt_crossley_step_energy(*c.params, step_law(c), p.depth);
     });
     return e;
 }
@@ -833,10 +837,31 @@ double BodyContacts::stable_step(const double* x, const double* v, const double*
 }
 
 int32_t BodyContacts::accumulate_reactions() {
-    int32_t count = 0;
+    // The contacts that act: the nodes in contact, and per collider the regions where it
+    // reaches beyond them, faces minus edges (their number, see shape_contact.hpp; where the
+    // nodes leave holes in such a region the difference falls below 1: one is counted).
+    int32_t count = 0, regions = 0;
+    bool faces_act = false;
+    Collider* region_collider = nullptr;
+    const auto close_regions = [&]() {
+        const int32_t counted = std::max(regions, faces_act ? 1 : 0);
+        faces_act = false;
+        count += counted;
+        if (region_collider) region_collider->state.contact_count += counted;
+        regions = 0;
+    };
     const auto accumulate = [&](const ContactCandidate& c, const ContactPoint& p) {
         if (c.kind == ContactCandidate::kFaceNode) return;
-        if (p.depth > 0.0) ++count;
+        const bool excess = c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kEdgeShape;
+        if (c.collider != region_collider) {
+            close_regions();
+            region_collider = c.collider;
+        }
+        if (p.depth > 0.0 && excess) {
+            regions += c.kind == ContactCandidate::kEdgeShape ? -1 : 1;
+            faces_act |= c.kind == ContactCandidate::kFaceShape;
+        }
+        if (p.depth > 0.0 && !excess) ++count;
         if (!c.collider) return;
         sh_contact_state& s = c.collider->state;
         for (int a = 0; a < p.count; ++a) {
@@ -850,11 +875,13 @@ int32_t BodyContacts::accumulate_reactions() {
             }
         }
         if (!(p.depth > 0.0)) return;  // friction kept through a step on a contact that came off
-        ++s.contact_count;
+        if (!excess) ++s.contact_count;
         s.max_depth = std::max(s.max_depth, p.depth);
         if (c.kind == ContactCandidate::kNodeShape) s.penetration_volume += p.depth * node_area_[static_cast<size_t>(c.node)];
     };
     evaluate(body_.x.data(), body_.v.data(), accumulate);
+    close_regions();
+    region_collider = nullptr;
     evaluate_friction(body_.v.data(), accumulate);
     return count;
 }

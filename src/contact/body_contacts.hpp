@@ -18,19 +18,17 @@ namespace sh {
 /// evaluated afresh at each state.
 struct ContactCandidate {
     enum Kind : uint8_t {
-        kNodeShape,  ///< own node inside a collider
-        kFaceShape,  ///< a collider through own surface triangle (smaller than it)
+        kNodeShape,  ///< own node inside a collider (its depth's term)
+        kFaceShape,  ///< a collider on own surface triangle `face` (its excess term)
         kNodeFace,   ///< own surface node inside another body, behind its triangle `face`
         kFaceNode,   ///< another body's node behind own triangle `face`
-        kEdgeShape   ///< a collider through own convex surface edge (face[0], face[1]), between
-                     ///< own triangle `face` and the triangle across it, whose third node is
-                     ///< `node`
+        kEdgeShape   ///< a collider on own surface edge (face[0], face[1]) (its excess term,
+                     ///< subtracted)
     };
     Kind kind;
-    int32_t node;     ///< kNodeShape, kNodeFace: own node; kFaceNode: the other body's node;
-                      ///< kEdgeShape: the third node of the triangle across the edge
-    int32_t face[3];  ///< kFaceShape, kFaceNode, kEdgeShape: own nodes; kNodeFace: the other
-                      ///< body's nodes
+    int32_t node;     ///< kNodeShape, kNodeFace: own node; kFaceNode: the other body's node
+    int32_t face[3];  ///< kFaceShape, kFaceNode: own nodes; kEdgeShape: own nodes in face[0],
+                      ///< face[1]; kNodeFace: the other body's nodes
     Collider* collider;                ///< shape kinds
     const Body* other;                 ///< body-pair kinds
     const sh_contact_params* params;   ///< the contact law
@@ -40,6 +38,9 @@ struct ContactCandidate {
     /// Implicit bodies: its depth at the start of the step (m, 0 if it did not touch then),
     /// from which the step's law takes the depth rate (hunt_crossley_step_law).
     double start_depth = 0.0;
+    /// kFaceShape, kEdgeShape: the share of its excess it carries (excess_weight of its size
+    /// when the body's contacts were set up).
+    double excess_weight = 1.0;
 };
 
 /// The contact state of one body: surface, broad phase and candidates.
@@ -57,8 +58,10 @@ public:
     void refit(double margin);
 
     /// Adds the candidates against collider: every surface node (and, for shapes other than
-    /// planes, every surface triangle) whose box overlaps the collider's bounds grown by reach
-    /// (m). Keeps at most its capacity, the deepest first; returns true if it dropped any.
+    /// planes, the excess terms of every surface triangle and its edges) whose box
+    /// overlaps the collider's bounds grown by reach (m): the terms of the contact potential
+    /// of shape_contact.hpp. Keeps at most its capacity, the deepest first; returns true if
+    /// it dropped any.
     bool detect(Collider& collider, double reach);
 
     /// Adds to both a and b the candidates of a's surface nodes inside b's tets, each behind b's
@@ -143,8 +146,7 @@ private:
     /// tangent it then has. See the comment in body_contacts.cpp.
     double friction_chord(const ContactCandidate& c, const ContactPoint& p) const;
     /// Calls emit(candidate, point) for every candidate at (x, v) (v null: at rest, without
-    /// damping or friction), point null for one not in contact. Group by group, node contacts
-    /// before the faces they share depth with.
+    /// damping or friction), point null for one not in contact.
     template <class Emit>
     void evaluate_candidates(const double* x, const double* v, Emit&& emit) const;
     /// evaluate_candidates for the candidates in contact only, with a reference to the point.
@@ -162,6 +164,8 @@ private:
     vec<double> node_area_;        ///< per node: a third of its surface triangles' rest area (m^2)
     vec<int32_t> edge_neighbor_;   ///< per surface triangle and edge k (nodes k, k + 1): the
                                    ///< triangle across it, -1 if not exactly one
+    vec<double> edge_length_;      ///< per surface triangle and edge k: its length when the
+                                   ///< contacts were set up (m), for excess_weight
     vec<Aabb> boxes_;              ///< per surface primitive (triangle, or node for springs)
     AabbTree tree_;
     double margin_ = 0.0;          ///< the last refit's margin (m)
@@ -172,7 +176,6 @@ private:
     uint32_t pass_ = 0;
     vec<ContactCandidate> candidates_;
     vec<Group> groups_;
-    mutable vec<double> node_depth_; ///< per node: its depth in the current group's collider
     vec<double> keys_;               ///< scratch for keep_deepest
     mutable double evaluation_seconds_ = 0.0;
     /// Explicit bodies: a friction contact as the (sub)step's first add_forces found it, for

@@ -15,7 +15,8 @@ struct ContactPoint {
     double weights[3];       ///< own nodes' shares of the node side's motion and friction (sign
                              ///< included: kFaceNode's own face is the far side)
     double gradient[3][3];   ///< per own node: -d depth / d x, its weight times the normal (the
-                             ///< normal force on it is the normal force times this)
+                             ///< normal force on it is the normal force times this; for an
+                             ///< excess term, the same at its maximiser, for the tangent only)
     double node_force[3][3]; ///< per own node: the force it feels (N)
     double stiffness;        ///< dFn/dx (N/m)
     double damping;          ///< dFn/dx' (N s/m)
@@ -23,8 +24,12 @@ struct ContactPoint {
     double normal_force;     ///< Hunt-Crossley normal force (N)
     double friction_normal;  ///< normal force the friction is proportional to (N); 0: no friction
     double relative_velocity[3]; ///< node side's velocity relative to the other side (m/s)
-    double law_scale;        ///< share of the contact law it carries: 1 but for an edge flatter
-                             ///< than kFullEdgeAngle (body_contacts.cpp)
+    double law_scale;        ///< the sign of the term in the contact potential: -1 for an
+                             ///< edge's excess, else 1 (shape_contact.hpp)
+    double energy;           ///< excess terms: the term's potential, sign included (J)
+    double net_normal_force; ///< what its friction is proportional to (N): the normal force, or
+                             ///< for an excess term the net push of its node forces along
+                             ///< the normal, sign included
     double other_weights[3]; ///< kNodeFace: the other body's face nodes' shares (-w, the far
                              ///< side); their gradients are these times the normal
 };

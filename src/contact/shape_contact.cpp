@@ -9,10 +9,6 @@
 namespace sh {
 namespace {
 
-// Dihedral angle (between the outward normals) from which a convex edge has the whole contact
-// law (rad): 15 degrees.
-constexpr double kFullEdgeAngle = 0.2617993877991494;
-
 void set_geometry(const Penetration& pen, int count, const int32_t* nodes, const double* weights, ContactPoint& out) {
     out.depth = pen.depth;
     out.count = count;
@@ -40,45 +36,135 @@ bool node_shape_contact(const Collider& collider, const double* x, int32_t node,
     return true;
 }
 
-bool face_shape_contact(const Collider& collider, const double* x, const int32_t face[3], ContactPoint& out) {
+namespace {
+
+// The step's Hunt-Crossley law as the potential the excess maximises.
+class StepLawPotential final : public DepthPotential {
+public:
+    StepLawPotential(const sh_contact_params& params, const StepLaw& law) : params_(params), law_(law) {}
+    double energy(double depth) const override { return hunt_crossley_step_energy(params_, law_, depth); }
+    double force(double depth) const override { return hunt_crossley_step(params_, law_, depth).force; }
+    double stiffness(double depth) const override { return hunt_crossley_step(params_, law_, depth).stiffness; }
+
+private:
+    const sh_contact_params& params_;
+    const StepLaw& law_;
+};
+
+// Where every node of a feature is in the collider, the mesh resolves the contact there and
+// its node terms carry it: the feature's excess (then only the interpolant's own small error,
+// whose maximiser wanders with every node's motion and slows Newton) fades out as its
+// shallowest nodes come in: factor 1 - prod_a s(d_a), s a C^1 smoothstep from 0 at depth 0 to
+// 1 at the band. A feature with a node outside keeps its whole excess, so a tool smaller than
+// the triangles is held exactly as the potential says.
+class ResolvedFade {
+public:
+    explicit ResolvedFade(double band) : band_(band) {}
+    void add_node(double depth) {
+        const double t = std::min(std::max(depth / band_, 0.0), 1.0);
+        step_[count_] = t * t * (3.0 - 2.0 * t);
+        slope_[count_] = 6.0 * t * (1.0 - t) / band_;
+        ++count_;
+    }
+    /// Multiplies the factor (and its slopes) by a constant weight.
+    void scale(double weight) { weight_ = weight; }
+    double factor() const {
+        double product = 1.0;
+        for (int a = 0; a < count_; ++a) product *= step_[a];
+        return weight_ * (1.0 - product);
+    }
+    /// d factor / d depth of node a.
+    double slope(int a) const {
+        double product = -weight_ * slope_[a];
+        for (int b = 0; b < count_; ++b)
+            if (b != a) product *= step_[b];
+        return product;
+    }
+
+private:
+    double band_, weight_ = 1.0;
+    double step_[3] = {}, slope_[3] = {};
+    int count_ = 0;
+};
+
+}  // namespace
+
+double excess_weight(const Collider& collider, double size) {
+    const double t = std::min(std::max(collider.shape.inner_radius() / size - 1.0, 0.0), 1.0);
+    return std::isfinite(t) ? 1.0 - t * t * (3.0 - 2.0 * t) : 0.0;
+}
+
+double resolved_band(const Collider& collider) { return 0.02 * collider.shape.inner_radius(); }
+
+bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
+                          int count, double weight, ContactPoint& out) {
+    if (collider.shape.kind() == SH_SHAPE_PLANE || !(weight > 0.0)) return false;
+    const StepLawPotential psi(collider.params, law);
+    double node_energy[3], node_push[3][3], node_normal[3][3];
+    const double* points[3];
+    ResolvedFade fade(resolved_band(collider));
+    for (int a = 0; a < count; ++a) {
+        points[a] = at(x, nodes[a]);
+        Penetration pen;
+        const bool inside = collider.shape.penetrate_point(collider.pose, points[a], pen);
+        node_energy[a] = inside ? psi.energy(pen.depth) : 0.0;
+        const double force = inside ? psi.force(pen.depth) : 0.0;
+        for (int k = 0; k < 3; ++k) {
+            node_push[a][k] = force * pen.normal[k];
+            node_normal[a][k] = pen.normal[k];
+        }
+        fade.add_node(inside ? pen.depth : 0.0);
+    }
+    if (!(fade.factor() > 0.0)) return false;
+    fade.scale(weight);
+    SimplexExcess e;
+    if (!collider.shape.deepest_excess(collider.pose, points, node_energy, count, psi, e)) return false;
     Penetration pen;
-    double w[3];
-    if (!collider.shape.penetrate_triangle(collider.pose, at(x, face[0]), at(x, face[1]), at(x, face[2]), pen, w))
-        return false;
-    set_geometry(pen, 3, face, w, out);
+    pen.depth = e.depth;
+    for (int k = 0; k < 3; ++k) {
+        pen.normal[k] = e.normal[k];
+        pen.point[k] = e.point[k];
+    }
+    set_geometry(pen, count, nodes, e.weights, out);
+    const double scale = (count == 2 ? -1.0 : 1.0) * fade.factor();
+    const double force = psi.force(e.depth);
+    out.law_scale = count == 2 ? -1.0 : 1.0;
+    out.energy = scale * e.value;
+    out.normal_force = scale * force;
+    // For the tangent: the law's curvature at the maximiser times the excess's share of the
+    // law's energy there, which vanishes with the excess (where the law's own curvature does
+    // not, as for a linear law at its onset).
+    const double law_energy = psi.energy(e.depth);
+    out.stiffness = scale * psi.stiffness(e.depth) * (law_energy > 0.0 ? std::min(e.value / law_energy, 1.0) : 0.0);
+    out.damping = out.friction = out.friction_normal = 0.0;
+    out.net_normal_force = 0.0;
+    for (int k = 0; k < 3; ++k) out.relative_velocity[k] = 0.0;
+    // Node a: w_a (push at the maximiser - its own push), the gradient of the excess, and
+    // the fade's: -excess d(factor)/dx_a, along the node's push.
+    for (int a = 0; a < count; ++a) {
+        const double fade_slope = (count == 2 ? -1.0 : 1.0) * e.value * fade.slope(a);
+        for (int k = 0; k < 3; ++k) {
+            out.node_force[a][k] = scale * e.weights[a] * (e.push[k] - node_push[a][k]) + fade_slope * node_normal[a][k];
+            // For the tangent, stiffness times gradient gradient^T: the law's curvature at the
+            // maximiser through its weights (the positive part of the term's Hessian; the
+            // nodes' own curvature it subtracts, the maximiser's motion and the fade are left
+            // to the line search). Not the node forces over the law's force: that ratio grows
+            // without bound where the maximiser is shallow and its nodes deep.
+            out.gradient[a][k] = e.weights[a] * e.normal[k];
+            out.net_normal_force += out.node_force[a][k] * out.normal[k];
+        }
+    }
     return true;
 }
 
-bool edge_shape_contact(const Collider& collider, const double* x, const int32_t edge[4], ContactPoint& out) {
-    const double *a = at(x, edge[0]), *b = at(x, edge[1]);
-    double ab[3], ac[3], ad[3], n1[3], n2[3];
-    sub3(b, a, ab);
-    sub3(at(x, edge[2]), a, ac);
-    sub3(at(x, edge[3]), a, ad);
-    cross3(ab, ac, n1);  // own triangle (a, b, c), outward
-    cross3(ad, ab, n2);  // the one across, (b, a, d), outward
-    const double l1 = norm3(n1), l2 = norm3(n2);
-    if (!(l1 > 0.0 && l2 > 0.0)) return false;
-    for (int k = 0; k < 3; ++k) {
-        n1[k] /= l1;
-        n2[k] /= l2;
-    }
-    // Convex there: the node across lies behind own triangle's plane.
-    if (!(dot3(n1, ad) < -1e-9 * std::sqrt(dot3(ab, ab) * dot3(ad, ad)))) return false;
-    Penetration pen;
-    double t = 0.0;
-    if (!collider.shape.penetrate_edge(collider.pose, a, b, n1, n2, pen, t)) return false;
-    const double w[2] = {1.0 - t, t};
-    set_geometry(pen, 2, edge, w, out);
-    // The edge's region (the directions between n1 and n2) closes as the edge flattens, and
-    // past flat the two faces' regions overlap instead (each takes the tool, see
-    // penetrate_triangle): its law ramps in with the dihedral angle up to kFullEdgeAngle, so
-    // that an edge that folds through flat under load (the faces of a dent) changes the force
-    // continuously. A sharp edge has the whole law.
-    double fold[3];
-    cross3(n1, n2, fold);
-    out.law_scale = std::min(1.0, std::atan2(norm3(fold), dot3(n1, n2)) / kFullEdgeAngle);
-    return true;
+void apply_excess_damping(const sh_contact_params& p, const double vrel[3], ContactPoint& out) {
+    const double factor = std::max(0.0, 1.0 - 1.5 * p.damping * dot3(out.normal, vrel));
+    for (int k = 0; k < 3; ++k) out.relative_velocity[k] = vrel[k];
+    out.normal_force *= factor;
+    out.net_normal_force *= factor;
+    out.stiffness *= factor;
+    for (int a = 0; a < out.count; ++a)
+        for (int k = 0; k < 3; ++k) out.node_force[a][k] *= factor;
 }
 
 void velocity_against_collider(const Collider& collider, const ContactPoint& out, const double* v, double vrel[3]) {
@@ -100,6 +186,8 @@ void set_normal_force(const NormalForce& fn, const double* vrel, ContactPoint& o
     out.stiffness = out.law_scale * fn.stiffness;
     out.damping = out.law_scale * fn.damping;
     out.normal_force = out.law_scale * fn.force;
+    out.net_normal_force = out.normal_force;
+    out.energy = 0.0;
     out.friction = 0.0;
     out.friction_normal = 0.0;
     for (int k = 0; k < 3; ++k) out.relative_velocity[k] = vrel[k];

@@ -19,15 +19,45 @@ namespace sh {
 /// node of weight 1. False if it does not touch.
 bool node_shape_contact(const Collider& collider, const double* x, int32_t node, ContactPoint& out);
 
-/// The collider reaching through the triangle face (positions x) between its nodes: fills
-/// out's geometry with the three nodes weighted barycentrically. False if it does not.
-bool face_shape_contact(const Collider& collider, const double* x, const int32_t face[3], ContactPoint& out);
+/// The contact potential of a body's surface against a collider is
+///   E = sum_nodes psi(d_i) + sum_faces X_f - sum_edges X_e,
+/// psi the law's potential of a depth, d_i a node's depth, and X the excess of a triangle or
+/// an edge: the most that psi(depth(x)) exceeds, over the closed feature, the linear
+/// interpolant of its nodes' psi(d_i) (at a node the excess is 0). Node terms carry what the
+/// mesh resolves; the excess carries a tool reaching between nodes, and hands over to a node
+/// smoothly as it comes in (the node's own term grows by what the interpolant takes away).
+/// Counting faces minus edges (plus vertices, whose excess is 0) over the region where the
+/// excess exceeds a level counts its connected pieces (its Euler characteristic), so each
+/// region where the tool reaches beyond the nodes is carried once: a tool smaller than the
+/// triangles feels the law psi'(d) at its depth d whether it touches a face, an edge or a
+/// vertex, the force is continuous as it slides across them, and a flat tool on nodes adds
+/// nothing to them. Each term is a function of the nodes' positions, its forces its exact
+/// gradient (the envelope theorem at the maximiser).
+///
+/// The share (0..1) of its excess a surface edge or triangle of size (m: its length, or its
+/// longest edge) carries against the collider: 1 while the collider's inner radius is at most
+/// the size (it can reach between the feature's nodes), 0 from twice the size on (the mesh
+/// resolves its curvature: the excess is then only the interpolant's small error, whose
+/// maximiser wanders with every node and slows Newton), a C^1 smoothstep between.
+double excess_weight(const Collider& collider, double size);
 
-/// The collider on the convex surface edge (edge[0], edge[1]) between own triangle
-/// (edge[0], edge[1], edge[2]) and the one across, (edge[1], edge[0], edge[3]), both outward:
-/// fills out's geometry with the edge's two nodes and out.law_scale, the share of the law an
-/// edge flatter than 15 degrees carries. False if the edge is not convex or not touched.
-bool edge_shape_contact(const Collider& collider, const double* x, const int32_t edge[4], ContactPoint& out);
+/// Depth (m) over which a feature's excess fades out as its last nodes come into the collider
+/// (the mesh then resolves the contact there): a tenth of the collider's inner radius.
+double resolved_band(const Collider& collider);
+
+/// The excess term of the surface edge (count 2) or outward triangle (count 3) nodes at
+/// positions x under law (the step's, or the law at rest): fills out's geometry at the
+/// maximiser (depth, point, weights, normal), its signed energy and law_scale (-1 for an
+/// edge), node forces, stiffness (psi'' at the depth, signed; for the tangent), normal_force
+/// (psi', signed) and net_normal_force, all scaled by weight (excess_weight) and the fade of
+/// resolved_band. False if the excess is not positive or has no weight, and for planes (their
+/// depth is linear: their nodes carry it all).
+bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
+                          int count, double weight, ContactPoint& out);
+
+/// Explicit bodies: scales an excess term's forces by the Hunt-Crossley damping factor
+/// 1 + 3/2 alpha x' (at least 0) at the depth rate x' its point has at relative velocity vrel.
+void apply_excess_damping(const sh_contact_params& p, const double vrel[3], ContactPoint& out);
 
 /// Velocity (m/s) of out's node side (its weighted nodes at velocities v) relative to the
 /// collider's material point at out.point.

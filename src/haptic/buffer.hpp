@@ -17,8 +17,8 @@ struct BufferCapacity {
     int32_t tets, nodes;
     int32_t blocks() const { return (tets + kLanes - 1) / kLanes + 4; }  ///< one partial per model
     int32_t triangles() const { return 4 * tets; }  ///< each buffer tet has at most 4 surface faces
-    int32_t edges() const { return 6 * tets; }      ///< 3 per triangle, each shared by two
-    int32_t friction_records() const { return 2 * nodes; }  ///< friction contacts per sub-step
+    int32_t edges() const { return 12 * tets; }     ///< at most 3 per triangle
+    int32_t friction_records() const { return 4 * nodes; }  ///< friction contacts per sub-step (node, vertex and face terms)
 };
 
 /// One exchanged buffer. The arrays are carved at creation with the capacities; the counts
@@ -48,8 +48,11 @@ struct Buffer {
     double* inverse_mass = nullptr;  ///< 0 for boundary nodes (driven by the full model)
     double* mass = nullptr;
     int32_t* triangles = nullptr;    ///< 3 local nodes per surface triangle, outward
-    int32_t* edges = nullptr;        ///< 4 local nodes per surface edge shared by two triangles:
-                                     ///< the edge's two, own third, the one across (edge_shape_contact)
+    int32_t* edges = nullptr;        ///< 2 local nodes per edge of the surface triangles, each once
+    double* triangle_size = nullptr; ///< per triangle: its longest edge at x_start (m), for
+                                     ///< excess_weight (held while the buffer is stepped, so that
+                                     ///< its contact forces stay a potential's gradient)
+    double* edge_size = nullptr;     ///< per edge: its length at x_start (m)
     int32_t* surface_nodes = nullptr;
 
     /// Carves the arrays for capacity from arena (or measures them).
@@ -63,7 +66,9 @@ struct Buffer {
         inverse_mass = arena.take<double>(n);
         mass = arena.take<double>(n);
         triangles = arena.take<int32_t>(3 * static_cast<size_t>(capacity.triangles()));
-        edges = arena.take<int32_t>(4 * static_cast<size_t>(capacity.edges()));
+        edges = arena.take<int32_t>(2 * static_cast<size_t>(capacity.edges()));
+        triangle_size = arena.take<double>(static_cast<size_t>(capacity.triangles()));
+        edge_size = arena.take<double>(static_cast<size_t>(capacity.edges()));
         surface_nodes = arena.take<int32_t>(n);
     }
 };

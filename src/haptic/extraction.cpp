@@ -237,23 +237,30 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
         ++count;
     }
     out.triangle_count = count;
-    // The surface edges two buffer triangles share, each once.
+    // The buffer surface's edges, each once (the contact potential's edge terms).
     neighbor_.resize(3 * static_cast<size_t>(count));
     pair_triangles_across_edges(out.triangles, static_cast<size_t>(count), neighbor_.data());
     int32_t edges = 0;
     for (int32_t t = 0; t < count; ++t)
         for (int k = 0; k < 3; ++k) {
             const int32_t across = neighbor_[3 * static_cast<size_t>(t) + static_cast<size_t>(k)];
-            if (across <= t) continue;
+            if (across >= 0 && across <= t) continue;
             const int32_t* own = out.triangles + 3 * t;
-            const int32_t a = own[k], b = own[(k + 1) % 3];
-            int32_t* edge = out.edges + 4 * edges++;
-            edge[0] = a;
-            edge[1] = b;
-            edge[2] = own[(k + 2) % 3];
-            edge[3] = third_node(out.triangles + 3 * across, a, b);
+            int32_t* edge = out.edges + 2 * edges++;
+            edge[0] = own[k];
+            edge[1] = own[(k + 1) % 3];
         }
     out.edge_count = edges;
+    auto length = [&](int32_t a, int32_t b) {
+        double e[3];
+        sub3(out.x_start + 3 * static_cast<size_t>(a), out.x_start + 3 * static_cast<size_t>(b), e);
+        return norm3(e);
+    };
+    for (int32_t t = 0; t < count; ++t) {
+        const int32_t* f = out.triangles + 3 * t;
+        out.triangle_size[t] = std::max({length(f[0], f[1]), length(f[1], f[2]), length(f[2], f[0])});
+    }
+    for (int32_t e = 0; e < edges; ++e) out.edge_size[e] = length(out.edges[2 * e], out.edges[2 * e + 1]);
     int32_t surface = 0;
     for (int32_t i = 0; i < n; ++i) out.surface_nodes[i] = 0;
     for (int32_t j = 0; j < 3 * count; ++j) out.surface_nodes[out.triangles[j]] = 1;

@@ -20,7 +20,6 @@ struct WorkingArrays {
     double* force;
     double* saved_x;
     double* saved_v;
-    double* depth;
     FrictionRecord* friction;
 };
 
@@ -35,7 +34,6 @@ void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3
     w.force = arena.take<double>(3 * n);
     w.saved_x = arena.take<double>(3 * n);
     w.saved_v = arena.take<double>(3 * n);
-    w.depth = arena.take<double>(n);
     w.friction = arena.take<FrictionRecord>(static_cast<size_t>(capacity.friction_records()));
 }
 
@@ -96,7 +94,6 @@ HapticContext::HapticContext(World& world, const sh_haptic_def& def)
     force_ = w.force;
     saved_x_ = w.saved_x;
     saved_v_ = w.saved_v;
-    depth_ = w.depth;
     friction_ = w.friction;
     friction_capacity_ = capacity_of(def).friction_records();
     pose_ = tool_.target;

@@ -107,7 +107,6 @@ private:
     double* force_ = nullptr;  ///< 3 per node
     double* saved_x_ = nullptr;
     double* saved_v_ = nullptr;
-    double* depth_ = nullptr;  ///< per node: its depth in the tool at this evaluation
     FrictionRecord* friction_ = nullptr;  ///< the sub-step's friction contacts
     int32_t friction_capacity_ = 0;
     int32_t friction_count_ = 0;

@@ -54,28 +54,31 @@ void add_reaction(const ContactPoint& p, const double* x, const double tool_posi
     }
 }
 
-// Calls visit(nodes, count) for each surface node (count 1), edge (count 4: its two nodes, own
-// third, the one across) and triangle (count 3) of buffer b whose box at x meets lo..hi, nodes
-// first.
+// Calls visit(nodes, count, size) for each term of the contact potential (shape_contact.hpp)
+// over buffer b's surface whose nodes' box at x meets lo..hi: per surface node its depth's
+// term (count 1), per edge (count 2) and per triangle (count 3) their excess terms with the
+// feature's size.
 template <class Visit>
-void visit_features_in_box(const Buffer& b, const double* x, const double lo[3], const double hi[3], Visit&& visit) {
+void visit_terms_in_box(const Buffer& b, const double* x, const double lo[3], const double hi[3], Visit&& visit) {
     for (int32_t s = 0; s < b.surface_node_count; ++s)
-        if (inside_box(lo, hi, at(x, b.surface_nodes[s]))) visit(&b.surface_nodes[s], 1);
+        if (inside_box(lo, hi, at(x, b.surface_nodes[s]))) visit(&b.surface_nodes[s], 1, 0.0);
     for (int32_t e = 0; e < b.edge_count; ++e) {
-        const int32_t* edge = b.edges + 4 * e;
-        if (boxes_overlap(lo, hi, at(x, edge[0]), at(x, edge[1]), at(x, edge[1]))) visit(edge, 4);
+        const int32_t* edge = b.edges + 2 * e;
+        if (boxes_overlap(lo, hi, at(x, edge[0]), at(x, edge[1]), at(x, edge[1]))) visit(edge, 2, b.edge_size[e]);
     }
     for (int32_t t = 0; t < b.triangle_count; ++t) {
         const int32_t* face = b.triangles + 3 * t;
-        if (boxes_overlap(lo, hi, at(x, face[0]), at(x, face[1]), at(x, face[2]))) visit(face, 3);
+        if (boxes_overlap(lo, hi, at(x, face[0]), at(x, face[1]), at(x, face[2]))) visit(face, 3, b.triangle_size[t]);
     }
 }
 
-// The contact of the tool with a feature of visit_features_in_box.
-bool feature_contact(const Collider& tool, const double* x, const int32_t* nodes, int count, ContactPoint& out) {
+// The tool's term of visit_terms_in_box at rest (the buffer is explicit: the depth rate's
+// damping comes after, from the velocities).
+bool term_contact(const Collider& tool, const double* x, const int32_t* nodes, int count, double size,
+                  ContactPoint& out) {
     if (count == 1) return node_shape_contact(tool, x, nodes[0], out);
-    if (count == 4) return edge_shape_contact(tool, x, nodes, out);
-    return face_shape_contact(tool, x, nodes, out);
+    return excess_shape_contact(tool, hunt_crossley_step_law(tool.params, 0.0, 0.0), x, nodes, count,
+                                excess_weight(tool, size), out);
 }
 
 }  // namespace
@@ -122,23 +125,25 @@ double HapticContext::substep_limit(const Buffer& b, const double* x, const doub
     const double closing =
         dt * (norm3(tool_.velocity) + 0.5 * norm3(extent) * norm3(tool_.angular) + std::sqrt(fastest));
     tool_.shape.bounds(tool_.pose, closing, lo, hi);
-    // Per node: the stiffest contact it may feel in the step, at the depth its node, edge or
-    // face contact has now plus the closing distance (weights are at most 1). force_ holds the
-    // stiffness (x) and damping (y) until the step's forces overwrite it.
+    // Per node: the contact stiffness it may feel in the step, at the depth each of its terms
+    // has now plus the closing distance (weights are at most 1). force_ holds the stiffness
+    // (x) and damping (y) until the step's forces overwrite it.
     for (int32_t i = 0; i < b.node_count; ++i) at(force_, i)[0] = at(force_, i)[1] = 0.0;
     const sh_contact_params& law = tool_.params;
+    // A node feels its own term and the excess terms of every edge and face around it, each
+    // at most the law's stiffness there: their sum bounds its contact stiffness.
     auto reach = [&](const int32_t* nodes, int count, bool touching, double depth) {
         const NormalForce fn = hunt_crossley(law, (touching ? depth : 0.0) + closing, 0.0);
         for (int a = 0; a < count; ++a) {
             double* k = at(force_, nodes[a]);
-            k[0] = std::max(k[0], fn.stiffness);
-            k[1] = std::max(k[1], fn.damping);
+            k[0] += fn.stiffness;
+            k[1] += fn.damping;
         }
     };
-    visit_features_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count) {
+    visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
         ContactPoint p;
-        const bool touching = feature_contact(tool_, x, nodes, count, p);
-        reach(nodes, count == 4 ? 2 : count, touching, p.depth);
+        const bool touching = term_contact(tool_, x, nodes, count, size, p);
+        reach(nodes, count, touching, p.depth);
     });
     const double omega_fem = b.dt_stable > 0.0 && std::isfinite(b.dt_stable) ? 2.0 / b.dt_stable : 0.0;
     double step = omega_fem > 0.0 ? 2.0 / omega_fem : INFINITY;
@@ -159,30 +164,24 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
     auto act = [&](ContactPoint& p) {
         double vrel[3];
         velocity_against_collider(tool_, p, v, vrel);
-        apply_normal_law(law, vrel, p);
+        if (p.count == 1) apply_normal_law(law, vrel, p);
+        else apply_excess_damping(law, vrel, p);
         for (int a = 0; a < p.count; ++a)
             for (int k = 0; k < 3; ++k) at(f, p.nodes[a])[k] += p.node_force[a][k];
         add_reaction(p, x, tool_.pose.p, force, torque);
         contact = true;
         // Friction as the full model's explicit bodies take it: implicitly, after the update.
-        if (!(law.static_friction > 0.0 && p.normal_force > 0.0)) return;
+        if (!(law.static_friction > 0.0 && p.net_normal_force > 0.0)) return;
         if (friction_count_ == friction_capacity_) {
             step_warnings_ |= 1u << SH_WARN_CAPACITY;
             return;
         }
-        p.friction_normal = p.normal_force;
+        p.friction_normal = p.net_normal_force;
         friction_[friction_count_++] = friction_record(p, law, v);
     };
-    for (int32_t s = 0; s < b.surface_node_count; ++s) depth_[b.surface_nodes[s]] = 0.0;
-    // Nodes first; a tool between nodes: edges and triangles act while none of their nodes
-    // touches.
-    visit_features_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count) {
-        for (int a = 0; a < count && count > 1; ++a)
-            if (depth_[nodes[a]] > 0.0) return;
+    visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
         ContactPoint p;
-        if (!feature_contact(tool_, x, nodes, count, p)) return;
-        if (count == 1) depth_[nodes[0]] = p.depth;
-        act(p);
+        if (term_contact(tool_, x, nodes, count, size, p)) act(p);
     });
 }
 

@@ -1,0 +1,206 @@
+// Shape::deepest_excess: how far a shape's contact potential over a surface edge or triangle
+// exceeds the linear interpolant of its nodes' own potentials, the quantity the contact
+// potential's face and edge terms take (contact/shape_contact.cpp). One solver per shape
+// kind, chosen through one table; the sphere's is exact.
+#include "collision/shape.hpp"
+
+#include "core/vec3.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sh {
+namespace {
+
+// A simplex in the shape's local frame: count (2 or 3) points and their nodes' energies (J).
+struct LocalSimplex {
+    double p[3][3];
+    double energy[3];
+    int count;
+};
+
+// A candidate maximiser in the local frame.
+struct LocalExcess {
+    double value = -INFINITY;  ///< J
+    double depth = 0.0;        ///< m
+    double w[3] = {0.0, 0.0, 0.0};
+    double x[3] = {0.0, 0.0, 0.0};
+    double n[3] = {0.0, 0.0, 1.0};     ///< unit push
+    double push[3] = {0.0, 0.0, 0.0};  ///< N
+};
+
+double interpolated_energy(const LocalSimplex& s, const double w[3]) {
+    double e = 0.0;
+    for (int i = 0; i < s.count; ++i) e += w[i] * s.energy[i];
+    return e;
+}
+
+// A ball of radius R whose centre lies at distance `height` from a line or plane: along a ray
+// in that line or plane from the centre's foot, at offset r the ball's potential falls with
+// slope phi(r) = psi'(R - rho) r / rho, rho = sqrt(height^2 + r^2); phi rises from 0 and falls
+// back to 0 at the rim. The first r where phi reaches `slope` is where the potential minus a
+// linear interpolant of that slope stops rising: the local maximum. Returns -1 if phi stays
+// below slope. The first crossing is bracketed on a scan of the rim radius, then refined by
+// bisection to round-off.
+double first_crossing(const DepthPotential& psi, double radius, double height, double slope) {
+    const double rim2 = radius * radius - height * height;
+    if (!(rim2 > 0.0)) return -1.0;
+    if (!(slope > 0.0)) return 0.0;
+    const double rim = std::sqrt(rim2);
+    auto phi = [&](double r) {
+        const double rho = std::sqrt(height * height + r * r);
+        return rho > 0.0 ? psi.force(radius - rho) * r / rho : 0.0;
+    };
+    constexpr int kScan = 16;
+    double lo = 0.0, hi = -1.0;
+    for (int k = 1; k <= kScan; ++k) {
+        const double r = rim * k / kScan;
+        if (phi(r) >= slope) {
+            hi = r;
+            break;
+        }
+        lo = r;
+    }
+    if (hi < 0.0) return -1.0;
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * rim; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        if (mid <= lo || mid >= hi) break;
+        (phi(mid) >= slope ? hi : lo) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+// Fills candidate c at local point x with weights w against a ball (centre, radius).
+void ball_candidate(const LocalSimplex& s, const DepthPotential& psi, const double centre[3], double radius,
+                    const double x[3], const double w[3], LocalExcess& best) {
+    double d[3];
+    sub3(x, centre, d);
+    const double rho = norm3(d);
+    const double depth = radius - rho;
+    if (!(depth > 0.0)) return;
+    const double value = psi.energy(depth) - interpolated_energy(s, w);
+    if (!(value > best.value)) return;
+    best.value = value;
+    best.depth = depth;
+    const double force = psi.force(depth);
+    for (int k = 0; k < 3; ++k) {
+        best.w[k] = w[k];
+        best.x[k] = x[k];
+        // At the centre any direction pushes out: the local z.
+        best.n[k] = rho > 0.0 ? d[k] / rho : (k == 2 ? 1.0 : 0.0);
+        best.push[k] = force * best.n[k];
+    }
+}
+
+// Along the segment from node i to node j: its local maximum (the potential is a bell around
+// the centre's foot, the interpolant a line) and its ends.
+void ball_on_segment(const LocalSimplex& s, const DepthPotential& psi, const double centre[3], double radius, int i,
+                     int j, LocalExcess& best) {
+    const double *a = s.p[i], *b = s.p[j];
+    double e[3], ac[3];
+    sub3(b, a, e);
+    sub3(centre, a, ac);
+    const double len = norm3(e);
+    for (const int end : {i, j}) {
+        double w[3] = {0.0, 0.0, 0.0};
+        w[end] = 1.0;
+        ball_candidate(s, psi, centre, radius, s.p[end], w, best);
+    }
+    if (!(len > 0.0)) return;
+    const double foot = dot3(ac, e) / len;
+    const double height = std::sqrt(std::max(dot3(ac, ac) - foot * foot, 0.0));
+    const double slope = (s.energy[j] - s.energy[i]) / len;
+    const double r = first_crossing(psi, radius, height, std::fabs(slope));
+    if (r < 0.0) return;
+    const double t = foot - (slope > 0.0 ? r : -r);
+    if (!(t > 0.0 && t < len)) return;
+    const double u = t / len;
+    double w[3] = {0.0, 0.0, 0.0}, x[3];
+    w[i] = 1.0 - u;
+    w[j] = u;
+    for (int k = 0; k < 3; ++k) x[k] = a[k] + u * e[k];
+    ball_candidate(s, psi, centre, radius, x, w, best);
+}
+
+// The triangle's interior local maximum: on the ray from the centre's foot against the
+// in-plane gradient g of the interpolant, where the bell's slope reaches |g|.
+void ball_inside_triangle(const LocalSimplex& s, const DepthPotential& psi, const double centre[3], double radius,
+                          LocalExcess& best) {
+    double e1[3], e2[3], normal[3];
+    sub3(s.p[1], s.p[0], e1);
+    sub3(s.p[2], s.p[0], e2);
+    const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2);
+    const double det = g11 * g22 - g12 * g12;
+    if (!(det > 1e-14 * g11 * g22)) return;  // degenerate: its edges decide
+    const double d1 = s.energy[1] - s.energy[0], d2 = s.energy[2] - s.energy[0];
+    const double a1 = (g22 * d1 - g12 * d2) / det, a2 = (g11 * d2 - g12 * d1) / det;
+    double g[3];
+    for (int k = 0; k < 3; ++k) g[k] = a1 * e1[k] + a2 * e2[k];
+    const double slope = norm3(g);
+    cross3(e1, e2, normal);
+    const double nl = norm3(normal);
+    double r0[3];
+    sub3(centre, s.p[0], r0);
+    const double height = dot3(r0, normal) / nl;
+    const double r = first_crossing(psi, radius, height, slope);
+    if (r < 0.0) return;
+    double x[3];
+    for (int k = 0; k < 3; ++k) x[k] = centre[k] - height * normal[k] / nl - (slope > 0.0 ? r * g[k] / slope : 0.0);
+    sub3(x, s.p[0], r0);
+    const double b1 = dot3(e1, r0), b2 = dot3(e2, r0);
+    const double u = (g22 * b1 - g12 * b2) / det, v = (g11 * b2 - g12 * b1) / det;
+    if (!(u >= 0.0 && v >= 0.0 && u + v <= 1.0)) return;
+    const double w[3] = {1.0 - u - v, u, v};
+    ball_candidate(s, psi, centre, radius, x, w, best);
+}
+
+LocalExcess ball_excess(const LocalSimplex& s, const DepthPotential& psi, const double centre[3], double radius) {
+    LocalExcess best;
+    if (s.count == 3) ball_inside_triangle(s, psi, centre, radius, best);
+    for (int i = 0; i < s.count; ++i) {
+        if (s.count == 2 && i == 1) break;
+        ball_on_segment(s, psi, centre, radius, i, (i + 1) % s.count, best);
+    }
+    return best;
+}
+
+LocalExcess sphere_excess(const Shape& shape, const LocalSimplex& s, const DepthPotential& psi) {
+    const double centre[3] = {0.0, 0.0, 0.0};
+    return ball_excess(s, psi, centre, shape.radius());
+}
+
+LocalExcess no_excess(const Shape&, const LocalSimplex&, const DepthPotential&) { return LocalExcess{}; }
+
+using ExcessSolver = LocalExcess (*)(const Shape&, const LocalSimplex&, const DepthPotential&);
+
+// Per shape kind, in the order of sh_shape_kind.
+// Capsules, boxes and convex hulls have none yet: their nodes carry their contact (the best
+// ball along a capsule's axis and the vertices of a polytope's facet arrangement both make
+// the maximum jump or kink where its maximiser changes, which Newton does not survive).
+constexpr ExcessSolver kExcessSolvers[] = {sphere_excess, no_excess, no_excess, no_excess, no_excess};
+
+}  // namespace
+
+bool Shape::deepest_excess(const Pose& pose, const double* const points[3], const double node_energy[3], int count,
+                           const DepthPotential& psi, SimplexExcess& out) const {
+    static_assert(SH_SHAPE_SPHERE == 0 && SH_SHAPE_CAPSULE == 1 && SH_SHAPE_BOX == 2 && SH_SHAPE_CONVEX == 3 &&
+                      SH_SHAPE_PLANE == 4,
+                  "kExcessSolvers follows sh_shape_kind");
+    LocalSimplex s;
+    s.count = count;
+    for (int i = 0; i < count; ++i) {
+        pose.to_local(points[i], s.p[i]);
+        s.energy[i] = node_energy[i];
+    }
+    const LocalExcess e = kExcessSolvers[static_cast<int>(kind_)](*this, s, psi);
+    if (!(e.value > 0.0) || !std::isfinite(e.value)) return false;
+    out.value = e.value;
+    out.depth = e.depth;
+    for (int k = 0; k < 3; ++k) out.weights[k] = k < count ? e.w[k] : 0.0;
+    pose.to_world(e.x, out.point);
+    pose.rotate(e.n, out.normal);
+    pose.rotate(e.push, out.push);
+    return true;
+}
+
+}  // namespace sh

@@ -1,0 +1,338 @@
+// The contact potential of contact/shape_contact.hpp on fixed surface patches, through the
+// library's internal functions: forces are minus the gradient of the potential (central
+// differences), a tool smaller than the triangles feels exactly the law lambda d^n at its depth
+// on a face, an edge or a vertex of a flat patch, a contact the mesh resolves is its nodes' own
+// laws, the energy follows the forces' work along random paths, and a sphere sliding at constant height over a curved patch feels a force that
+// changes smoothly. Capsules, boxes and convex hulls have node terms only (their forces are
+// still checked against the potential).
+#include "contact/collider.hpp"
+#include "contact/hunt_crossley.hpp"
+#include "contact/shape_contact.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+extern "C" {
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+}
+
+namespace {
+
+using sh::Collider;
+using sh::ContactPoint;
+
+// A surface patch: nodes, outward triangles, and its edges and nodes, each once.
+struct Patch {
+    std::vector<double> x;
+    std::vector<int32_t> tris, edges, nodes;
+};
+
+// Edges and nodes of the triangles, each once.
+void finish_patch(Patch& p) {
+    for (size_t t = 0; t < p.tris.size(); t += 3)
+        for (int k = 0; k < 3; ++k) {
+            int32_t a = p.tris[t + k], b = p.tris[t + (k + 1) % 3];
+            if (a > b) std::swap(a, b);
+            bool seen = false;
+            for (size_t e = 0; e < p.edges.size(); e += 2) seen |= p.edges[e] == a && p.edges[e + 1] == b;
+            if (!seen) {
+                p.edges.push_back(a);
+                p.edges.push_back(b);
+            }
+        }
+    for (int32_t i = 0; i < static_cast<int32_t>(p.x.size() / 3); ++i) p.nodes.push_back(i);
+}
+
+// A hexagonal fan of six triangles of circumradius r around a centre raised by bump (m),
+// in the plane z = 0 (bump 0: flat), outward +z.
+Patch hexagon(double r, double bump) {
+    Patch p;
+    p.x = {0.0, 0.0, bump};
+    for (int k = 0; k < 6; ++k) {
+        p.x.push_back(r * std::cos(k * M_PI / 3.0));
+        p.x.push_back(r * std::sin(k * M_PI / 3.0));
+        p.x.push_back(0.0);
+    }
+    for (int k = 0; k < 6; ++k) {
+        p.tris.push_back(0);
+        p.tris.push_back(1 + k);
+        p.tris.push_back(1 + (k + 1) % 6);
+    }
+    finish_patch(p);
+    return p;
+}
+
+// Height of the patch over (px, py) (its triangles' linear interpolation), 0 off it.
+double surface_height(const Patch& p, double px, double py) {
+    for (size_t t = 0; t < p.tris.size(); t += 3) {
+        const double* a = &p.x[3 * static_cast<size_t>(p.tris[t])];
+        const double* b = &p.x[3 * static_cast<size_t>(p.tris[t + 1])];
+        const double* c = &p.x[3 * static_cast<size_t>(p.tris[t + 2])];
+        const double det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+        const double u = ((px - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (py - a[1])) / det;
+        const double v = ((b[0] - a[0]) * (py - a[1]) - (px - a[0]) * (b[1] - a[1])) / det;
+        if (u >= -1e-12 && v >= -1e-12 && u + v <= 1.0 + 1e-12) return a[2] + u * (b[2] - a[2]) + v * (c[2] - a[2]);
+    }
+    return 0.0;
+}
+
+Collider make_collider(sh_shape_kind kind, const double position[3], double size) {
+    static const double cube[8][3] = {{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {1, 1, -1},
+                                      {-1, -1, 1},  {1, -1, 1},  {-1, 1, 1},  {1, 1, 1}};
+    static double points[8][3];
+    sh_collider_def def{};
+    def.shape.kind = kind;
+    def.shape.radius = size;
+    def.shape.half_length = kind == SH_SHAPE_CAPSULE ? 2.0 * size : 0.0;
+    for (int k = 0; k < 3; ++k) def.shape.half_extents[k] = size;
+    for (int i = 0; i < 8; ++i)
+        for (int k = 0; k < 3; ++k) points[i][k] = size * cube[i][k];
+    def.shape.points = &points[0][0];
+    def.shape.point_count = 8;
+    for (int k = 0; k < 3; ++k) def.position[k] = position[k];
+    // A tilted orientation, so that boxes and capsules meet the patch off their axes.
+    const double half = 0.3;
+    def.orientation[0] = std::cos(half);
+    def.orientation[1] = std::sin(half) * 0.6;
+    def.orientation[2] = std::sin(half) * 0.8;
+    def.contact.stiffness = 1e4;
+    def.contact.exponent = 1.5;
+    def.contact.damping = 0.0;
+    def.contact.slip_velocity = 1e-3;
+    def.contact.capacity = 4096;
+    return Collider(def, true);
+}
+
+// Calls visit(point) for every acting term of the patch's potential against the collider, at
+// rest: node terms with their law applied, excess terms as excess_shape_contact gives them.
+template <class Visit>
+void each_term(const Collider& c, const Patch& p, const double* x, Visit&& visit) {
+    const sh::StepLaw law = sh::hunt_crossley_step_law(c.params, 0.0, 0.0);
+    for (const int32_t node : p.nodes) {
+        ContactPoint point;
+        if (!sh::node_shape_contact(c, x, node, point)) continue;
+        sh::apply_normal_law(c.params, nullptr, point);
+        point.energy = sh::hunt_crossley_step_energy(c.params, law, point.depth);
+        visit(point);
+    }
+    // Each feature's weight from its size in the patch as given (the reference shape).
+    auto weight = [&](const int32_t* nodes, int count) {
+        double size = 0.0;
+        for (int a = 0; a < count; ++a) {
+            double e = 0.0;
+            for (int k = 0; k < 3; ++k) {
+                const double d = p.x[3 * static_cast<size_t>(nodes[a]) + k] - p.x[3 * static_cast<size_t>(nodes[(a + 1) % count]) + k];
+                e += d * d;
+            }
+            size = std::max(size, std::sqrt(e));
+        }
+        return sh::excess_weight(c, size);
+    };
+    for (size_t e = 0; e < p.edges.size(); e += 2) {
+        ContactPoint point;
+        if (sh::excess_shape_contact(c, law, x, &p.edges[e], 2, weight(&p.edges[e], 2), point)) visit(point);
+    }
+    for (size_t t = 0; t < p.tris.size(); t += 3) {
+        ContactPoint point;
+        if (sh::excess_shape_contact(c, law, x, &p.tris[t], 3, weight(&p.tris[t], 3), point)) visit(point);
+    }
+}
+
+double potential(const Collider& c, const Patch& p, const double* x) {
+    double e = 0.0;
+    each_term(c, p, x, [&](const ContactPoint& q) { e += q.energy; });
+    return e;
+}
+
+// Force on each node (3 per node) and in total.
+std::vector<double> forces(const Collider& c, const Patch& p, const double* x, double total[3]) {
+    std::vector<double> f(p.x.size(), 0.0);
+    for (int k = 0; k < 3; ++k) total[k] = 0.0;
+    each_term(c, p, x, [&](const ContactPoint& q) {
+        for (int a = 0; a < q.count; ++a)
+            for (int k = 0; k < 3; ++k) {
+                f[3 * static_cast<size_t>(q.nodes[a]) + k] += q.node_force[a][k];
+                total[k] += q.node_force[a][k];
+            }
+    });
+    return f;
+}
+
+// Largest gap between the forces and minus the potential's central-difference gradient,
+// relative to the largest force.
+double gradient_error(const Collider& c, const Patch& p) {
+    double total[3];
+    const std::vector<double> f = forces(c, p, p.x.data(), total);
+    double largest = 0.0, gap = 0.0;
+    for (const double v : f) largest = std::max(largest, std::fabs(v));
+    std::vector<double> x = p.x;
+    const double h = 1e-8;
+    for (size_t i = 0; i < x.size(); ++i) {
+        const double keep = x[i];
+        x[i] = keep + h;
+        const double up = potential(c, p, x.data());
+        x[i] = keep - h;
+        const double down = potential(c, p, x.data());
+        x[i] = keep;
+        gap = std::max(gap, std::fabs(f[i] + (up - down) / (2.0 * h)));
+    }
+    return largest > 0.0 ? gap / largest : 0.0;
+}
+
+void test_forces_are_the_potentials_gradient(void**) {
+    const Patch cap = hexagon(0.01, 0.002);
+    const sh_shape_kind kinds[] = {SH_SHAPE_SPHERE, SH_SHAPE_CAPSULE, SH_SHAPE_BOX, SH_SHAPE_CONVEX};
+    const char* names[] = {"sphere", "capsule", "box", "convex"};
+    // Over the centre node, over a face, over an edge; small and large tools.
+    const double spots[3][2] = {{0.0005, 0.0003}, {0.004, 0.002}, {0.0045, 0.0}};
+    for (int s = 0; s < 4; ++s)
+        for (const double size : {0.0015, 0.006})
+            for (const auto& spot : spots) {
+                // The tool's lowest point 0.8 mm below the surface (less than its radius).
+                double position[3] = {spot[0], spot[1], 0.0};
+                Collider c = make_collider(kinds[s], position, size);
+                const double down[3] = {0.0, 0.0, -1.0};
+                double lowest[3];
+                c.shape.support(c.pose, down, lowest);
+                position[2] = surface_height(cap, lowest[0], lowest[1]) - 0.0008 - lowest[2];
+                c = make_collider(kinds[s], position, size);
+                double total[3];
+                forces(c, cap, cap.x.data(), total);
+                const double error = gradient_error(c, cap);
+                printf("%-8s size %.1f mm at (%.1f, %.1f) mm: |F| %.4g N, gradient error %.2e\n", names[s],
+                       1e3 * size, 1e3 * spot[0], 1e3 * spot[1], std::sqrt(total[0] * total[0] + total[1] * total[1] + total[2] * total[2]), error);
+                assert_true(total[2] < 0.0 || s > 0);  // other kinds: nodes only, may miss them
+                assert_true(error < 1e-5);
+            }
+}
+
+// A sphere smaller than the triangles of a flat patch, between its nodes: whether its deepest
+// point is over a face, on an edge or near a vertex (not reaching it), the force is the law's
+// lambda d^n at its depth d, along the normal.
+void test_small_sphere_feels_the_law_on_faces_edges_and_vertices(void**) {
+    const Patch flat = hexagon(0.01, 0.0);
+    const double radius = 0.001, depth = 0.0004;
+    const double spots[4][2] = {{0.004, 0.002}, {0.005, 0.0}, {0.0025, 0.0043301}, {0.0016, 0.0002}};
+    for (const auto& spot : spots) {
+        const double position[3] = {spot[0], spot[1], radius - depth};
+        const Collider c = make_collider(SH_SHAPE_SPHERE, position, radius);
+        double total[3];
+        forces(c, flat, flat.x.data(), total);
+        const double law = c.params.stiffness * std::pow(depth, c.params.exponent);
+        printf("sphere at (%.2f, %.2f) mm: F (%.3g, %.3g, %.6g) N, lambda d^n %.6g N\n", 1e3 * spot[0], 1e3 * spot[1],
+               total[0], total[1], total[2], law);
+        assert_true(std::fabs(total[2] + law) < 1e-9 * law);
+        assert_true(std::fabs(total[0]) + std::fabs(total[1]) < 1e-9 * law);
+    }
+}
+
+// A sphere more than twice as large as a flat patch's triangles: the mesh resolves the
+// contact, and the force is the nodes' own laws, lambda d_i^n along each node's radial
+// direction.
+void test_resolved_contact_is_the_nodes_own(void**) {
+    const Patch flat = hexagon(0.005, 0.0);
+    const double radius = 0.02, press = 0.003;
+    const double position[3] = {0.0004, 0.0003, radius - press};
+    const Collider c = make_collider(SH_SHAPE_SPHERE, position, radius);
+    double total[3], expected[3] = {0.0, 0.0, 0.0};
+    forces(c, flat, flat.x.data(), total);
+    for (size_t i = 0; i < flat.x.size(); i += 3) {
+        double d[3];
+        for (int k = 0; k < 3; ++k) d[k] = flat.x[i + k] - position[k];
+        const double rho = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        const double depth = radius - rho;
+        assert_true(depth > 0.0);
+        for (int k = 0; k < 3; ++k) expected[k] += c.params.stiffness * std::pow(depth, c.params.exponent) * d[k] / rho;
+    }
+    printf("20 mm sphere 3 mm into 7 nodes 5 mm apart: F (%.9g %.9g %.9g) N, their laws (%.9g %.9g %.9g) N\n", total[0], total[1],
+           total[2], expected[0], expected[1], expected[2]);
+    for (int k = 0; k < 3; ++k) assert_true(std::fabs(total[k] - expected[k]) < 1e-12 * std::fabs(expected[2]));
+}
+
+// A 2 mm sphere slid at constant height across a bumped patch (over faces, edges and the
+// raised centre node) in 10 um steps: the force's change per step stays within what the law
+// changes for a 10 um change of depth (at the smallest depth on the path), so there is no
+// jump where the contact passes from a face to an edge, a vertex or a node.
+void test_sliding_force_is_smooth(void**) {
+    const Patch cap = hexagon(0.006, 0.0008);
+    const double radius = 0.001, height = 0.0008 + radius - 0.0005;
+    double previous[3] = {0.0, 0.0, 0.0};
+    double worst = 0.0, smallest = INFINITY, largest = 0.0;
+    const int steps = 500;
+    for (int i = 0; i <= steps; ++i) {
+        const double s = -0.0025 + 0.005 * i / steps;
+        const double position[3] = {s, 0.3 * s + 0.0002, height};
+        const Collider c = make_collider(SH_SHAPE_SPHERE, position, radius);
+        double total[3];
+        forces(c, cap, cap.x.data(), total);
+        const double magnitude = std::sqrt(total[0] * total[0] + total[1] * total[1] + total[2] * total[2]);
+        if (i > 0) {
+            double change[3];
+            for (int k = 0; k < 3; ++k) change[k] = total[k] - previous[k];
+            const double jump = std::sqrt(change[0] * change[0] + change[1] * change[1] + change[2] * change[2]) / magnitude;
+            worst = std::max(worst, jump);
+        }
+        smallest = std::min(smallest, magnitude);
+        largest = std::max(largest, magnitude);
+        for (int k = 0; k < 3; ++k) previous[k] = total[k];
+    }
+    printf("slide: |F| %.4g..%.4g N, largest change per 10 um step %.3f %%\n", smallest, largest, 100.0 * worst);
+    assert_true(smallest > 0.0);
+    assert_true(worst < 0.05);
+}
+
+// The potential along a straight path through random node positions, a sphere pressing a
+// bumped patch whose nodes come in and out of it: the energy's change over each step of the
+// path matches the forces' work (midpoint rule) to 1 %, so there is no jump or kink that a
+// line search would trip on.
+void test_potential_is_smooth_along_paths(void**) {
+    for (const double radius : {0.001, 0.003})
+        for (const double exponent : {1.0, 1.5}) {
+            Patch cap = hexagon(0.0025, 0.0003);
+            srand(3);
+            std::vector<double> direction(cap.x.size());
+            for (double& v : direction) v = (rand() / static_cast<double>(RAND_MAX) - 0.5) * 1e-3;
+            for (double& v : cap.x) v += (rand() / static_cast<double>(RAND_MAX) - 0.5) * 2e-4;
+            const double position[3] = {0.0003, 0.0002, 0.0003 + radius - 0.6 * radius};
+            Collider c = make_collider(SH_SHAPE_SPHERE, position, radius);
+            c.params.exponent = exponent;
+            const int steps = 4000;
+            std::vector<double> x = cap.x;
+            double previous = potential(c, cap, x.data()), worst = 0.0, largest = 0.0;
+            std::vector<double> gaps;
+            for (int i = 1; i <= steps; ++i) {
+                for (size_t j = 0; j < x.size(); ++j) x[j] = cap.x[j] + (i - 0.5) / steps * direction[j];
+                double total[3];
+                const std::vector<double> f = forces(c, cap, x.data(), total);
+                double work = 0.0;  // minus the forces' work over the step
+                for (size_t j = 0; j < x.size(); ++j) work -= f[j] * direction[j] / steps;
+                for (size_t j = 0; j < x.size(); ++j) x[j] = cap.x[j] + static_cast<double>(i) / steps * direction[j];
+                const double e = potential(c, cap, x.data());
+                worst = std::max(worst, std::fabs(e - previous - work));
+                largest = std::max(largest, std::fabs(work));
+                previous = e;
+            }
+            printf("sphere %.0f mm on 2.5 mm triangles, n %.1f: largest step energy %.3g J, largest gap to the work %.3g J\n", 1e3 * radius,
+                   exponent, largest, worst);
+            assert_true(largest > 0.0);
+            assert_true(worst < 0.01 * largest);
+        }
+}
+
+}  // namespace
+
+int main() {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_forces_are_the_potentials_gradient),
+        cmocka_unit_test(test_small_sphere_feels_the_law_on_faces_edges_and_vertices),
+        cmocka_unit_test(test_resolved_contact_is_the_nodes_own),
+        cmocka_unit_test(test_sliding_force_is_smooth),
+        cmocka_unit_test(test_potential_is_smooth_along_paths),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}

@@ -128,7 +128,7 @@ BodyContacts::BodyContacts(const Body& body) : body_(body) {
     edge_length_.resize(tris.size());
     for (size_t i = 0; i < tris.size(); ++i) {
         double e[3];
-        sub3(at(body.x.data(), tris[i]), at(body.x.data(), tris[i - i % 3 + (i % 3 + 1) % 3]), e);
+        sub3(at(body.rest.data(), tris[i]), at(body.rest.data(), tris[i - i % 3 + (i % 3 + 1) % 3]), e);
         edge_length_[i] = norm3(e);
     }
     stamp_.assign(n, 0);

@@ -38,8 +38,8 @@ struct ContactCandidate {
     /// Implicit bodies: its depth at the start of the step (m, 0 if it did not touch then),
     /// from which the step's law takes the depth rate (hunt_crossley_step_law).
     double start_depth = 0.0;
-    /// kFaceShape, kEdgeShape: the share of its excess it carries (excess_weight of its size
-    /// when the body's contacts were set up).
+    /// kFaceShape, kEdgeShape: the share of its excess it carries (excess_weight of its rest
+    /// size).
     double excess_weight = 1.0;
 };
 
@@ -164,8 +164,8 @@ private:
     vec<double> node_area_;        ///< per node: a third of its surface triangles' rest area (m^2)
     vec<int32_t> edge_neighbor_;   ///< per surface triangle and edge k (nodes k, k + 1): the
                                    ///< triangle across it, -1 if not exactly one
-    vec<double> edge_length_;      ///< per surface triangle and edge k: its length when the
-                                   ///< contacts were set up (m), for excess_weight
+    vec<double> edge_length_;      ///< per surface triangle and edge k: its rest length (m), for
+                                   ///< excess_weight
     vec<Aabb> boxes_;              ///< per surface primitive (triangle, or node for springs)
     AabbTree tree_;
     double margin_ = 0.0;          ///< the last refit's margin (m)

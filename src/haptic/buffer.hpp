@@ -49,10 +49,9 @@ struct Buffer {
     double* mass = nullptr;
     int32_t* triangles = nullptr;    ///< 3 local nodes per surface triangle, outward
     int32_t* edges = nullptr;        ///< 2 local nodes per edge of the surface triangles, each once
-    double* triangle_size = nullptr; ///< per triangle: its longest edge at x_start (m), for
-                                     ///< excess_weight (held while the buffer is stepped, so that
-                                     ///< its contact forces stay a potential's gradient)
-    double* edge_size = nullptr;     ///< per edge: its length at x_start (m)
+    double* triangle_size = nullptr; ///< per triangle: its longest edge at rest (m), for
+                                     ///< excess_weight, as the full model weighs it
+    double* edge_size = nullptr;     ///< per edge: its rest length (m)
     int32_t* surface_nodes = nullptr;
 
     /// Carves the arrays for capacity from arena (or measures them).

@@ -253,7 +253,7 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
     out.edge_count = edges;
     auto length = [&](int32_t a, int32_t b) {
         double e[3];
-        sub3(out.x_start + 3 * static_cast<size_t>(a), out.x_start + 3 * static_cast<size_t>(b), e);
+        sub3(at(body.rest.data(), out.node_id[a]), at(body.rest.data(), out.node_id[b]), e);
         return norm3(e);
     };
     for (int32_t t = 0; t < count; ++t) {

@@ -10,6 +10,7 @@
 namespace sh {
 
 Body::Body(IntegrationSettings s, vec<double> rest_positions) : settings(s), x(std::move(rest_positions)) {
+    rest = x;
     const size_t n = x.size() / 3;
     v.assign(3 * n, 0.0);
     mass.assign(n, 0.0);

@@ -106,6 +106,7 @@ public:
 
     IntegrationSettings settings;
     vec<double> x, v;            ///< 3 per node (m, m/s)
+    vec<double> rest;            ///< the rest shape, 3 per node (m)
     vec<double> mass;            ///< lumped mass per node (kg); 0 for orphans
     vec<double> inverse_mass;    ///< 1/m for free nodes, 0 for fixed, prescribed and orphans
     vec<uint8_t> kinematic;      ///< 1 if the node's position is fixed or prescribed

@@ -331,7 +331,10 @@ BodyContacts* BodyContacts::finish_detection(double h) {
         const size_t index = static_cast<size_t>(&c - candidates_.data());
         candidates_[index].start_depth = point->depth;
         if (!friction) return;
-        candidates_[index].friction_normal = point->net_normal_force;
+        // Only pushing terms take friction (an edge's subtracted term would make the
+        // dissipation potential concave): where a region straddles an edge, both faces carry
+        // friction on their share.
+        candidates_[index].friction_normal = std::max(point->net_normal_force, 0.0);
         FrictionIterate& r = iterates[index];
         for (int k = 0; k < 3; ++k) {
             r.lag_normal[k] = point->normal[k];
@@ -361,9 +364,7 @@ bool BodyContacts::lagged_friction(const ContactCandidate& c, const double* v, C
     // the gradient of a dissipation potential (dissipation()). A candidate that touched at the
     // start keeps it through the step even at iterates where it has come off: else it would
     // vanish as a node leaves the surface, a jump Newton cannot converge across.
-    // An edge's term is subtracted (excess_shape_contact): so is its friction (a negative
-    // normal force), which cancels the faces' share of the same region.
-    if (c.friction_normal == 0.0 || iterates_.size() != candidates_.size() || !(c.params->static_friction > 0.0))
+    if (!(c.friction_normal > 0.0) || iterates_.size() != candidates_.size() || !(c.params->static_friction > 0.0))
         return false;
     const FrictionIterate& r = iterates_[static_cast<size_t>(&c - candidates_.data())];
     double vrel[3] = {0.0, 0.0, 0.0};

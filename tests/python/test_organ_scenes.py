@@ -27,12 +27,13 @@ from test_implicit_robust import hanging_liver
 
 HZ60 = 1.0 / 60.0
 
-# A tool as small as the coarse mesh's elements still sinks between its nodes once a node
-# touches it (README, Limits): these scenes fail on that today, by their assertions (any other
-# error fails the suite). strict: when contact holds, they pass and the marker must go.
-SINKS_BETWEEN_NODES = pytest.mark.xfail(
+# The haptic buffer's rendered force still jumps by up to 10 % of its peak between ticks on the
+# coarse liver (at the 60 Hz hand-overs of a new buffer): this scene fails on that today, by
+# its assertions (any other error fails the suite). strict: when it renders smoothly, it passes
+# and the marker must go.
+BUFFER_HANDOVER_JUMPS = pytest.mark.xfail(
     strict=True, raises=AssertionError,
-    reason="a small tool sinks between a coarse mesh's nodes once one touches it (README Limits)")
+    reason="the rendered force jumps at buffer hand-overs on a coarse mesh (README Limits)")
 
 
 def press_triangle(mesh):
@@ -72,7 +73,6 @@ def pose_at(top, t):
     return top - (0.0, 0.0, DEPTH * min(1.0, t))
 
 
-@SINKS_BETWEEN_NODES
 @pytest.mark.parametrize("model", ["corotational", "stvk", "neohookean"])
 def test_palpation_force_grows_while_pressing_and_holds(meshes, model):
     with softhap.World(gravity=(0, 0, 0)) as world:
@@ -104,7 +104,6 @@ def test_palpation_force_grows_while_pressing_and_holds(meshes, model):
 MEMBRANE = (0.04, 0.04, 0.002)  # 4 cm x 4 cm x 2 mm, 20 x 20 x 2 boxes of 2 x 2 x 1 mm
 
 
-@SINKS_BETWEEN_NODES
 @pytest.mark.parametrize("xy", [(0.0207, 0.0193), (0.02, 0.02)], ids=["mid-triangle", "on-node"])
 def test_small_fast_sphere_never_passes_through_a_membrane(xy):
     mesh = box_mesh(MEMBRANE, (20, 20, 2))
@@ -193,7 +192,7 @@ def test_quasi_static_press_of_a_block_follows_hertz_and_the_static_solve():
 # Haptic rendering of the press: 1 kHz device ticks, the full model at 60 Hz
 
 
-@SINKS_BETWEEN_NODES
+@BUFFER_HANDOVER_JUMPS
 @pytest.mark.parametrize("radius", [0.01, 0.003], ids=["sphere-1cm", "probe-3mm"])
 def test_haptic_press_renders_a_smooth_force_and_the_model_holds_the_tool(meshes, radius):
     with softhap.World(gravity=(0, 0, 0)) as world:

@@ -1,5 +1,5 @@
 // Shape: a rigid convex collider (sphere, capsule, box, convex hull of points, plane) and its
-// narrow-phase queries against points and triangles.
+// narrow-phase queries against points and surface simplices.
 #pragma once
 
 #include "collision/pose.hpp"
@@ -66,29 +66,6 @@ public:
     /// True if world point x lies inside the shape at pose (depth > 0); then out holds the
     /// depth, the outward normal at the nearest surface point and out.point = x.
     bool penetrate_point(const Pose& pose, const double x[3], Penetration& out) const;
-
-    /// True if the shape at pose reaches through the triangle (a, b, c) from its outer side:
-    /// the shape's deepest point below the triangle's plane (outward normal (b - a) x (c - a))
-    /// projects inside the triangle and lies depth > 0 below it, with the shape's centre
-    /// (pose.p) on the outer side. Then out.normal is minus the triangle's unit outward normal
-    /// (the push that moves the triangle out of the shape), out.point the deepest point's
-    /// projection on the triangle and bary its barycentric weights (each >= 0, sum 1).
-    /// Zero-area triangles and planes give false.
-    bool penetrate_triangle(const Pose& pose, const double a[3], const double b[3], const double c[3],
-                            Penetration& out, double bary[3]) const;
-
-    /// True if the shape at pose reaches through the edge (a, b) where two surface triangles
-    /// with unit outward normals n1 and n2 meet in a convex dihedral, in the edge's own region:
-    /// over the directions m between n1 and n2 (perpendicular to the edge) the overlap
-    /// m.a - min over the shape of m.s is least strictly between them (at n1 or n2 it is a
-    /// face's, see penetrate_triangle), and positive there, the shape's deepest point along -m
-    /// projects onto the segment and its centre is on the outer side. Then out.depth is that
-    /// overlap, out.normal = -m (the push that moves the edge out of the shape), out.point the
-    /// projected point and t its parameter from a (0) to b (1). Exact for spheres (m points
-    /// from the edge to the centre); a one-dimensional search over m for the other shapes.
-    /// Planes, zero-length edges and parallel normals give false.
-    bool penetrate_edge(const Pose& pose, const double a[3], const double b[3], const double n1[3],
-                        const double n2[3], Penetration& out, double& t) const;
 
     /// Maximises psi(depth(x)) - sum_i w_i node_energy[i] over the simplex of `count` (2 or 3)
     /// world points, x = sum_i w_i points[i], depth(x) the shape's penetration depth at x.

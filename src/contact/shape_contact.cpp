@@ -126,9 +126,10 @@ bool excess_shape_contact(const Collider& collider, const StepLaw& law, const do
         pen.point[k] = e.point[k];
     }
     set_geometry(pen, count, nodes, e.weights, out);
-    const double scale = (count == 2 ? -1.0 : 1.0) * fade.factor();
+    const double sign = count == 2 ? -1.0 : 1.0;  // faces add, edges subtract
+    const double scale = sign * fade.factor();
     const double force = psi.force(e.depth);
-    out.law_scale = count == 2 ? -1.0 : 1.0;
+    out.law_scale = sign;
     out.energy = scale * e.value;
     out.normal_force = scale * force;
     // For the tangent: the law's curvature at the maximiser times the excess's share of the
@@ -142,7 +143,7 @@ bool excess_shape_contact(const Collider& collider, const StepLaw& law, const do
     // Node a: w_a (push at the maximiser - its own push), the gradient of the excess, and
     // the fade's: -excess d(factor)/dx_a, along the node's push.
     for (int a = 0; a < count; ++a) {
-        const double fade_slope = (count == 2 ? -1.0 : 1.0) * e.value * fade.slope(a);
+        const double fade_slope = sign * e.value * fade.slope(a);
         for (int k = 0; k < 3; ++k) {
             out.node_force[a][k] = scale * e.weights[a] * (e.push[k] - node_push[a][k]) + fade_slope * node_normal[a][k];
             // For the tangent, stiffness times gradient gradient^T: the law's curvature at the

@@ -105,9 +105,4 @@ void apply_implicit_friction(const FrictionRecord& r, const double* inverse_mass
 /// share that edge. Allocates.
 void pair_triangles_across_edges(const int32_t* tris, size_t count, int32_t* neighbor);
 
-/// The node of triangle u (3 nodes) that is neither a nor b.
-inline int32_t third_node(const int32_t* u, int32_t a, int32_t b) {
-    return u[0] != a && u[0] != b ? u[0] : u[1] != a && u[1] != b ? u[1] : u[2];
-}
-
 }  // namespace sh

@@ -313,8 +313,12 @@ static void test_stale_data_and_bad_pose_ramp_the_force_out(void** state) {
     out = press(haptic, z, 1, dt);
     assert_int_equal(out.faults, 0);
     assert_true(out.data_age <= dt * 1.000001);
+    /* Ramped back in: after ramp_time the rendered force is the buffer's own again (it rings
+     * while its boundary catches up with a full model that stood still for 0.2 s and has
+     * taken one step, so its value is not the one held before). */
     out = press(haptic, z, 30, dt);
-    assert_true(norm3(out.force) > 0.5 * held);
+    assert_true(out.contact && norm3(out.raw_force) > 0.0);
+    for (int k = 0; k < 3; ++k) assert_true(fabs(out.force[k] - out.raw_force[k]) <= 1e-12);
 
     /* NaN pose: invalid argument, a fault bit, and a finite force that ramps out. */
     const double bad[3] = {NAN, 0.0, 0.0};

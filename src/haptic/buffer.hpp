@@ -18,7 +18,7 @@ struct BufferCapacity {
     int32_t blocks() const { return (tets + kLanes - 1) / kLanes + 4; }  ///< one partial per model
     int32_t triangles() const { return 4 * tets; }  ///< each buffer tet has at most 4 surface faces
     int32_t edges() const { return 12 * tets; }     ///< at most 3 per triangle
-    int32_t friction_records() const { return 4 * nodes; }  ///< friction contacts per sub-step (node, vertex and face terms)
+    int32_t friction_records() const { return nodes; }  ///< friction contacts per sub-step: one per surface node
 };
 
 /// One exchanged buffer. The arrays are carved at creation with the capacities; the counts
@@ -43,8 +43,8 @@ struct Buffer {
     TetBlock* blocks = nullptr;   ///< local node numbers
     int32_t* node_id = nullptr;   ///< body node of each local node, ascending
     double* x_start = nullptr;    ///< full model at the start of its step (3 per node)
-    double* x_end = nullptr;      ///< at its end
-    double* v_end = nullptr;      ///< velocity at its end
+    double* x_end = nullptr;      ///< at its end (the boundary's mean velocity across the step
+                                  ///< is (x_end - x_start) / period)
     double* inverse_mass = nullptr;  ///< 0 for boundary nodes (driven by the full model)
     double* mass = nullptr;
     int32_t* triangles = nullptr;    ///< 3 local nodes per surface triangle, outward
@@ -61,7 +61,6 @@ struct Buffer {
         node_id = arena.take<int32_t>(n);
         x_start = arena.take<double>(3 * n);
         x_end = arena.take<double>(3 * n);
-        v_end = arena.take<double>(3 * n);
         inverse_mass = arena.take<double>(n);
         mass = arena.take<double>(n);
         triangles = arena.take<int32_t>(3 * static_cast<size_t>(capacity.triangles()));

@@ -182,7 +182,6 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
         for (int k = 0; k < 3; ++k) {
             out.x_start[3 * i + k] = at(start, node)[k];
             out.x_end[3 * i + k] = at(body.x.data(), node)[k];
-            out.v_end[3 * i + k] = at(body.v.data(), node)[k];
         }
         out.mass[i] = body.mass[static_cast<size_t>(node)];
         // A node is interior when every tet around it is in the buffer and the full model

@@ -18,8 +18,11 @@ struct WorkingArrays {
     double* v[2];
     int32_t* id[2];
     double* force;
+    double* contact;
     double* saved_x;
     double* saved_v;
+    double* path_x;
+    double* path_v;
     FrictionRecord* friction;
 };
 
@@ -32,8 +35,11 @@ void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3
         w.id[k] = arena.take<int32_t>(n);
     }
     w.force = arena.take<double>(3 * n);
+    w.contact = arena.take<double>(3 * n);
     w.saved_x = arena.take<double>(3 * n);
     w.saved_v = arena.take<double>(3 * n);
+    w.path_x = arena.take<double>(3 * n);
+    w.path_v = arena.take<double>(3 * n);
     w.friction = arena.take<FrictionRecord>(static_cast<size_t>(capacity.friction_records()));
 }
 
@@ -92,8 +98,11 @@ HapticContext::HapticContext(World& world, const sh_haptic_def& def)
         id_[k] = w.id[k];
     }
     force_ = w.force;
+    contact_ = w.contact;
     saved_x_ = w.saved_x;
     saved_v_ = w.saved_v;
+    path_x_ = w.path_x;
+    path_v_ = w.path_v;
     friction_ = w.friction;
     friction_capacity_ = capacity_of(def).friction_records();
     pose_ = tool_.target;

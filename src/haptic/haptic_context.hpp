@@ -76,10 +76,12 @@ private:
 
     // haptic side
     void load_state(const Buffer& b, bool keep);
+    void follow_boundary(const Buffer& b, double t, double* x, double* v) const;
     void adopt(const Buffer& b);
     bool step_buffer(const Buffer& b, double dt, double force[3], double torque[3], int32_t& substeps, bool& contact);
     void add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double force[3],
                             double torque[3], bool& contact);
+    void record_node_friction(const Buffer& b, const double* x, const double* v);
     void apply_friction_impulses(const Buffer& b, double h, double* x, double* v, double force[3], double torque[3]);
     bool proxy_force(const Buffer& b, double force[3], double torque[3]) const;
     double substep_limit(const Buffer& b, const double* x, const double* v, double dt);
@@ -105,8 +107,11 @@ private:
     int32_t node_count_ = 0;
     sh_body_id state_body_ = 0;
     double* force_ = nullptr;  ///< 3 per node
+    double* contact_ = nullptr;  ///< 3 per node: the sub-step's contact force on it
     double* saved_x_ = nullptr;
     double* saved_v_ = nullptr;
+    double* path_x_ = nullptr;  ///< where each boundary node's path starts: the haptic side's
+    double* path_v_ = nullptr;  ///< state of the node at the hand-over, else the full model's
     FrictionRecord* friction_ = nullptr;  ///< the sub-step's friction contacts
     int32_t friction_capacity_ = 0;
     int32_t friction_count_ = 0;

@@ -81,29 +81,78 @@ bool term_contact(const Collider& tool, const double* x, const int32_t* nodes, i
                                 excess_weight(tool, size), out);
 }
 
+// How far past the full model's step (in steps) the boundary keeps its end velocity, when the
+// next buffer is late: the haptic clock and the full model's meet every 16 or 17 ticks at
+// 1 kHz and 60 Hz, so the boundary must not stop for the odd tick; a late full model is
+// reported stale (sh_haptic_def.stale_after) and the boundary waits for it.
+constexpr double kOverrun = 0.25;
+
+// Node i's mean velocity across b's full-model step (0 without a step). An explicit body's
+// velocity at the end of its last sub-step rings with its fastest modes; the mean is the
+// motion the boundary follows (for implicit Euler it is the end velocity).
+void mean_velocity(const Buffer& b, int32_t i, double out[3]) {
+    const double rate = b.period > 0.0 ? 1.0 / b.period : 0.0;
+    for (int k = 0; k < 3; ++k) out[k] = rate * (at(b.x_end, i)[k] - at(b.x_start, i)[k]);
+}
+
 }  // namespace
 
 void HapticContext::load_state(const Buffer& b, bool keep) {
-    // With keep, nodes the old buffer integrated keep the haptic side's state; the others
-    // start from the full model at the start of its step, where the boundary starts too.
+    // With keep, nodes the old buffer had keep the haptic side's state (a boundary node's path
+    // starts from it); the others start from the full model at the start of its step.
     const int other = 1 - current_;
     const bool same_body = keep && b.body != 0 && b.body == state_body_;
     int32_t j = 0;
     for (int32_t i = 0; i < b.node_count; ++i) {
         const int32_t id = b.node_id[i];
         while (same_body && j < node_count_ && id_[current_][j] < id) ++j;
-        const bool kept = same_body && j < node_count_ && id_[current_][j] == id && b.inverse_mass[i] > 0.0;
+        const bool kept = same_body && j < node_count_ && id_[current_][j] == id;
+        double mean[3];
+        mean_velocity(b, i, mean);
         const double* xs = kept ? at(x_[current_], j) : at(b.x_start, i);
-        const double* vs = kept ? at(v_[current_], j) : at(b.v_end, i);
+        const double* vs = kept ? at(v_[current_], j) : mean;
         for (int k = 0; k < 3; ++k) {
             at(x_[other], i)[k] = xs[k];
             at(v_[other], i)[k] = vs[k];
+            at(path_x_, i)[k] = xs[k];
+            at(path_v_, i)[k] = vs[k];
         }
         id_[other][i] = id;
     }
     current_ = other;
     node_count_ = b.node_count;
     state_body_ = b.body;
+}
+
+void HapticContext::follow_boundary(const Buffer& b, double t, double* x, double* v) const {
+    // The full model drives the boundary nodes across its step: each follows the cubic Hermite
+    // path from its state at the hand-over (path_x_, path_v_: the haptic side's, so that
+    // nothing jumps when a buffer replaces another or a free node becomes a boundary one) to
+    // the full model's end of step; past the step, on at the end velocity for a while; with
+    // no step to follow (a jump), it stays at the end.
+    const double period = b.period;
+    const double s = period > 0.0 ? std::min(t / period, 1.0 + kOverrun) : 1.0;
+    double p0 = 0.0, m0 = 0.0, p1 = 1.0, m1 = 0.0;   // weights of x0, T v0, x1, T v1 in x
+    double dp0 = 0.0, dm0 = 0.0, dp1 = 0.0, dm1 = 0.0;  // and of their rate (1/T)
+    if (period > 0.0 && s <= 1.0) {
+        const double s2 = s * s, s3 = s2 * s;
+        p0 = 2 * s3 - 3 * s2 + 1, m0 = s3 - 2 * s2 + s, p1 = -2 * s3 + 3 * s2, m1 = s3 - s2;
+        dp0 = 6 * s2 - 6 * s, dm0 = 3 * s2 - 4 * s + 1, dp1 = -dp0, dm1 = 3 * s2 - 2 * s;
+    } else if (period > 0.0) {
+        m1 = s - 1.0;
+        dm1 = s < 1.0 + kOverrun ? 1.0 : 0.0;
+    }
+    const double rate = period > 0.0 ? 1.0 / period : 0.0;
+    for (int32_t i = 0; i < b.node_count; ++i) {
+        if (b.inverse_mass[i] > 0.0) continue;
+        double v1[3];
+        mean_velocity(b, i, v1);
+        const double *x0 = at(path_x_, i), *x1 = at(b.x_end, i), *v0 = at(path_v_, i);
+        for (int k = 0; k < 3; ++k) {
+            at(x, i)[k] = p0 * x0[k] + p1 * x1[k] + period * (m0 * v0[k] + m1 * v1[k]);
+            at(v, i)[k] = rate * (dp0 * x0[k] + dp1 * x1[k]) + dm0 * v0[k] + dm1 * v1[k];
+        }
+    }
 }
 
 void HapticContext::adopt(const Buffer& b) {
@@ -160,29 +209,57 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
     double lo[3], hi[3];
     tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
     const sh_contact_params& law = tool_.params;
-    friction_count_ = 0;
-    auto act = [&](ContactPoint& p) {
+    for (int32_t s = 0; s < b.surface_node_count; ++s) {
+        double* push = at(contact_, b.surface_nodes[s]);
+        push[0] = push[1] = push[2] = 0.0;
+    }
+    visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
+        ContactPoint p;
+        if (!term_contact(tool_, x, nodes, count, size, p)) return;
         double vrel[3];
         velocity_against_collider(tool_, p, v, vrel);
         if (p.count == 1) apply_normal_law(law, vrel, p);
         else apply_excess_damping(law, vrel, p);
         for (int a = 0; a < p.count; ++a)
-            for (int k = 0; k < 3; ++k) at(f, p.nodes[a])[k] += p.node_force[a][k];
+            for (int k = 0; k < 3; ++k) {
+                at(f, p.nodes[a])[k] += p.node_force[a][k];
+                at(contact_, p.nodes[a])[k] += p.node_force[a][k];
+            }
         add_reaction(p, x, tool_.pose.p, force, torque);
         contact = true;
-        // Friction as the full model's explicit bodies take it: implicitly, after the update.
-        if (!(law.static_friction > 0.0 && p.net_normal_force > 0.0)) return;
+    });
+    record_node_friction(b, x, v);
+}
+
+void HapticContext::record_node_friction(const Buffer& b, const double* x, const double* v) {
+    // Friction per surface node, against the net push of all the terms on it: each term's own
+    // normal differs (a node's, an edge's and a face's maximiser look different ways), and
+    // friction taken per term would stop a node's motion across all of their tangent planes,
+    // normal separation included, as if it stuck to the tool.
+    friction_count_ = 0;
+    const sh_contact_params& law = tool_.params;
+    if (!(law.static_friction > 0.0)) return;
+    for (int32_t s = 0; s < b.surface_node_count; ++s) {
+        const int32_t node = b.surface_nodes[s];
+        const double* push = at(contact_, node);
+        const double fn = norm3(push);
+        if (!(fn > 0.0) || b.inverse_mass[node] == 0.0) continue;
         if (friction_count_ == friction_capacity_) {
             step_warnings_ |= 1u << SH_WARN_CAPACITY;
             return;
         }
-        p.friction_normal = p.net_normal_force;
+        ContactPoint p{};
+        p.count = 1;
+        p.nodes[0] = node;
+        p.weights[0] = 1.0;
+        for (int k = 0; k < 3; ++k) {
+            p.point[k] = at(x, node)[k];
+            p.normal[k] = push[k] / fn;
+        }
+        velocity_against_collider(tool_, p, v, p.relative_velocity);
+        p.friction_normal = fn;
         friction_[friction_count_++] = friction_record(p, law, v);
-    };
-    visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
-        ContactPoint p;
-        if (term_contact(tool_, x, nodes, count, size, p)) act(p);
-    });
+    }
 }
 
 void HapticContext::apply_friction_impulses(const Buffer& b, double h, double* x, double* v, double force[3],
@@ -219,18 +296,7 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
     const Pose start = tool_.start;
     for (int32_t s = 0; s < substeps; ++s) {
         tool_.pose = interpolate(start, tool_.target, static_cast<double>(s + 1) / substeps);
-        // The boundary follows the full model across its step.
-        const double t = t0 + (s + 1) * h;
-        const double fraction = b.period > 0.0 ? std::min(1.0, t / b.period) : 1.0;
-        const double rate = b.period > 0.0 && t < b.period ? 1.0 / b.period : 0.0;
-        for (int32_t i = 0; i < b.node_count; ++i) {
-            if (b.inverse_mass[i] > 0.0) continue;
-            for (int k = 0; k < 3; ++k) {
-                const double d = at(b.x_end, i)[k] - at(b.x_start, i)[k];
-                at(x, i)[k] = at(b.x_start, i)[k] + fraction * d;
-                at(v, i)[k] = rate * d;
-            }
-        }
+        follow_boundary(b, t0 + (s + 1) * h, x, v);
         for (int32_t i = 0; i < b.node_count; ++i)
             for (int k = 0; k < 3; ++k) at(force_, i)[k] = b.mass[i] * b.gravity[k];
         const double* damped_v = b.damping_stiffness > 0.0 ? v : nullptr;

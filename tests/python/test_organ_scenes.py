@@ -88,6 +88,30 @@ def test_palpation_force_grows_while_pressing_and_holds(meshes, model):
         assert hold.min() >= 0.8 * press[-1]
 
 
+# Spheres of 1, 3 and 10 mm, each with a law that holds three times the press's force before
+# its depth reaches its radius (lambda r^1.5 >= 3 N; a sphere's penalty holds at most that).
+SPHERES = [(0.001, 1e5), (0.003, 2e4), (0.01, 3e3)]
+
+
+@pytest.mark.parametrize("radius, stiffness", SPHERES, ids=["1mm", "3mm", "10mm"])
+def test_press_force_grows_whatever_the_sphere_size(meshes, radius, stiffness):
+    # A tool smaller than the 15 mm triangles is held by the face it touches: pressed 1 cm, it
+    # neither sinks between the nodes (the force would fall) nor passes through.
+    with softhap.World(gravity=(0, 0, 0)) as world:
+        _, tool, top = liver_and_tool(world, meshes, "corotational", radius, stiffness)
+        forces = []
+        for i in range(40):
+            tool.set_pose(top - (0.0, 0.0, 0.01 * (i + 1) / 40))
+            world.step(HZ60)  # raises on a failed step
+            forces.append(np.linalg.norm(tool.force))
+        assert world.warnings["SH_WARN_NOT_CONVERGED"] <= 3
+        assert largest_fall(forces) <= 0.05 * max(forces)
+        # The press triangle's nodes pushed 4 mm straight down meet 0.30 N (module docstring);
+        # the contact's own depth under these laws is below 0.5 mm, so the organ has travelled
+        # more than 9 mm.
+        assert forces[-1] >= 0.30
+
+
 # ------------------------------------------------------------------------------------------
 # A thin membrane and a small fast sphere
 

@@ -4,7 +4,7 @@ PYTHON ?= python3
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-c test-python test-reduced demo palpation haptic-loop tsan bench report report-deps haptic-report clean
+.PHONY: all deps build test test-c test-python test-reduced demo palpation haptic-loop tsan bench report report-deps haptic-report press-report clean
 
 all: build
 
@@ -84,6 +84,15 @@ haptic-report: build report-deps
 	OMP_NUM_THREADS=1 $(BUILD)/bench/softhap_bench haptic-error > report/haptic_error.jsonl
 	OMP_NUM_THREADS=1 $(BUILD)/bench/softhap_bench haptic-force --csv report/haptic_force.csv > report/haptic_force.jsonl
 	$(PYTHON) scripts/haptic_report.py report/
+
+# A sphere and a probe pressed 1.5 cm into liver2 with a 1 kHz haptic context (about 20 s): the
+# full model's and the rendered force against the tool's travel, in report/press_*.png.
+press-report: build report-deps
+	@mkdir -p report
+	PYTHONPATH=bindings/python SOFTHAP_LIBRARY=$(abspath $(BUILD))/libsofthap.so $(PYTHON) scripts/press_probe.py \
+	  liver2.msh 0.21 0.01 --friction 0.5 --plot report/press_liver2_sphere_10mm.png
+	PYTHONPATH=bindings/python SOFTHAP_LIBRARY=$(abspath $(BUILD))/libsofthap.so $(PYTHON) scripts/press_probe.py \
+	  liver2.msh 0.21 0.003 --stiffness 1e4 --friction 0.5 --plot report/press_liver2_probe_3mm.png
 
 clean:
 	rm -rf build build-no-cholmod build-no-ccd build-tsan

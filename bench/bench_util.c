@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #ifndef SOFTHAP_BENCH_MESH_DIR
@@ -47,6 +48,44 @@ double median(const double* sorted, int n) {
     return n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
 }
 
+stats summarize(double* v, int n) {
+    stats s = {0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    if (n <= 0) return s;
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) sum += v[i];
+    qsort(v, (size_t)n, sizeof(double), cmp_double);
+    s.count = n;
+    s.median = median(v, n);
+    s.p99 = quantile(v, n, 0.99);
+    s.p999 = quantile(v, n, 0.999);
+    s.max = v[n - 1];
+    s.mean = sum / n;
+    return s;
+}
+
+double norm3(const double* a) { return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
+
+int name_matches(const char* name, const char* filter) { return !filter || strstr(name, filter) != NULL; }
+
+int bench_filter_arg(const char* arg, const char** filter, void (*usage)(void)) {
+    if (!*filter && arg[0] != '-') {
+        *filter = arg;
+        return -1;
+    }
+    usage();
+    return strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0 ? 0 : 2;
+}
+
+const char* material_name(sh_material_model model) {
+    switch (model) {
+    case SH_MATERIAL_LINEAR: return "linear";
+    case SH_MATERIAL_STVK: return "stvk";
+    case SH_MATERIAL_COROTATIONAL: return "corotational";
+    case SH_MATERIAL_NEOHOOKEAN: return "neohookean";
+    }
+    return "?";
+}
+
 static int file_exists(const char* dir, const char* name) {
     char path[4096];
     snprintf(path, sizeof path, "%s/%s", dir, name);
@@ -63,15 +102,21 @@ const char* bench_find_mesh_dir(const char* given, const char* probe) {
     return NULL;
 }
 
-int bench_load_scaled_mesh(const char* dir, const char* file, const double* turn, double size, sh_mesh** out_mesh,
-                           double** out_nodes) {
+sh_mesh* bench_load_mesh(const char* dir, const char* file) {
     char path[4096];
     snprintf(path, sizeof path, "%s/%s", dir, file);
-    sh_mesh* raw = NULL;
-    if (sh_mesh_load(path, &raw) != SH_OK) {
+    sh_mesh* mesh = NULL;
+    if (sh_mesh_load(path, &mesh) != SH_OK) {
         fprintf(stderr, "softhap_bench: cannot load %s: %s\n", path, sh_last_error_message());
-        return 0;
+        return NULL;
     }
+    return mesh;
+}
+
+int bench_load_scaled_mesh(const char* dir, const char* file, const double* turn, double size, sh_mesh** out_mesh,
+                           double** out_nodes) {
+    sh_mesh* raw = bench_load_mesh(dir, file);
+    if (!raw) return 0;
     sh_mesh_info info;
     CHECK(sh_mesh_get_info(raw, &info));
     const int32_t n = info.node_count, t = info.tet_count;

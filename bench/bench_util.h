@@ -1,5 +1,5 @@
 /* Helpers shared by the softhap_bench subcommands: a fatal status check, a monotonic clock,
- * order statistics of timing samples, the mesh folder and scaled meshes. */
+ * order statistics of timing samples, case filters and names, the mesh folder and meshes. */
 #ifndef SOFTHAP_BENCH_UTIL_H
 #define SOFTHAP_BENCH_UTIL_H
 
@@ -27,9 +27,35 @@ double quantile(const double* sorted, int n, double q);
 /* Median of sorted[0..n). */
 double median(const double* sorted, int n);
 
+/* Order statistics and mean of a sample (count 0: all zero). */
+typedef struct {
+    int count;
+    double median, p99, p999, max, mean;
+} stats;
+
+/* Sorts v[0..n) and summarises it. */
+stats summarize(double* v, int n);
+
+/* Euclidean length of a 3-vector. */
+double norm3(const double* a);
+
+/* 1 if a case named name is wanted: no filter, or name contains filter. */
+int name_matches(const char* name, const char* filter);
+
+/* An argument none of a subcommand's own options took: the first word not starting with '-' is
+ * its FILTER (stored in *filter; returns -1: go on); --help or -h prints usage and returns 0;
+ * anything else prints usage and returns 2. A return >= 0 is the subcommand's exit code. */
+int bench_filter_arg(const char* arg, const char** filter, void (*usage)(void));
+
+/* The lower-case name of a material model ("stvk"), as the cases and JSON lines spell it. */
+const char* material_name(sh_material_model model);
+
 /* The mesh folder: given if not NULL, else the first of $SOFTHAP_MESHES, the build's default,
  * ../shared/meshes and ../../shared/meshes that holds probe (a file name). NULL if none. */
 const char* bench_find_mesh_dir(const char* given, const char* probe);
+
+/* Loads dir/file as it is; NULL with a message on stderr if it does not load. */
+sh_mesh* bench_load_mesh(const char* dir, const char* file);
 
 /* Loads dir/file, turns its nodes by turn (a row-major 3x3 rotation; NULL: as they are), moves
  * the lowest corner of their bounding box (of the turned nodes; of sh_mesh_info's bounds when

@@ -148,7 +148,7 @@ static const char* g_csv = NULL;
 static int g_steps = 0;
 static int g_rt = 0; /* --rt: the haptic thread runs SCHED_FIFO (1 if granted) */
 
-static int matches(const char* name) { return !g_filter || strstr(name, g_filter) != NULL; }
+static int matches(const char* name) { return name_matches(name, g_filter); }
 
 /* ------------------------------------------------------------------------------------------ */
 /* Allocation counting and threads                                                              */
@@ -206,36 +206,12 @@ static void sleep_until(double deadline_ns) {
 /* ------------------------------------------------------------------------------------------ */
 /* Statistics                                                                                   */
 
-typedef struct {
-    int count;
-    double median, p99, p999, max, mean;
-} stats;
-
-/* Sorts v[0..n) and summarises it. */
-static stats summarize(double* v, int n) {
-    stats s;
-    memset(&s, 0, sizeof s);
-    if (n <= 0) return s;
-    double sum = 0.0;
-    for (int i = 0; i < n; ++i) sum += v[i];
-    qsort(v, (size_t)n, sizeof(double), cmp_double);
-    s.count = n;
-    s.median = median(v, n);
-    s.p99 = quantile(v, n, 0.99);
-    s.p999 = quantile(v, n, 0.999);
-    s.max = v[n - 1];
-    s.mean = sum / n;
-    return s;
-}
-
 /* Prints "<prefix>median_us":..,... for times in ns. */
 static void print_times_us(const char* prefix, const stats* s) {
     printf("\"%smedian_us\":%.3f,\"%sp99_us\":%.3f,\"%sp999_us\":%.3f,\"%smax_us\":%.3f,\"%smean_us\":%.3f", prefix,
            s->median * 1e-3, prefix, s->p99 * 1e-3, prefix, s->p999 * 1e-3, prefix, s->max * 1e-3, prefix,
            s->mean * 1e-3);
 }
-
-static double norm3(const double* a) { return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
 
 static double distance3(const double* a, const double* b) {
     const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
@@ -481,16 +457,6 @@ static sh_haptic_def haptic_def_for(const scene* s, double radius, int32_t capac
 }
 
 static const double kIdentity[4] = {1.0, 0.0, 0.0, 0.0};
-
-static const char* material_name(sh_material_model m) {
-    switch (m) {
-    case SH_MATERIAL_LINEAR: return "linear";
-    case SH_MATERIAL_STVK: return "stvk";
-    case SH_MATERIAL_COROTATIONAL: return "corotational";
-    case SH_MATERIAL_NEOHOOKEAN: return "neohookean";
-    }
-    return "?";
-}
 
 /* ------------------------------------------------------------------------------------------ */
 /* Timed haptic ticks                                                                           */
@@ -1088,16 +1054,11 @@ int run_haptic(int argc, char** argv) {
             given_dir = argv[++i];
         } else if (strcmp(argv[i], "--rt") == 0) {
             g_rt = 1;
-        } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            usage();
-            return 0;
         } else if (strcmp(argv[i], "--csv") == 0 && i + 1 < argc) {
             g_csv = argv[++i];
-        } else if (!g_filter && argv[i][0] != '-') {
-            g_filter = argv[i];
         } else {
-            usage();
-            return 2;
+            const int code = bench_filter_arg(argv[i], &g_filter, usage);
+            if (code >= 0) return code;
         }
     }
     if (strcmp(command, "haptic") != 0) {

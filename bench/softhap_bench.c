@@ -9,6 +9,8 @@
  *   softhap_bench haptic [FILTER] [--steps N]               haptic step cost vs buffer size (haptic.c)
  *   softhap_bench haptic-error [FILTER]                     haptic force error vs buffer radius
  *   softhap_bench haptic-force [--csv PATH]                 haptic force smoothness, VBM vs ZOH
+ *   softhap_bench palpation [FILTER] [--meshes DIR]         a sphere pressed into the liver at 60 Hz
+ *                                                           (implicit, per material; palpation.c)
  *
  * Each case builds a world with one body from a mesh in ../shared/meshes (scaled so its largest
  * extent is kMeshSize), gravity on, the highest 1% of the nodes fixed, dt = kDtFraction * dt_crit
@@ -28,6 +30,7 @@
 #include "accuracy.h"
 #include "bench_util.h"
 #include "haptic.h"
+#include "palpation.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -252,8 +255,6 @@ static void print_case(const char* name, const bench_mesh* m, int springs, doubl
     fflush(stdout);
 }
 
-static int matches(const char* name, const char* filter) { return !filter || strstr(name, filter) != NULL; }
-
 static double body_dt_crit(sh_world* world, sh_body_id body) {
     sh_body_info info;
     CHECK(sh_body_get_info(world, body, &info));
@@ -266,7 +267,7 @@ static void run_case(const bench_mesh* m, const body_kind* kind, const char* fil
     snprintf(name[0], sizeof name[0], "%s/%s", kind->name, m->name);
     snprintf(name[1], sizeof name[1], "%s+report/%s", kind->name, m->name);
     for (int with_report = 0; with_report < 2; ++with_report) {
-        if (!matches(name[with_report], filter)) continue;
+        if (!name_matches(name[with_report], filter)) continue;
         sh_world_def wd;
         sh_world_def_default(&wd);
         sh_world* world = NULL;
@@ -297,7 +298,7 @@ static void run_integrators(const char* filter) {
     for (size_t k = 0; k < sizeof kIntegrators / sizeof kIntegrators[0]; ++k) {
         char name[256];
         snprintf(name, sizeof name, "integrator/%s/stvk/%s", kIntegrators[k].name, m.name);
-        if (!matches(name, filter)) continue;
+        if (!name_matches(name, filter)) continue;
         sh_world_def wd;
         sh_world_def_default(&wd);
         sh_world* world = NULL;
@@ -345,7 +346,7 @@ static void run_implicit(const char* filter) {
         for (size_t k = 0; k < sizeof kSolvers / sizeof kSolvers[0]; ++k) {
             char name[256];
             snprintf(name, sizeof name, "implicit/%s/%s/%s/%s", kScenarios[c], kKinds[j].name, kSolvers[k].name, m.name);
-            if (!matches(name, filter)) continue;
+            if (!name_matches(name, filter)) continue;
             if (kSolvers[k].solver == SH_LINEAR_SOLVER_CHOLMOD && !(sh_build_features() & SH_FEATURE_CHOLMOD)) continue;
             sh_world_def wd;
             sh_world_def_default(&wd);
@@ -538,7 +539,7 @@ static void run_contact(const char* filter) {
     for (size_t k = 0; k < sizeof kContactMeshes / sizeof kContactMeshes[0]; ++k) {
         char name[256];
         snprintf(name, sizeof name, "contact/%s", kContactMeshes[k].name);
-        if (!matches(name, filter)) continue;
+        if (!name_matches(name, filter)) continue;
         bench_mesh m;
         if (!load_mesh_file(kContactMeshes[k].file, kContactMeshes[k].name, &m)) continue; /* message printed */
         contact_run base, r;
@@ -568,7 +569,7 @@ static void run_contact(const char* filter) {
 static void usage(void) {
     fprintf(stderr,
             "usage: softhap_bench [integrators|implicit|contact] [FILTER] [--steps N] [--meshes DIR]\n"
-            "       softhap_bench accuracy|haptic|haptic-error|haptic-force ... (see their --help)\n"
+            "       softhap_bench accuracy|haptic|haptic-error|haptic-force|palpation ... (see their --help)\n"
             "  FILTER  keep the cases whose name contains it (e.g. stvk/raptorTetra_19409)\n"
             "  --steps N  timed steps per case (default: adaptive, %d..%d; implicit 100, contact 200)\n"
             "  --meshes DIR  mesh folder (default $SOFTHAP_MESHES, " SOFTHAP_BENCH_MESH_DIR
@@ -579,6 +580,7 @@ static void usage(void) {
 int main(int argc, char** argv) {
     if (argc > 1 && strcmp(argv[1], "accuracy") == 0) return run_accuracy(argc - 1, argv + 1);
     if (argc > 1 && is_haptic_command(argv[1])) return run_haptic(argc - 1, argv + 1);
+    if (argc > 1 && strcmp(argv[1], "palpation") == 0) return run_palpation(argc - 1, argv + 1);
     const char* filter = NULL;
     int integrators = 0, implicit = 0, contact = 0;
     for (int i = 1; i < argc; ++i) {
@@ -592,20 +594,15 @@ int main(int argc, char** argv) {
             g_factor_reuse = atof(argv[++i]);
         } else if (strcmp(argv[i], "--meshes") == 0 && i + 1 < argc) {
             g_mesh_dir = argv[++i];
-        } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            usage();
-            return 0;
         } else if (strcmp(argv[i], "integrators") == 0 && !integrators && !implicit && !contact) {
             integrators = 1;
         } else if (strcmp(argv[i], "implicit") == 0 && !integrators && !implicit && !contact) {
             implicit = 1;
         } else if (strcmp(argv[i], "contact") == 0 && !integrators && !implicit && !contact) {
             contact = 1;
-        } else if (!filter && argv[i][0] != '-') {
-            filter = argv[i];
         } else {
-            usage();
-            return 2;
+            const int code = bench_filter_arg(argv[i], &filter, usage);
+            if (code >= 0) return code;
         }
     }
     {
@@ -651,7 +648,7 @@ int main(int argc, char** argv) {
             snprintf(name, sizeof name, "%s/%s", kKinds[j].name, kMeshes[k]);
             char name_report[256];
             snprintf(name_report, sizeof name_report, "%s+report/%s", kKinds[j].name, kMeshes[k]);
-            wanted |= matches(name, filter) || matches(name_report, filter);
+            wanted |= name_matches(name, filter) || name_matches(name_report, filter);
         }
         if (!wanted) continue;
         bench_mesh m;

@@ -306,9 +306,13 @@ typedef struct sh_implicit_settings {
                                          linearised step that would raise the mechanical
                                          energy with no work done on the body goes on up to 20
                                          iterations towards the step's minimiser */
-    double newton_tolerance;        /**< stop when the residual |g| <= tol max(|g_0|, dt |f_ext +
-                                         m g|) or the velocity correction <= tol max(|v|, dt |g|,
-                                         1e-9 m/s); default 1e-6 */
+    double newton_tolerance;        /**< stop when the residual |g| <= tol max(|g_0|, dt |f|)
+                                         (f: f_ext + m g and the push of tools and other
+                                         bodies at the step's start) or the velocity correction
+                                         <= tol max(|v|, dt |g|, 1e-9 m/s); at the iteration
+                                         cap (creeping over friction and contact kinks), a last
+                                         correction <= tol L / dt is accepted too, L the bodies'
+                                         bounding-box diagonal; default 1e-6 */
     double cg_tolerance;            /**< CG relative residual; default 1e-8 */
     int32_t cg_max_iterations;      /**< CG iteration cap; default 2000 */
     double factor_reuse;            /**< direct solvers (CHOLMOD, LDLT), > 0: the factorisation

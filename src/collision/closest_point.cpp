@@ -2,6 +2,7 @@
 
 #include "core/vec3.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace sh {
@@ -43,6 +44,45 @@ double closest_on_triangle(const double* p, const double* a, const double* b, co
     for (int k = 0; k < 3; ++k) q[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
     sub3(p, q, d);
     return std::sqrt(dot3(d, d));
+}
+
+namespace {
+
+// Where p lies against the plane of triangle (a, b, c): its height above it along the outward
+// unit normal n, and the barycentric weights w of the point of the triangle nearest to p's
+// projection, at distance lateral from it. False if the triangle is degenerate. Sets edge2 to
+// its longer edge from a, squared.
+bool over_face(const double* p, const double* a, const double* b, const double* c, double& height, double n[3],
+               double w[3], double& lateral, double& edge2) {
+    double ab[3], ac[3], ap[3];
+    sub3(b, a, ab);
+    sub3(c, a, ac);
+    cross3(ab, ac, n);
+    const double area2 = std::sqrt(dot3(n, n));
+    edge2 = std::max(dot3(ab, ab), dot3(ac, ac));
+    if (!(area2 > 1e-14 * edge2)) return false;
+    for (int k = 0; k < 3; ++k) n[k] /= area2;
+    sub3(p, a, ap);
+    height = dot3(n, ap);
+    double q[3];
+    for (int k = 0; k < 3; ++k) q[k] = p[k] - height * n[k];
+    lateral = closest_on_triangle(q, a, b, c, w);
+    return true;
+}
+
+}  // namespace
+
+bool node_behind_face(const double* p, const double* a, const double* b, const double* c, double& depth, double n[3],
+                      double w[3]) {
+    double height, lateral, edge2;
+    if (!over_face(p, a, b, c, height, n, w, lateral, edge2)) return false;
+    depth = -height;
+    return depth > 0.0 && lateral * lateral <= edge2;
+}
+
+bool node_before_face(const double* p, const double* a, const double* b, const double* c) {
+    double height, n[3], w[3], lateral, edge2;
+    return over_face(p, a, b, c, height, n, w, lateral, edge2) && height >= 0.0 && lateral * lateral <= 1e-18 * edge2;
 }
 
 }  // namespace sh

@@ -1,5 +1,8 @@
 // BodyContacts: one body's contact candidates for a step (against tools, obstacles and other
-// bodies) and the contact forces they exert at any state the integrators try.
+// bodies) and the contact forces they exert at any state the integrators try. Implemented in
+// parts: body_contacts.cpp (the potential: forces, energy, stable step), contact_detection.cpp
+// (broad phase), contact_tangent.cpp, contact_friction.cpp and contact_reactions.cpp; the
+// per-term geometry and law are shape_contact's, shared with the haptic buffer.
 #pragma once
 
 #include "collision/aabb_tree.hpp"
@@ -143,7 +146,7 @@ private:
     void record_friction_iterate(const ContactCandidate& c, const ContactPoint* point) const;
     /// Implicit bodies, from add_tangent: the slope along the slip that candidate c's friction
     /// tangent takes at point p instead of the exact one (-1: the exact one), and records the
-    /// tangent it then has. See the comment in body_contacts.cpp.
+    /// tangent it then has. See the comment in contact_friction.cpp.
     double friction_chord(const ContactCandidate& c, const ContactPoint& p) const;
     /// Calls emit(candidate, point) for every candidate at (x, v) (v null: at rest, without
     /// damping or friction), point null for one not in contact.

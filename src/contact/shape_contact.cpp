@@ -24,7 +24,6 @@ void set_geometry(const Penetration& pen, int count, const int32_t* nodes, const
     }
 }
 
-inline const double* at(const double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
 
 }  // namespace
 

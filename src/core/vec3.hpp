@@ -2,8 +2,14 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 
 namespace sh {
+
+/// The 3 coordinates of node `node` in an array of 3 doubles per node.
+inline double* at(double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
+inline const double* at(const double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
 
 /// out = a - b.
 inline void sub3(const double* a, const double* b, double* out) {

@@ -14,7 +14,6 @@
 namespace sh {
 namespace {
 
-inline const double* at(const double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
 
 // The tool's nearest FEM surface: which body, which triangle, the point and the distance.
 struct NearestSurface {

@@ -25,8 +25,6 @@ constexpr double kSafety = 0.9;
 // A step longer than this is not a haptic step (s).
 constexpr double kLongestStep = 1.0;
 
-inline double* at(double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
-inline const double* at(const double* x, int32_t node) { return x + 3 * static_cast<size_t>(node); }
 
 bool boxes_overlap(const double lo[3], const double hi[3], const double* a, const double* b, const double* c) {
     for (int k = 0; k < 3; ++k) {

@@ -1,0 +1,46 @@
+// BodyContacts' evaluation loops over its candidates, for the files that implement it (the
+// potential, its tangent, friction and reactions): not for other users.
+#pragma once
+
+#include "contact/body_contacts.hpp"
+
+namespace sh {
+
+template <class Emit>
+void BodyContacts::evaluate_friction(const double* v, Emit&& emit) const {
+    if (!v || iterates_.size() != candidates_.size()) return;  // iterates_: implicit bodies only
+    for (const ContactCandidate& c : candidates_) {
+        ContactPoint point;
+        if (lagged_friction(c, v, point)) emit(c, point);
+    }
+}
+
+template <class Emit>
+void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& emit) const {
+    for (const Group& group : groups_) {
+        for (int32_t i = group.begin; i < group.end; ++i) {
+            const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
+            ContactPoint point;
+            if (!touching(c, x, v, point)) {
+                emit(c, static_cast<const ContactPoint*>(nullptr));
+                continue;
+            }
+            emit(c, &point);
+        }
+    }
+}
+
+template <class Emit>
+void BodyContacts::evaluate(const double* x, const double* v, Emit&& emit) const {
+    evaluate_candidates(x, v, [&](const ContactCandidate& c, const ContactPoint* point) {
+        if (point) emit(c, *point);
+    });
+}
+
+template <class Visit>
+void BodyContacts::for_each_pair_candidate(const Body& other, const int32_t* own_index, Visit&& visit) const {
+    for (const ContactCandidate& c : candidates_)
+        if (c.kind == ContactCandidate::kNodeFace && c.other == &other && own_index[c.node] >= 0) visit(c);
+}
+
+}  // namespace sh

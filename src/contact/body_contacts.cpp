@@ -47,6 +47,7 @@ BodyContacts::BodyContacts(const Body& body) : body_(body) {
         edge_length_[i] = norm3(e);
     }
     stamp_.assign(n, 0);
+    node_push_.assign(3 * n, 0.0);
 }
 
 void BodyContacts::clear() {
@@ -86,8 +87,7 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
                 return false;
             if (!v || implicit_step()) return true;
             velocity_against_collider(*c.collider, out, v, vrel);
-            apply_excess_damping(p, vrel, out);
-            if (out.net_normal_force > 0.0 && p.static_friction > 0.0) apply_friction(p, out.net_normal_force, out);
+            apply_excess_damping(p, vrel, out);  // friction per node (add_forces)
             return true;
         }
         case ContactCandidate::kNodeFace:
@@ -127,14 +127,16 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
     }
     apply_normal_law(p, v ? vrel : nullptr, out);
     // Explicit bodies evaluate forces at the (sub)step's start: the friction there is
-    // proportional to the normal force there.
-    if (v && out.normal_force > 0.0 && p.static_friction > 0.0) apply_friction(p, out.normal_force, out);
+    // proportional to the normal force there; a collider's per node (add_forces).
+    if (v && !c.collider && out.normal_force > 0.0 && p.static_friction > 0.0) apply_friction(p, out.normal_force, out);
     return true;
 }
 
 void BodyContacts::add_forces(const double* x, const double* v, double* f) const {
     const ScopedTimer timer(evaluation_seconds_);
-    // Explicit bodies feel their friction in end_explicit_step, not here.
+    // Explicit bodies feel their friction in end_explicit_step, not here: against another
+    // body per contact, against a collider per node (node_friction_point), recorded at the
+    // (sub)step's first evaluation.
     const bool explicit_friction = !implicit_step();
     const bool record = recording_ && v;
     if (record) friction_records_.clear();
@@ -149,6 +151,11 @@ void BodyContacts::add_forces(const double* x, const double* v, double* f) const
         add(p, friction);
         if (friction && record) friction_records_.push_back(friction_record(p, *c.params, v));
     });
+    if (explicit_friction && record)
+        for_each_node_push(x, v, [&](const Collider& collider, int32_t node, const double* push) {
+            if (collider.params.static_friction > 0.0 && norm3(push) > 0.0)
+                friction_records_.push_back(friction_record(node_friction_point(collider, node, push, x, v), collider.params, v));
+        });
     evaluate_friction(v, [&](const ContactCandidate& c, const ContactPoint& p) {
         record_friction_iterate(c, &p);
         add(p, false);

@@ -156,6 +156,18 @@ private:
     template <class Emit>
     void evaluate(const double* x, const double* v, Emit&& emit) const;
     bool keep_deepest(Group& group, int32_t capacity);
+    /// Adds p's node forces (a collider's term) to the nodes' net push, listing each node once.
+    void add_node_push(const ContactPoint& p) const;
+    /// Calls emit(node, push) for each node with a net push since the last call, and clears it.
+    template <class Emit>
+    void drain_node_pushes(Emit&& emit) const;
+    /// Calls emit(collider, node, push) for each surface node a collider's terms push at (x, v):
+    /// their net force on it (N).
+    template <class Emit>
+    void for_each_node_push(const double* x, const double* v, Emit&& emit) const;
+    /// Explicit bodies: adds to each collider's state the reaction of its friction per node
+    /// (Coulomb's law on the nodes' net push at the body's state).
+    void add_node_friction_reactions();
     /// Calls visit(candidate) for each kNodeFace candidate against other whose node has
     /// own_index >= 0.
     template <class Visit>
@@ -181,6 +193,8 @@ private:
     vec<Group> groups_;
     vec<double> keys_;               ///< scratch for keep_deepest
     mutable double evaluation_seconds_ = 0.0;
+    mutable vec<double> node_push_;       ///< per node: a collider's net push on it (N), see add_node_push
+    mutable vec<int32_t> pushed_nodes_;   ///< the nodes with a push in node_push_
     /// Explicit bodies: a friction contact as the (sub)step's first add_forces found it, for
     /// end_explicit_step.
     mutable vec<FrictionRecord> friction_records_;

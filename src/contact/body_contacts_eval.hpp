@@ -43,4 +43,31 @@ void BodyContacts::for_each_pair_candidate(const Body& other, const int32_t* own
         if (c.kind == ContactCandidate::kNodeFace && c.other == &other && own_index[c.node] >= 0) visit(c);
 }
 
+template <class Emit>
+void BodyContacts::drain_node_pushes(Emit&& emit) const {
+    for (const int32_t node : pushed_nodes_) {
+        double* push = &node_push_[3 * static_cast<size_t>(node)];
+        emit(node, static_cast<const double*>(push));
+        push[0] = push[1] = push[2] = 0.0;
+    }
+    pushed_nodes_.clear();
+}
+
+template <class Emit>
+void BodyContacts::for_each_node_push(const double* x, const double* v, Emit&& emit) const {
+    Collider* pushing = nullptr;
+    const auto drain = [&]() {
+        drain_node_pushes([&](int32_t node, const double* push) { emit(*pushing, node, push); });
+    };
+    evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
+        if (!c.collider) return;
+        if (c.collider != pushing) {  // candidates come collider by collider
+            if (pushing) drain();
+            pushing = c.collider;
+        }
+        add_node_push(p);
+    });
+    if (pushing) drain();
+}
+
 }  // namespace sh

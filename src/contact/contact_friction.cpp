@@ -90,6 +90,14 @@ double BodyContacts::dissipation(const double* v) const {
     return total;
 }
 
+void BodyContacts::add_node_push(const ContactPoint& p) const {
+    for (int a = 0; a < p.count; ++a) {
+        double* push = &node_push_[3 * static_cast<size_t>(p.nodes[a])];
+        if (push[0] == 0.0 && push[1] == 0.0 && push[2] == 0.0) pushed_nodes_.push_back(p.nodes[a]);
+        for (int k = 0; k < 3; ++k) push[k] += p.node_force[a][k];
+    }
+}
+
 void BodyContacts::begin_explicit_step() const {
     recording_ = true;
     friction_records_.clear();

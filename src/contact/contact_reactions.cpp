@@ -8,6 +8,24 @@
 #include <algorithm>
 
 namespace sh {
+namespace {
+
+// Adds the reaction of contact p (its node forces at positions x) to collider's force and torque.
+void add_reaction(const double* x, Collider& collider, const ContactPoint& p) {
+    sh_contact_state& s = collider.state;
+    for (int a = 0; a < p.count; ++a) {
+        double r[3], torque[3];
+        const double reaction[3] = {-p.node_force[a][0], -p.node_force[a][1], -p.node_force[a][2]};
+        sub3(at(x, p.nodes[a]), collider.pose.p, r);
+        cross3(r, reaction, torque);
+        for (int k = 0; k < 3; ++k) {
+            s.force[k] += reaction[k];
+            s.torque[k] += torque[k];
+        }
+    }
+}
+
+}  // namespace
 
 int32_t BodyContacts::accumulate_reactions() {
     // The contacts that act: the nodes in contact, and per collider the regions where it
@@ -37,16 +55,7 @@ int32_t BodyContacts::accumulate_reactions() {
         if (p.depth > 0.0 && !excess) ++count;
         if (!c.collider) return;
         sh_contact_state& s = c.collider->state;
-        for (int a = 0; a < p.count; ++a) {
-            double r[3], torque[3];
-            const double reaction[3] = {-p.node_force[a][0], -p.node_force[a][1], -p.node_force[a][2]};
-            sub3(&body_.x[3 * static_cast<size_t>(p.nodes[a])], c.collider->pose.p, r);
-            cross3(r, reaction, torque);
-            for (int k = 0; k < 3; ++k) {
-                s.force[k] += reaction[k];
-                s.torque[k] += torque[k];
-            }
-        }
+        add_reaction(body_.x.data(), *c.collider, p);
         if (!(p.depth > 0.0)) return;  // friction kept through a step on a contact that came off
         if (!excess) ++s.contact_count;
         s.max_depth = std::max(s.max_depth, p.depth);
@@ -56,7 +65,19 @@ int32_t BodyContacts::accumulate_reactions() {
     close_regions();
     region_collider = nullptr;
     evaluate_friction(body_.v.data(), accumulate);
+    add_node_friction_reactions();
     return count;
+}
+
+void BodyContacts::add_node_friction_reactions() {
+    if (implicit_step()) return;  // their friction is lagged_friction's, in accumulate_reactions
+    const double* x = body_.x.data();
+    for_each_node_push(x, body_.v.data(), [&](Collider& collider, int32_t node, const double* push) {
+        if (!(collider.params.static_friction > 0.0 && norm3(push) > 0.0)) return;
+        ContactPoint p = node_friction_point(collider, node, push, x, body_.v.data());
+        apply_friction(collider.params, p.friction_normal, p);
+        add_reaction(x, collider, p);
+    });
 }
 
 void BodyContacts::mark_nodes_of_other_contacts(const Collider* except, uint8_t* marks) const {

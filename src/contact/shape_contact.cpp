@@ -234,6 +234,24 @@ FrictionRecord friction_record(const ContactPoint& p, const sh_contact_params& p
     return r;
 }
 
+ContactPoint node_friction_point(const Collider& collider, int32_t node, const double push[3], const double* x,
+                                 const double* v) {
+    ContactPoint p{};
+    p.count = 1;
+    p.nodes[0] = node;
+    p.weights[0] = 1.0;
+    p.law_scale = 1.0;
+    const double fn = norm3(push);
+    for (int k = 0; k < 3; ++k) {
+        p.point[k] = at(x, node)[k];
+        p.normal[k] = fn > 0.0 ? push[k] / fn : 0.0;
+        p.gradient[0][k] = p.normal[k];
+    }
+    velocity_against_collider(collider, p, v, p.relative_velocity);
+    p.friction_normal = fn;
+    return p;
+}
+
 void apply_implicit_friction(const FrictionRecord& r, const double* inverse_mass, double h, double* x, double* v,
                              double impulse[3]) {
     if (impulse) impulse[0] = impulse[1] = impulse[2] = 0.0;

@@ -92,6 +92,15 @@ struct FrictionRecord {
 /// The record of contact p (law params) at velocities v.
 FrictionRecord friction_record(const ContactPoint& p, const sh_contact_params& params, const double* v);
 
+/// The friction contact of surface node `node` (positions x, velocities v) against collider:
+/// a point of weight 1 at the node, its normal along push and its friction_normal |push| (N),
+/// push the net force of all the collider's contact terms on the node; no friction force yet
+/// (apply_friction). Friction is taken per node, not per term: a node's own, edge and face
+/// terms push along different normals, and friction per term would resist its motion across
+/// all their tangent planes, separation from the tool included.
+ContactPoint node_friction_point(const Collider& collider, int32_t node, const double push[3], const double* x,
+                                 const double* v);
+
 /// Backward-Euler friction of record r over a step of h (s) on velocities v (and, when x is
 /// not null, the positions the step reached with them), nodes of inverse masses inverse_mass:
 /// the contact's tangential velocity ends at implicit_slip_speed's. Stable at any step: a

@@ -230,10 +230,8 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
 }
 
 void HapticContext::record_node_friction(const Buffer& b, const double* x, const double* v) {
-    // Friction per surface node, against the net push of all the terms on it: each term's own
-    // normal differs (a node's, an edge's and a face's maximiser look different ways), and
-    // friction taken per term would stop a node's motion across all of their tangent planes,
-    // normal separation included, as if it stuck to the tool.
+    // Friction per surface node, against the net push of all the terms on it (see
+    // node_friction_point).
     friction_count_ = 0;
     const sh_contact_params& law = tool_.params;
     if (!(law.static_friction > 0.0)) return;
@@ -246,17 +244,7 @@ void HapticContext::record_node_friction(const Buffer& b, const double* x, const
             step_warnings_ |= 1u << SH_WARN_CAPACITY;
             return;
         }
-        ContactPoint p{};
-        p.count = 1;
-        p.nodes[0] = node;
-        p.weights[0] = 1.0;
-        for (int k = 0; k < 3; ++k) {
-            p.point[k] = at(x, node)[k];
-            p.normal[k] = push[k] / fn;
-        }
-        velocity_against_collider(tool_, p, v, p.relative_velocity);
-        p.friction_normal = fn;
-        friction_[friction_count_++] = friction_record(p, law, v);
+        friction_[friction_count_++] = friction_record(node_friction_point(tool_, node, push, x, v), law, v);
     }
 }
 

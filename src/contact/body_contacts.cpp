@@ -65,14 +65,6 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
     const sh_contact_params& p = *c.params;
     double vrel[3] = {0.0, 0.0, 0.0};  // velocity of the node side relative to the other side
     out.law_scale = 1.0;
-    auto set_nodes = [&](int count, const int32_t* nodes, const double* weights) {
-        out.count = count;
-        for (int a = 0; a < count; ++a) {
-            out.nodes[a] = nodes[a];
-            out.weights[a] = weights[a];
-            for (int k = 0; k < 3; ++k) out.gradient[a][k] = weights[a] * out.normal[k];
-        }
-    };
     const double one = 1.0;
     switch (c.kind) {
         case ContactCandidate::kNodeShape:
@@ -101,11 +93,11 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
                 return false;
             for (int k = 0; k < 3; ++k) out.point[k] = at(xn, c.node)[k];
             if (own_node) {
-                set_nodes(1, &c.node, &one);
+                set_contact_nodes(1, &c.node, &one, out);
                 for (int k = 0; k < 3; ++k) out.other_weights[k] = -w[k];
             } else {
                 const double far_side[3] = {-w[0], -w[1], -w[2]};
-                set_nodes(3, c.face, far_side);
+                set_contact_nodes(3, c.face, far_side, out);
             }
             if (v) {
                 const double* vn = own_node ? v : c.other->v.data();

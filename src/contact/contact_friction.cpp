@@ -53,19 +53,13 @@ bool BodyContacts::lagged_friction(const ContactCandidate& c, const double* v, C
             break;
     }
     out.depth = 0.0;
-    out.count = count;
     for (int k = 0; k < 3; ++k) {
         out.normal[k] = r.lag_normal[k];
         out.point[k] = r.lag_point[k];
     }
-    for (int a = 0; a < count; ++a) {
-        out.nodes[a] = nodes[a];
-        out.weights[a] = weights[a];
-        for (int k = 0; k < 3; ++k) {
-            out.gradient[a][k] = weights[a] * out.normal[k];
-            vrel[k] += weights[a] * at(v, nodes[a])[k];
-        }
-    }
+    set_contact_nodes(count, nodes, weights, out);
+    for (int a = 0; a < count; ++a)
+        for (int k = 0; k < 3; ++k) vrel[k] += weights[a] * at(v, nodes[a])[k];
     out.stiffness = out.damping = out.normal_force = 0.0;
     out.law_scale = 1.0;
     out.friction_normal = c.friction_normal;

@@ -11,19 +11,13 @@ namespace {
 
 void set_geometry(const Penetration& pen, int count, const int32_t* nodes, const double* weights, ContactPoint& out) {
     out.depth = pen.depth;
-    out.count = count;
     out.law_scale = 1.0;
     for (int k = 0; k < 3; ++k) {
         out.normal[k] = pen.normal[k];
         out.point[k] = pen.point[k];
     }
-    for (int a = 0; a < count; ++a) {
-        out.nodes[a] = nodes[a];
-        out.weights[a] = weights[a];
-        for (int k = 0; k < 3; ++k) out.gradient[a][k] = weights[a] * out.normal[k];
-    }
+    set_contact_nodes(count, nodes, weights, out);
 }
-
 
 }  // namespace
 
@@ -216,6 +210,15 @@ void apply_friction(const sh_contact_params& p, double friction_normal, ContactP
         for (int k = 0; k < 3; ++k) out.node_force[a][k] += out.weights[a] * ft[k];
 }
 
+void set_contact_nodes(int count, const int32_t* nodes, const double* weights, ContactPoint& out) {
+    out.count = count;
+    for (int a = 0; a < count; ++a) {
+        out.nodes[a] = nodes[a];
+        out.weights[a] = weights[a];
+        for (int k = 0; k < 3; ++k) out.gradient[a][k] = weights[a] * out.normal[k];
+    }
+}
+
 FrictionRecord friction_record(const ContactPoint& p, const sh_contact_params& params, const double* v) {
     FrictionRecord r;
     r.count = p.count;
@@ -237,16 +240,13 @@ FrictionRecord friction_record(const ContactPoint& p, const sh_contact_params& p
 ContactPoint node_friction_point(const Collider& collider, int32_t node, const double push[3], const double* x,
                                  const double* v) {
     ContactPoint p{};
-    p.count = 1;
-    p.nodes[0] = node;
-    p.weights[0] = 1.0;
     p.law_scale = 1.0;
-    const double fn = norm3(push);
+    const double fn = norm3(push), one = 1.0;
     for (int k = 0; k < 3; ++k) {
         p.point[k] = at(x, node)[k];
         p.normal[k] = fn > 0.0 ? push[k] / fn : 0.0;
-        p.gradient[0][k] = p.normal[k];
     }
+    set_contact_nodes(1, &node, &one, p);
     velocity_against_collider(collider, p, v, p.relative_velocity);
     p.friction_normal = fn;
     return p;

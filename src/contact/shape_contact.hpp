@@ -15,6 +15,10 @@
 
 namespace sh {
 
+/// Sets out's count nodes with their shares weights, and their depth gradients weights[a]
+/// times out.normal (which must be set).
+void set_contact_nodes(int count, const int32_t* nodes, const double* weights, ContactPoint& out);
+
 /// Node `node` (positions x) inside the collider: fills out's depth, normal, point and one
 /// node of weight 1. False if it does not touch.
 bool node_shape_contact(const Collider& collider, const double* x, int32_t node, ContactPoint& out);

@@ -185,12 +185,10 @@ double BodyContacts::stable_step(const double* x, const double* v, const double*
                           c.kind == ContactCandidate::kEdgeShape;
         const int count = point ? point->count : c.kind == ContactCandidate::kEdgeShape ? 2 : face ? 3 : 1;
         const NormalForce fn = hunt_crossley(*c.params, (point ? point->depth : 0.0) + anticipated_depth, 0.0);
-        double row = 0.0;
-        for (int b = 0; point && b < count; ++b) row += std::sqrt(dot3(point->gradient[b], point->gradient[b]));
         for (int a = 0; a < count; ++a) {
             const int32_t node = point ? point->nodes[a] : face ? c.face[a] : c.node;
             if (!body_.is_free(node)) continue;
-            const double share = point ? std::sqrt(dot3(point->gradient[a], point->gradient[a])) * row : 1.0;
+            const double share = point ? stiffness_share(*point, a) : 1.0;
             step = std::min(step, damped_stable_step(share * fn.stiffness, share * fn.damping, mass[node]));
         }
     });

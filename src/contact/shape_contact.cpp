@@ -210,6 +210,12 @@ void apply_friction(const sh_contact_params& p, double friction_normal, ContactP
         for (int k = 0; k < 3; ++k) out.node_force[a][k] += out.weights[a] * ft[k];
 }
 
+double stiffness_share(const ContactPoint& p, int a) {
+    double row = 0.0;
+    for (int b = 0; b < p.count; ++b) row += norm3(p.gradient[b]);
+    return norm3(p.gradient[a]) * row;
+}
+
 void set_contact_nodes(int count, const int32_t* nodes, const double* weights, ContactPoint& out) {
     out.count = count;
     for (int a = 0; a < count; ++a) {

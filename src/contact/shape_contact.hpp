@@ -15,6 +15,10 @@
 
 namespace sh {
 
+/// The share of node a's row in contact p's stiffness k g g^T, per unit k: |g_a| sum_b |g_b|
+/// (Gershgorin's bound on the row), for the stable step of an explicit integrator.
+double stiffness_share(const ContactPoint& p, int a);
+
 /// Sets out's count nodes with their shares weights, and their depth gradients weights[a]
 /// times out.normal (which must be set).
 void set_contact_nodes(int count, const int32_t* nodes, const double* weights, ContactPoint& out);

@@ -308,7 +308,7 @@ typedef struct sh_implicit_settings {
                                          iterations towards the step's minimiser */
     double newton_tolerance;        /**< stop when the residual |g| <= tol max(|g_0|, dt |f|)
                                          (f: f_ext + m g and the push of tools and other
-                                         bodies at the step's start) or the velocity correction
+                                         bodies at its first iterate) or the velocity correction
                                          <= tol max(|v|, dt |g|, 1e-9 m/s); at the iteration
                                          cap (creeping over friction and contact kinks), a last
                                          correction <= tol L / dt is accepted too, L the bodies'

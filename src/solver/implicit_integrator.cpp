@@ -15,7 +15,6 @@ namespace {
 // Speeds below this (m/s) count as rest when judging a Newton correction negligible.
 constexpr double kSpeedFloor = 1e-9;
 
-
 // An update solved with a kept factorisation is kept only if it cuts the residual at least by
 // this factor (chord iterations slower than this cost more solves than a new factorisation is
 // worth), and one factorisation serves at most kMaxStaleSolves such solves in a step.
@@ -159,7 +158,7 @@ public:
 
 private:
     void begin();
-    static double field_push_squared(Body& body, const ImplicitState& state);
+    double extent() const;
     void evaluate();
     double assemble_member(Body& body, ImplicitState& state);
     bool factorize_and_solve(bool& failed);
@@ -187,8 +186,8 @@ private:
     double r_ = 0.0, r_max_ = 0.0; // residual norms (2 and max) at the current iterate
     double largest_change_ = 0.0, largest_speed_ = 0.0;  // of the last update taken
     double energy0_ = 0.0, energy_scale0_ = 0.0;  // mechanical energy at the start, its scale
-    double field_push_ = 0.0;  // norm of the fields' push at the start (N)
-    double extent_ = 0.0;      // diagonal of the bodies' bounding box at the start (m)
+    double field_push_ = 0.0;  // norm of the fields' push at the first iterate (N)
+    bool first_evaluation_ = true;  // the next evaluate() is the step's first: it measures field_push_
     bool work_done_ = false;  // moving tools, other bodies or prescribed nodes work on the bodies
     bool energy_checked_ = false;  // the final iterate passed the linearised energy check
 };
@@ -219,42 +218,35 @@ bool NewtonStep::energy_rose(double fraction) const {
     return !std::isfinite(energy) || energy - energy0_ > fraction * energy_scale0_ + 1e-12;
 }
 
-// The squared norm of the push of body's field (its colliders and the bodies it touches) on
-// its free DOFs at the step's start, at rest (N^2).
-double NewtonStep::field_push_squared(Body& body, const ImplicitState& state) {
-    if (!body.field) return 0.0;
-    vec<double>& push = body.workspace.a[3];
-    push.assign(body.x.size(), 0.0);
-    body.field->add_forces(body.workspace.x0.data(), nullptr, push.data());
-    double sum = 0.0;
-    for (const int32_t j : state.system.dof_to_global()) sum += push[static_cast<size_t>(j)] * push[static_cast<size_t>(j)];
-    return sum;
+// Diagonal of the bodies' bounding box at the current iterate (m).
+double NewtonStep::extent() const {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    group_.each([&](const Body& body, const ImplicitState&, size_t) {
+        for (size_t j = 0; j < body.x.size(); ++j) {
+            lo[j % 3] = std::min(lo[j % 3], body.x[j]);
+            hi[j % 3] = std::max(hi[j % 3], body.x[j]);
+        }
+    });
+    if (!(hi[0] >= lo[0])) return 0.0;
+    const double d[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 }
 
 void NewtonStep::begin() {
     work_done_ = false;
     energy_checked_ = false;
-    double push2 = 0.0, lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    group_.each([&](Body& body, ImplicitState& state, size_t) {
-        for (size_t j = 0; j < body.x.size(); ++j) {
-            lo[j % 3] = std::min(lo[j % 3], body.x[j]);
-            hi[j % 3] = std::max(hi[j % 3], body.x[j]);
-        }
+    first_evaluation_ = true;
+    group_.each([&](Body& body, ImplicitState&, size_t) {
         save_start_state(body);
         begin_kinematic_motion(body, dt_);
         for (size_t j = 0; j < body.v.size() && !work_done_; ++j) work_done_ = body.kinematic[j / 3] && body.v[j] != 0.0;
         work_done_ = work_done_ || (body.field && body.field->does_work());
-        push2 += field_push_squared(body, state);
         // The internal damping's lagged base: elastic forces at the start state.
         if (!body.has_internal_damping()) return;
         vec<double>& base = body.workspace.a[1];
         std::fill(base.begin(), base.end(), 0.0);
         body.add_internal_forces(body.workspace.x0.data(), nullptr, base.data());
     });
-    field_push_ = std::sqrt(push2);
-    extent_ = hi[0] >= lo[0] ? std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                         (hi[2] - lo[2]) * (hi[2] - lo[2]))
-                             : 0.0;
     if (!work_done_) energy0_ = mechanical_energy(true, energy_scale0_);
     reuse_ = s_.factor_reuse > 0.0 && ns_.solver->is_direct();
     matrix_version_ = group_.matrix_version();
@@ -270,11 +262,15 @@ void NewtonStep::evaluate() {
         for (size_t j = 0; j < body.x.size(); ++j) body.x[j] = body.workspace.x0[j] + h * body.v[j];
     });
     Potential phi;
-    double sum2 = 0.0;
+    double sum2 = 0.0, push2 = 0.0;
     r_max_ = 0.0;
     group_.each([&](Body& body, ImplicitState& state, size_t offset) {
         double* f = body.workspace.a[0].data();
         std::fill(f, f + body.x.size(), 0.0);
+        // The field first: the step's first evaluation measures its push (iterate()).
+        if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
+        if (first_evaluation_)
+            for (const int32_t j : state.system.dof_to_global()) push2 += f[static_cast<size_t>(j)] * f[static_cast<size_t>(j)];
         body.add_internal_forces(body.x.data(), nullptr, f);
         double* damping = nullptr;  // -D0 v, the lagged internal damping force
         if (body.has_internal_damping()) {
@@ -284,7 +280,6 @@ void NewtonStep::evaluate() {
             const double* base = body.workspace.a[1].data();
             for (size_t j = 0; j < body.x.size(); ++j) damping[j] -= base[j];
         }
-        if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
         const double elastic = body.elastic_energy(body.x.data());
         const double field = body.field ? body.field->energy(body.x.data()) + h * body.field->dissipation(body.v.data()) : 0.0;
         phi.value += elastic + field;
@@ -308,6 +303,8 @@ void NewtonStep::evaluate() {
     });
     r_ = std::sqrt(sum2);
     phi_ = phi;
+    if (first_evaluation_) field_push_ = std::sqrt(push2);
+    first_evaluation_ = false;
 }
 
 // m (1 + dt c) + dt D + dt^2 K of one body into its own system; its force round-off.
@@ -424,7 +421,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
     int max_iterations = std::max(in_contact ? kContactNewtonIterations : 1, s_.newton_max_iterations);
     bool linearised = max_iterations == 1;
     // The residual's scale: the first one, or the impulse of the loads over the step, the
-    // field's push counted with f_ext. A body held still against a tool balances that push:
+    // field's push at the first iterate counted with f_ext. A body held still against a tool balances that push:
     // relative to the tiny residual of a step that starts at rest, the tolerance would sit
     // below what the contact's and friction's kinks let Newton reach.
     const double loads = std::hypot(group_.applied_load_norm(g_), field_push_);
@@ -446,7 +443,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
         // where the speeds above vanish): its last correction is negligible if it is tol of
         // the bodies' size per step.
         if (iteration == max_iterations)
-            return towards_minimiser || largest_change_ <= s_.newton_tolerance * extent_ / dt_;
+            return towards_minimiser || largest_change_ <= s_.newton_tolerance * extent() / dt_;
         bool failed = false;
         if (!factorize_and_solve(failed)) {
             solver_failed = true;

@@ -138,16 +138,16 @@ void BodyContacts::add_forces(const double* x, const double* v, double* f) const
             for (int k = 0; k < 3; ++k)
                 f[3 * static_cast<size_t>(p.nodes[a]) + k] += normal_only ? p.normal_force * p.gradient[a][k] : p.node_force[a][k];
     };
-    evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
+    const auto add_point = [&](const ContactCandidate& c, const ContactPoint& p) {
         const bool friction = explicit_friction && p.friction_normal > 0.0;
         add(p, friction);
         if (friction && record) friction_records_.push_back(friction_record(p, *c.params, v));
-    });
-    if (explicit_friction && record)
-        for_each_node_push(x, v, [&](const Collider& collider, int32_t node, const double* push) {
-            if (collider.params.static_friction > 0.0 && norm3(push) > 0.0)
-                friction_records_.push_back(friction_record(node_friction_point(collider, node, push, x, v), collider.params, v));
-        });
+    };
+    const auto record_node = [&](const Collider& collider, int32_t node, const double* push) {
+        if (collider.params.static_friction > 0.0 && norm3(push) > 0.0)
+            friction_records_.push_back(friction_record(node_friction_point(collider, node, push, x, v), collider.params, v));
+    };
+    evaluate_with_node_pushes(x, v, explicit_friction && record, add_point, record_node);
     evaluate_friction(v, [&](const ContactCandidate& c, const ContactPoint& p) {
         record_friction_iterate(c, &p);
         add(p, false);

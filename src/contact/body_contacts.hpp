@@ -161,13 +161,12 @@ private:
     /// Calls emit(node, push) for each node with a net push since the last call, and clears it.
     template <class Emit>
     void drain_node_pushes(Emit&& emit) const;
-    /// Calls emit(collider, node, push) for each surface node a collider's terms push at (x, v):
-    /// their net force on it (N).
-    template <class Emit>
-    void for_each_node_push(const double* x, const double* v, Emit&& emit) const;
-    /// Explicit bodies: adds to each collider's state the reaction of its friction per node
-    /// (Coulomb's law on the nodes' net push at the body's state).
-    void add_node_friction_reactions();
+    /// evaluate, calling on_point(candidate, point) for each contact and, with pushes, after
+    /// each collider's candidates on_node(collider, node, push) for each surface node its terms
+    /// push: their net force on it (N).
+    template <class OnPoint, class OnNode>
+    void evaluate_with_node_pushes(const double* x, const double* v, bool pushes, OnPoint&& on_point,
+                                   OnNode&& on_node) const;
     /// Calls visit(candidate) for each kNodeFace candidate against other whose node has
     /// own_index >= 0.
     template <class Visit>

@@ -53,14 +53,16 @@ void BodyContacts::drain_node_pushes(Emit&& emit) const {
     pushed_nodes_.clear();
 }
 
-template <class Emit>
-void BodyContacts::for_each_node_push(const double* x, const double* v, Emit&& emit) const {
+template <class OnPoint, class OnNode>
+void BodyContacts::evaluate_with_node_pushes(const double* x, const double* v, bool pushes, OnPoint&& on_point,
+                                             OnNode&& on_node) const {
     Collider* pushing = nullptr;
     const auto drain = [&]() {
-        drain_node_pushes([&](int32_t node, const double* push) { emit(*pushing, node, push); });
+        drain_node_pushes([&](int32_t node, const double* push) { on_node(*pushing, node, push); });
     };
     evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
-        if (!c.collider) return;
+        on_point(c, p);
+        if (!pushes || !c.collider) return;
         if (c.collider != pushing) {  // candidates come collider by collider
             if (pushing) drain();
             pushing = c.collider;

@@ -61,23 +61,21 @@ int32_t BodyContacts::accumulate_reactions() {
         s.max_depth = std::max(s.max_depth, p.depth);
         if (c.kind == ContactCandidate::kNodeShape) s.penetration_volume += p.depth * node_area_[static_cast<size_t>(c.node)];
     };
-    evaluate(body_.x.data(), body_.v.data(), accumulate);
-    close_regions();
-    region_collider = nullptr;
-    evaluate_friction(body_.v.data(), accumulate);
-    add_node_friction_reactions();
-    return count;
-}
-
-void BodyContacts::add_node_friction_reactions() {
-    if (implicit_step()) return;  // their friction is lagged_friction's, in accumulate_reactions
+    // Explicit bodies' friction against a collider acts per node (add_forces): its reaction is
+    // Coulomb's law on each node's net push at the body's state. Implicit bodies' is their
+    // lagged friction (evaluate_friction).
     const double* x = body_.x.data();
-    for_each_node_push(x, body_.v.data(), [&](Collider& collider, int32_t node, const double* push) {
+    const auto node_friction = [&](Collider& collider, int32_t node, const double* push) {
         if (!(collider.params.static_friction > 0.0 && norm3(push) > 0.0)) return;
         ContactPoint p = node_friction_point(collider, node, push, x, body_.v.data());
         apply_friction(collider.params, p.friction_normal, p);
         add_reaction(x, collider, p);
-    });
+    };
+    evaluate_with_node_pushes(x, body_.v.data(), !implicit_step(), accumulate, node_friction);
+    close_regions();
+    region_collider = nullptr;
+    evaluate_friction(body_.v.data(), accumulate);
+    return count;
 }
 
 void BodyContacts::mark_nodes_of_other_contacts(const Collider* except, uint8_t* marks) const {

@@ -14,7 +14,6 @@
 namespace sh {
 namespace {
 
-
 // The tool's nearest FEM surface: which body, which triangle, the point and the distance.
 struct NearestSurface {
     sh_body_id body = 0;

@@ -25,7 +25,6 @@ constexpr double kSafety = 0.9;
 // A step longer than this is not a haptic step (s).
 constexpr double kLongestStep = 1.0;
 
-
 bool boxes_overlap(const double lo[3], const double hi[3], const double* a, const double* b, const double* c) {
     for (int k = 0; k < 3; ++k) {
         const double t_lo = std::min({a[k], b[k], c[k]}), t_hi = std::max({a[k], b[k], c[k]});

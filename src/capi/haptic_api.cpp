@@ -65,10 +65,10 @@ SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_
         sh_haptic* handle = nullptr;
         try {
             handle = sh::create<sh_haptic>(sh_haptic{context, kLive});
-            w.add_haptic(context);
+            w.add_hook(context);
             capi::register_handle(capi::HandleKind::Haptic, handle);
         } catch (...) {
-            w.remove_haptic(context);
+            w.remove_hook(context);
             sh::destroy(handle);
             sh::destroy(context);
             throw;
@@ -82,7 +82,7 @@ SH_API sh_status sh_haptic_destroy(sh_haptic* haptic) {
         if (!haptic) return;
         if (!capi::unregister_handle(capi::HandleKind::Haptic, haptic))
             throw Error(SH_ERR_INVALID_HANDLE, "haptic is not a live object (destroyed twice or never created)");
-        if (World* w = haptic->context->world()) w->remove_haptic(haptic->context);
+        if (World* w = haptic->context->world()) w->remove_hook(haptic->context);
         haptic->magic = 0;
         sh::destroy(haptic->context);
         sh::destroy(haptic);

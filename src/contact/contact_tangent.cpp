@@ -5,7 +5,7 @@
 #include "contact/body_contacts_eval.hpp"
 #include "core/clock.hpp"
 #include "core/vec3.hpp"
-#include "solver/sparse_system.hpp"
+#include "linalg/sparse_system.hpp"
 
 #include <algorithm>
 #include <cmath>

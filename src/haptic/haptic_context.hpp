@@ -10,6 +10,7 @@
 #include "haptic/buffer.hpp"
 #include "haptic/force_filter.hpp"
 #include "haptic/triple_buffer.hpp"
+#include "world/step_hook.hpp"
 
 #include <softhap/softhap.h>
 
@@ -26,8 +27,8 @@ class World;
 /// Validates def's fields (messages name them as def->field).
 void validate_haptic_def(const sh_haptic_def& def);
 
-/// One tool's haptic context.
-class HapticContext {
+/// One tool's haptic context; the world calls it around each full step.
+class HapticContext final : public StepHook {
 public:
     /// Bytes of the arena a context made from (validated) def holds.
     static size_t memory_bytes(const sh_haptic_def& def);
@@ -35,20 +36,20 @@ public:
     /// Validates def against world (a live sphere, capsule or box tool), allocates the arena
     /// and extracts the first buffer. Does not register with world.
     HapticContext(World& world, const sh_haptic_def& def);
-    ~HapticContext();
+    ~HapticContext() override;
     HapticContext(const HapticContext&) = delete;
     HapticContext& operator=(const HapticContext&) = delete;
 
     // --- sim side ---------------------------------------------------------------------------
 
     /// Moves the tool to the newest device pose and keeps the buffer body's start state.
-    void before_step(World& world);
+    void before_step(World& world) override;
 
     /// Cuts a new buffer from the full model after a step of dt (s) and publishes it.
-    void after_step(World& world, double dt);
+    void after_step(World& world, double dt) override;
 
     /// The world is gone: from now on the haptic step reports SH_HAPTIC_FAULT_NO_TOOL.
-    void detach();
+    void detach() override;
 
     /// The world it serves (null once detached).
     World* world() const { return world_; }

@@ -6,7 +6,7 @@
 
 #include "material/material_params.hpp"
 #include "material/tet_materials.hpp"
-#include "solver/sparse_system.hpp"
+#include "linalg/sparse_system.hpp"
 
 #include <Eigen/Dense>
 

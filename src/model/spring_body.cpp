@@ -1,7 +1,7 @@
 #include "model/spring_body.hpp"
 
 #include "core/error.hpp"
-#include "solver/sparse_system.hpp"
+#include "linalg/sparse_system.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -9,8 +9,8 @@
 
 #include "model/body.hpp"
 #include "solver/explicit_integrator.hpp"
-#include "solver/linear_solver.hpp"
-#include "solver/sparse_system.hpp"
+#include "linalg/linear_solver.hpp"
+#include "linalg/sparse_system.hpp"
 
 namespace sh {
 

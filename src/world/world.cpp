@@ -5,7 +5,6 @@
 #include "contact/collider.hpp"
 #include "core/clock.hpp"
 #include "core/error.hpp"
-#include "haptic/haptic_context.hpp"
 #include "solver/explicit_integrator.hpp"
 #include "solver/implicit_integrator.hpp"
 #include "solver/static_solver.hpp"
@@ -45,7 +44,7 @@ World::World(const sh_world_def& def) : error_estimate_(def.error_estimate != 0)
 }
 
 World::~World() {
-    for (HapticContext* haptic : haptics_) haptic->detach();
+    for (StepHook* hook : hooks_) hook->detach();
     for (Slot& slot : slots_) destroy_slot(slot);
     for (ColliderSlot& c : colliders_) sh::destroy(c.collider);
     sh::destroy(islands_);
@@ -195,11 +194,9 @@ void World::set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params
 
 const BodyContacts* World::contacts_of(sh_body_id id) const { return is_valid(id) ? slots_[slot_of(id)].contacts : nullptr; }
 
-void World::add_haptic(HapticContext* haptic) { haptics_.push_back(haptic); }
+void World::add_hook(StepHook* hook) { hooks_.push_back(hook); }
 
-void World::remove_haptic(HapticContext* haptic) {
-    haptics_.erase(std::remove(haptics_.begin(), haptics_.end(), haptic), haptics_.end());
-}
+void World::remove_hook(StepHook* hook) { hooks_.erase(std::remove(hooks_.begin(), hooks_.end(), hook), hooks_.end()); }
 
 void World::step_bodies(double h, sh_step_report& r, vec<uint8_t>& skip) {
     // Implicit bodies pressing on each other are stepped together, island by island.
@@ -320,7 +317,7 @@ void World::step(double dt, sh_step_report* report) {
     r.substeps = 1;
     r.error_estimate = error_estimate_ ? 0.0 : -1.0;
     r.dt_critical = INFINITY;
-    for (HapticContext* haptic : haptics_) haptic->before_step(*this);
+    for (StepHook* hook : hooks_) hook->before_step(*this);
     r.contact_substeps = begin_colliders(dt);
     try {
         run_attempts(dt, r);
@@ -338,7 +335,7 @@ void World::step(double dt, sh_step_report* report) {
             if (slot.contacts) r.collision_seconds += slot.contacts->take_evaluation_seconds();
         if (r.warnings & (1u << SH_WARN_CAPACITY)) ++warnings[SH_WARN_CAPACITY];
     }
-    for (HapticContext* haptic : haptics_) haptic->after_step(*this, dt);
+    for (StepHook* hook : hooks_) hook->after_step(*this, dt);
     const Slot* failed = nullptr;
     for (const Slot& slot : slots_)
         if (slot.body && slot.failed) {
@@ -479,7 +476,7 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
     sh_static_report r{};
     for (Slot& slot : slots_)
         if (slot.body) save_start_state(*slot.body);
-    for (HapticContext* haptic : haptics_) haptic->before_step(*this);
+    for (StepHook* hook : hooks_) hook->before_step(*this);
     try {
         if (has_contact()) {
             // Tools rest at their host-set poses; candidates reach as far as the tool's size,
@@ -522,8 +519,8 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
         throw;
     }
     r.converged = 1;
-    // The haptic contexts take up the equilibrium at once (no step to move across).
-    for (HapticContext* haptic : haptics_) haptic->after_step(*this, 0.0);
+    // The hooks take up the equilibrium at once (no step to move across).
+    for (StepHook* hook : hooks_) hook->after_step(*this, 0.0);
     r.wall_seconds = now_seconds() - start;
     if (report) *report = r;
 }

@@ -4,6 +4,7 @@
 #include "core/memory.hpp"
 #include "model/body.hpp"
 #include "solver/explicit_integrator.hpp"
+#include "world/step_hook.hpp"
 
 #include <softhap/softhap.h>
 
@@ -13,7 +14,6 @@ namespace sh {
 
 class BodyContacts;
 class ContactIslands;
-class HapticContext;
 struct Collider;
 struct ImplicitState;
 struct StepDoubling;
@@ -62,12 +62,12 @@ public:
     /// body is restored and the error rethrown.
     void solve_static(const sh_static_def& def, sh_static_report* report);
 
-    /// Registers a haptic context: each step then takes its device pose first and refreshes
-    /// its buffer last. The context is told (detach) if the world goes first.
-    void add_haptic(HapticContext* haptic);
+    /// Registers a step hook (a haptic context takes its device pose before each step and
+    /// refreshes its buffer after). The hook is told (detach) if the world goes first.
+    void add_hook(StepHook* hook);
 
-    /// Unregisters a haptic context.
-    void remove_haptic(HapticContext* haptic);
+    /// Unregisters a step hook.
+    void remove_hook(StepHook* hook);
 
     /// The contact state of body id after the last step, or null if it has none yet.
     const BodyContacts* contacts_of(sh_body_id id) const;
@@ -146,7 +146,7 @@ private:
     vec<BodyPair> pairs_;
     vec<uint8_t> skip_;  ///< per slot: sits out the current attempt
     ContactIslands* islands_ = nullptr;  ///< built on the first step with body pairs
-    vec<HapticContext*> haptics_;
+    vec<StepHook*> hooks_;
     bool error_estimate_ = false;
     sh_body_id id_of(size_t index) const;
     vec<Slot> slots_;

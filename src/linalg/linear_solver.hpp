@@ -4,7 +4,7 @@
 #pragma once
 
 #include "core/memory.hpp"
-#include "solver/sparse_system.hpp"
+#include "linalg/sparse_system.hpp"
 
 #include <memory>
 

@@ -1,4 +1,4 @@
-#include "solver/sparse_system.hpp"
+#include "linalg/sparse_system.hpp"
 
 #include "core/error.hpp"
 

@@ -8,7 +8,7 @@
 // (OpenBLAS is about 2.5x faster there than the reference BLAS).
 #if SOFTHAP_WITH_CHOLMOD
 
-#include "solver/linear_solver.hpp"
+#include "linalg/linear_solver.hpp"
 
 #include "core/error.hpp"
 

@@ -1,7 +1,7 @@
 // Eigen backends: simplicial LDL^T (AMD ordering, symbolic analysis reused) and conjugate
 // gradient with a Jacobi preconditioner and warm start. Both read the SparseSystem's
 // upper-triangle CSC arrays in place through an Eigen::Map (no copy of the system).
-#include "solver/linear_solver.hpp"
+#include "linalg/linear_solver.hpp"
 
 #include "core/error.hpp"
 

@@ -2,6 +2,7 @@
 #include "capi/guard.hpp"
 #include "capi/world_handle.hpp"
 #include "material/material_params.hpp"
+#include "mesh/io/mesh_io.hpp"
 #include "model/fem_body.hpp"
 
 #include <algorithm>
@@ -202,7 +203,15 @@ SH_API sh_status sh_body_write_vtu(const sh_world* world, sh_body_id body, const
     return capi::guard([&] {
         const Body& b = body_of(world, body);
         capi::require_pointer(path, "path");
-        b.write_vtu(path);
+        VtuFrame frame;
+        frame.points = b.x.data();
+        frame.point_count = b.node_count();
+        frame.cells = b.element_nodes();
+        frame.cell_count = b.element_count();
+        frame.nodes_per_cell = b.nodes_per_element();
+        frame.point_vectors = b.v.data();
+        frame.point_vectors_name = "velocity";
+        write_vtu(path, frame);
     });
 }
 

@@ -2,8 +2,6 @@
 
 #include "model/external_field.hpp"
 
-#include "mesh/io/mesh_io.hpp"
-
 #include <algorithm>
 #include <cmath>
 
@@ -38,18 +36,6 @@ void Body::set_node_damping(const double* coefficients) {
     else
         node_damping = vec<double>();
     ++matrix_version;
-}
-
-void Body::write_vtu(const std::string& path) const {
-    VtuFrame frame;
-    frame.points = x.data();
-    frame.point_count = node_count();
-    frame.cells = element_nodes();
-    frame.cell_count = element_count();
-    frame.nodes_per_cell = nodes_per_element();
-    frame.point_vectors = v.data();
-    frame.point_vectors_name = "velocity";
-    sh::write_vtu(path, frame);
 }
 
 double Body::critical_dt() const {

@@ -7,7 +7,6 @@
 #include <softhap/softhap.h>
 
 #include <cstdint>
-#include <string>
 
 namespace sh {
 
@@ -77,9 +76,6 @@ public:
 
     /// Starts a new count for inverted_elements (at the start of each step).
     virtual void clear_inverted_elements() {}
-
-    /// Writes the current shape (element cells, velocity point data) as .vtu.
-    void write_vtu(const std::string& path) const;
 
     /// Critical step of this body's integrator at the current state (s).
     double critical_dt() const;

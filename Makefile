@@ -4,7 +4,7 @@ PYTHON ?= python3
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-c test-python test-reduced demo palpation haptic-loop tsan bench report report-deps haptic-report press-report clean
+.PHONY: all deps build test test-c test-python test-reduced demo palpation haptic-loop tsan asan fuzz bench report report-deps haptic-report press-report clean
 
 all: build
 
@@ -61,6 +61,46 @@ tsan: deps
 	TSAN_OPTIONS="halt_on_error=1 $(TSAN_OPTIONS)" OMP_THREAD_LIMIT=1 SOFTHAP_HAPTIC_STEPS=$(TSAN_HAPTIC_STEPS) \
 	  $(TSAN_BUILD)/tests/test_haptic
 
+# AddressSanitizer + UBSan build (build-asan, SOFTHAP_SANITIZE) of the library and the cmocka tests:
+# every ctest test, then the whole pytest suite against the sanitized library. Any report fails:
+# ASan stops at its first error, UBSan too (-fno-sanitize-recover=undefined; halt_on_error for
+# what else it checks), LeakSanitizer fails a C test that leaks. The Python interpreter is not
+# built with ASan, so the runtime the library links is preloaded into it, with leak detection off
+# there (the interpreter keeps its objects until exit by design); the C programs some Python tests
+# compile inherit both. pytest captures sys.stdout/err only (--capture=sys), so that a report
+# reaches the terminal instead of the capture file of the test whose process it ends. Nothing is excluded: test_haptic runs ASAN_HAPTIC_STEPS haptic steps
+# instead of its default 1e5 (SOFTHAP_HAPTIC_STEPS, as for make tsan: ASan slows the steps down),
+# and skips, by itself, its count of the haptic thread's allocations, which needs malloc interposed
+# where ASan's own interceptors are.
+ASAN_BUILD ?= build-asan
+ASAN_HAPTIC_STEPS ?= 20000
+ASAN_UBSAN_OPTIONS = UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1$(if $(UBSAN_OPTIONS),:$(UBSAN_OPTIONS))"
+# For the interpreter: the library's ASan runtime, then its libstdc++, which must be loaded when
+# ASan starts for ASan to intercept C++ exceptions (else the library's first throw aborts).
+ASAN_PRELOAD = $$(ldd $(ASAN_BUILD)/libsofthap.so | awk '/libasan/ { print $$3 }') \
+  $$(ldd $(ASAN_BUILD)/libsofthap.so | awk '/libstdc\+\+/ { print $$3 }')
+asan: deps
+	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSOFTHAP_SANITIZE=ON \
+	  -DSOFTHAP_BUILD_TESTS=ON -DSOFTHAP_BUILD_EXAMPLES=OFF -DSOFTHAP_BUILD_BENCH=OFF $(CMAKE_FLAGS) > /dev/null
+	cmake --build $(ASAN_BUILD) -j $(JOBS)
+	cd $(ASAN_BUILD) && $(ASAN_UBSAN_OPTIONS) SOFTHAP_HAPTIC_STEPS=$(ASAN_HAPTIC_STEPS) ctest --output-on-failure -j $(JOBS)
+	$(ASAN_UBSAN_OPTIONS) ASAN_OPTIONS="detect_leaks=0$(if $(ASAN_OPTIONS),:$(ASAN_OPTIONS))" LD_PRELOAD="$(ASAN_PRELOAD)" \
+	  SOFTHAP_LIBRARY=$(abspath $(ASAN_BUILD))/libsofthap.so $(PYTHON) -m pytest -q --capture=sys tests/python
+
+# libFuzzer targets of the mesh readers (tests/fuzz/README.md), built with clang, ASan and UBSan
+# in build-fuzz, then each run for FUZZ_SECONDS over its committed seeds and regression inputs.
+# A crash, leak, UB report, hang or failed check fails the target and keeps the input in
+# build-fuzz/fuzz-work/<format>/artifacts/. clang and libFuzzer are installed here on demand
+# (install-deps.sh fuzz): make test does not need them.
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 40
+fuzz:
+	@scripts/install-deps.sh fuzz
+	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DSOFTHAP_FUZZ=ON -DSOFTHAP_BUILD_TESTS=OFF -DSOFTHAP_BUILD_EXAMPLES=OFF -DSOFTHAP_BUILD_BENCH=OFF $(CMAKE_FLAGS) > /dev/null
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target softhap_fuzzers
+	tests/fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
+
 bench: build
 	$(BUILD)/bench/softhap_bench
 
@@ -97,4 +137,4 @@ press-report: build report-deps
 	  liver2.msh 0.21 0.003 --stiffness 1e4 --friction 0.5 --plot report/press_liver2_probe_3mm.png
 
 clean:
-	rm -rf build build-no-cholmod build-no-ccd build-tsan
+	rm -rf build build-no-cholmod build-no-ccd build-tsan build-asan build-fuzz

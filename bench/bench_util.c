@@ -77,13 +77,8 @@ int bench_filter_arg(const char* arg, const char** filter, void (*usage)(void)) 
 }
 
 const char* material_name(sh_material_model model) {
-    switch (model) {
-    case SH_MATERIAL_LINEAR: return "linear";
-    case SH_MATERIAL_STVK: return "stvk";
-    case SH_MATERIAL_COROTATIONAL: return "corotational";
-    case SH_MATERIAL_NEOHOOKEAN: return "neohookean";
-    }
-    return "?";
+    static const char* const kNames[SH_MATERIAL_COUNT] = {"linear", "stvk", "corotational", "neohookean"};
+    return (int)model >= 0 && model < SH_MATERIAL_COUNT ? kNames[model] : "?";
 }
 
 static int file_exists(const char* dir, const char* name) {

@@ -113,14 +113,9 @@ static sh_status add_table(sh_world* world, double friction, sh_obstacle_id* out
 }
 
 static const char* integrator_name(sh_integrator integrator) {
-    switch (integrator) {
-    case SH_INTEGRATOR_FORWARD_EULER: return "forward Euler";
-    case SH_INTEGRATOR_SYMPLECTIC_EULER: return "symplectic Euler";
-    case SH_INTEGRATOR_RK2: return "RK2";
-    case SH_INTEGRATOR_RK4: return "RK4";
-    case SH_INTEGRATOR_IMPLICIT_EULER: return "implicit Euler";
-    }
-    return "?";
+    static const char* const kNames[SH_INTEGRATOR_COUNT] = {"forward Euler", "symplectic Euler", "RK2", "RK4",
+                                                            "implicit Euler"};
+    return (int)integrator >= 0 && integrator < SH_INTEGRATOR_COUNT ? kNames[integrator] : "?";
 }
 
 int liver_scene_create(const liver_scene_def* def, liver_scene* out) {

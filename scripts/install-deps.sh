@@ -1,12 +1,18 @@
 #!/usr/bin/env bash
 # Installs what softhap needs and is missing: Debian packages and Python packages.
 # Safe to run repeatedly; does nothing when everything is present.
+# `install-deps.sh fuzz` also installs clang and its libFuzzer/sanitizer runtimes (make fuzz only:
+# make test builds with the system's GCC and does not need them).
 set -euo pipefail
 
 # libopenblas0-serial: an optimised single-threaded BLAS for CHOLMOD's supernodal factorisation
 # and solves (Debian's default reference BLAS makes them ~2.5x and ~1.9x slower). Installing it
 # makes it the system's libblas.so.3 through update-alternatives.
 debian_packages=(libeigen3-dev libccd-dev libsuitesparse-dev libopenblas0-serial libcmocka-dev pkg-config)
+# libclang-rt-14-dev holds libFuzzer (libclang_rt.fuzzer*.a) and clang's ASan/UBSan runtimes.
+if [ "${1:-}" = fuzz ]; then
+  debian_packages+=(clang libclang-rt-14-dev)
+fi
 missing=()
 for package in "${debian_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")

@@ -358,6 +358,28 @@ static void test_foreign_pointers(void** state) {
 /* ------------------------------------------------------------------------------------------ */
 /* Destroyed objects (the pointers are only passed back to softhap, never dereferenced)         */
 
+/* A handle names one object for its whole life: after the object is destroyed and its table
+ * slot serves new objects, the old handle stays invalid, and a live handle of one kind is
+ * refused where another kind is expected. */
+static void test_stale_handles_never_name_a_new_object(void** state) {
+    (void)state;
+    sh_mesh_info info;
+    sh_world* stale = make_world();
+    assert_ok(sh_world_destroy(stale));
+    for (int round = 0; round < 1000; ++round) {
+        sh_world* world = make_world();
+        sh_mesh* mesh = sh_test_unit_tet(0.01);
+        assert_true(world != stale && (void*)mesh != (void*)stale);
+        assert_error(sh_world_step(stale, 1e-3, NULL), SH_ERR_INVALID_HANDLE, "world");
+        assert_error(sh_world_destroy(stale), SH_ERR_INVALID_HANDLE, "world");
+        assert_error(sh_mesh_get_info((const sh_mesh*)stale, &info), SH_ERR_INVALID_HANDLE, "mesh");
+        assert_ok(sh_world_step(world, 1e-3, NULL));
+        assert_ok(sh_mesh_get_info(mesh, &info));
+        assert_ok(sh_mesh_destroy(mesh));
+        assert_ok(sh_world_destroy(world));
+    }
+}
+
 static void test_destroyed_world(void** state) {
     (void)state;
     sh_mesh* mesh = sh_test_unit_tet(0.01);
@@ -1187,6 +1209,7 @@ int main(void) {
         cmocka_unit_test(test_null_handles),
         cmocka_unit_test(test_foreign_pointers),
         cmocka_unit_test(test_destroyed_world),
+        cmocka_unit_test(test_stale_handles_never_name_a_new_object),
         cmocka_unit_test(test_destroyed_mesh),
         cmocka_unit_test(test_stale_body_ids),
         cmocka_unit_test(test_null_and_garbage_body_ids),

@@ -349,6 +349,12 @@ static void test_stale_data_and_bad_pose_ramp_the_force_out(void** state) {
     assert_true(out.faults & SH_HAPTIC_FAULT_NO_TOOL);
     assert_ok(sh_haptic_destroy(haptic));
     assert_int_equal(sh_haptic_destroy(haptic), SH_ERR_INVALID_HANDLE);
+    /* The destroyed context passed back in is refused without touching its freed memory
+     * (ASan builds check that): the step, the warnings, and where a world is expected. */
+    assert_int_equal(sh_haptic_step(haptic, p, kIdentity, dt, &out), SH_ERR_INVALID_HANDLE);
+    uint64_t warnings[SH_WARN_COUNT];
+    assert_int_equal(sh_haptic_get_warnings(haptic, warnings), SH_ERR_INVALID_HANDLE);
+    assert_int_equal(sh_world_step((sh_world*)haptic, 1e-3, NULL), SH_ERR_INVALID_HANDLE);
 }
 
 /* A contact far too stiff for the sub-step budget makes the buffer run away: the step is

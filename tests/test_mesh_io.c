@@ -1,13 +1,14 @@
 /* Mesh files through the public C API: the shared meshes load with the counts their README
  * gives; the same small mesh loads identically from every format; corrupted files fail with
- * an exact status and a message naming the file line; a file cut short anywhere never crashes;
- * .vtu written by the library reads back bit for bit. Expected values come from the README,
- * from the fixtures' hand-written content (tests/data/README.md), or from an independent numpy
- * computation over the files. */
+ * an exact status and a message naming the file line; a file cut short anywhere never crashes,
+ * nor does any input the fuzzers kept (tests/fuzz/regressions); .vtu written by the library
+ * reads back bit for bit. Expected values come from the README, from the fixtures' hand-written
+ * content (tests/data/README.md), or from an independent numpy computation over the files. */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp */
 
 #include "test_support.h"
 
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -453,9 +454,25 @@ static void test_binary_garbage(void** state) {
     }
 }
 
-/* Every proper prefix of a fixture (a file cut short anywhere) loads or is refused as
- * malformed, unsupported or degenerate, with the file named: never a crash, a hang, an I/O or
- * internal error. A TetGen prefix is loaded with the other file of its pair complete. */
+/* Loads path, which must load or be refused as malformed, unsupported or degenerate with the
+ * file (name) named in the message: never a crash, a hang, an I/O or internal error. what names
+ * the input in a failure report. */
+static void expect_clean_load(const char* path, const char* name, const char* what) {
+    sh_mesh* mesh = NULL;
+    const sh_status status = sh_mesh_load(path, &mesh);
+    if (status == SH_OK) {
+        assert_ok(sh_mesh_destroy(mesh));
+        return;
+    }
+    if ((status != SH_ERR_PARSE && status != SH_ERR_UNSUPPORTED && status != SH_ERR_DEGENERATE_MESH) ||
+        !strstr(sh_last_error_message(), name)) {
+        print_error("%s: %s (%s)\n", what, sh_status_string(status), sh_last_error_message());
+        fail();
+    }
+}
+
+/* Every proper prefix of a fixture (a file cut short anywhere) loads or is refused cleanly
+ * (expect_clean_load). A TetGen prefix is loaded with the other file of its pair complete. */
 static void check_prefixes(const char* fixture, const char* name, const char* companion_fixture,
                            const char* companion_name) {
     print_message("%s\n", fixture);
@@ -470,18 +487,9 @@ static void check_prefixes(const char* fixture, const char* name, const char* co
     const char* path = temp_path(name);
     for (size_t length = 0; length < size; ++length) {
         write_file(path, bytes, length);
-        sh_mesh* mesh = NULL;
-        const sh_status status = sh_mesh_load(path, &mesh);
-        if (status == SH_OK) {
-            assert_ok(sh_mesh_destroy(mesh));
-            continue;
-        }
-        if ((status != SH_ERR_PARSE && status != SH_ERR_UNSUPPORTED && status != SH_ERR_DEGENERATE_MESH) ||
-            !strstr(sh_last_error_message(), name)) {
-            print_error("%s cut to %zu bytes: %s (%s)\n", fixture, length, sh_status_string(status),
-                        sh_last_error_message());
-            fail();
-        }
+        char what[256];
+        snprintf(what, sizeof what, "%s cut to %zu bytes", fixture, length);
+        expect_clean_load(path, name, what);
     }
     free(bytes);
 }
@@ -496,6 +504,126 @@ static void test_every_truncation_fails_cleanly(void** state) {
     check_prefixes(SH_TEST_DATA("two_tets.vtu"), "cut.vtu", NULL, NULL);
     check_prefixes(SH_TEST_DATA("two_tets0.node"), "cut_node.node", SH_TEST_DATA("two_tets0.ele"), "cut_node.ele");
     check_prefixes(SH_TEST_DATA("two_tets0.ele"), "cut_ele.ele", SH_TEST_DATA("two_tets0.node"), "cut_ele.node");
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Fuzzer findings: inputs of the fuzz targets kept in tests/fuzz/regressions/<format>/, written */
+/* as their target writes them (tests/fuzz/README.md)                                           */
+
+#define SH_TEST_REGRESSIONS "tests/fuzz/regressions/"
+
+/* The text target's input is one field of a Gmsh 2.2 file: the tag, or the x, of a fifth node
+ * (line 10) that no tet uses. */
+#define FIELD_NODES MSH2_HEAD "$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n"
+#define FIELD_REST " 0 0\n$EndNodes\n" MSH2_TET
+
+/* Writes prefix, then bytes[0, size), then suffix into path. */
+static void write_between(const char* path, const char* prefix, const char* bytes, size_t size, const char* suffix) {
+    const size_t before = strlen(prefix), after = strlen(suffix);
+    char* content = malloc(before + size + after);
+    assert_non_null(content);
+    memcpy(content, prefix, before);
+    if (size > 0) memcpy(content + before, bytes, size);
+    memcpy(content + before + size, suffix, after);
+    write_file(path, content, before + size + after);
+    free(content);
+}
+
+/* Temporary paths the regressions are written to, registered once. */
+typedef struct regression_paths {
+    const char* by_extension[3]; /* msh, vtk, vtu */
+    const char* node;
+    const char* ele;
+    const char* tag;
+    const char* x;
+} regression_paths;
+
+static regression_paths make_regression_paths(void) {
+    const regression_paths paths = {{temp_path("regression.msh"), temp_path("regression.vtk"), temp_path("regression.vtu")},
+                                    temp_path("regression.node"), temp_path("regression.ele"),
+                                    temp_path("regression_tag.msh"), temp_path("regression_x.msh")};
+    return paths;
+}
+
+/* Loads the regression input bytes of format as its fuzz target does; what names it in failures. */
+static void load_regression(const regression_paths* paths, const char* format, const char* bytes, size_t size,
+                            const char* what) {
+    static const char* const extensions[3] = {"gmsh", "vtk", "vtu"};
+    for (int i = 0; i < 3; ++i)
+        if (strcmp(format, extensions[i]) == 0) {
+            write_file(paths->by_extension[i], bytes, size);
+            expect_clean_load(paths->by_extension[i], "regression.", what);
+            return;
+        }
+    if (strcmp(format, "text") == 0) {
+        write_between(paths->tag, FIELD_NODES, bytes, size, " 0.5" FIELD_REST);
+        expect_clean_load(paths->tag, "regression_tag.msh", what);
+        write_between(paths->x, FIELD_NODES "5 ", bytes, size, FIELD_REST);
+        expect_clean_load(paths->x, "regression_x.msh", what);
+        return;
+    }
+    assert_string_equal(format, "tetgen"); /* the .node text, a line ".ele", the .ele text */
+    size_t split = 0;
+    while (split + 6 <= size && memcmp(bytes + split, "\n.ele\n", 6) != 0) ++split;
+    const int found = split + 6 <= size;
+    const size_t ele = found ? split + 6 : size;
+    write_file(paths->node, bytes, found ? split : size);
+    write_file(paths->ele, bytes + ele, size - ele);
+    expect_clean_load(paths->node, "regression.", what);
+    expect_clean_load(paths->ele, "regression.", what);
+}
+
+/* Every regression input loads or is refused cleanly (expect_clean_load), as the fuzzers demand. */
+static void test_fuzz_regressions_load_cleanly(void** state) {
+    (void)state;
+    static const char* const formats[] = {"gmsh", "vtk", "vtu", "tetgen", "text"};
+    const regression_paths paths = make_regression_paths();
+    int count = 0;
+    for (size_t f = 0; f < sizeof formats / sizeof formats[0]; ++f) {
+        char folder[128];
+        snprintf(folder, sizeof folder, SH_TEST_REGRESSIONS "%s", formats[f]);
+        DIR* dir = opendir(folder);
+        if (!dir) continue; /* no finding in this format */
+        for (struct dirent* entry = readdir(dir); entry; entry = readdir(dir)) {
+            if (entry->d_name[0] == '.') continue;
+            char path[512];
+            snprintf(path, sizeof path, "%s/%s", folder, entry->d_name);
+            print_message("%s\n", path);
+            size_t size = 0;
+            char* bytes = read_file(path, &size);
+            load_regression(&paths, formats[f], bytes, size, path);
+            free(bytes);
+            ++count;
+        }
+        closedir(dir);
+    }
+    assert_true(count > 0);
+}
+
+/* text/plus_minus_sign.txt: "+-1" was read as -1 (the '+' was dropped, then std::from_chars took
+ * the '-' as the sign). It is no number: refused naming the line and the field. A lone leading
+ * '+' still reads. */
+static void test_fuzz_plus_minus_sign_is_no_number(void** state) {
+    (void)state;
+    size_t size = 0;
+    char* field = read_file(SH_TEST_REGRESSIONS "text/plus_minus_sign.txt", &size);
+    const char* tag = temp_path("plus_minus_tag.msh");
+    write_between(tag, FIELD_NODES, field, size, " 0.5" FIELD_REST);
+    const char* const as_tag[3] = {"plus_minus_tag.msh:10:", "expected an integer for a node tag, got '+-1'", NULL};
+    expect_load(tag, SH_ERR_PARSE, as_tag);
+    const char* x = temp_path("plus_minus_x.msh");
+    write_between(x, FIELD_NODES "5 ", field, size, FIELD_REST);
+    const char* const as_x[3] = {"plus_minus_x.msh:10:", "expected a number for a node coordinate, got '+-1'", NULL};
+    expect_load(x, SH_ERR_PARSE, as_x);
+    free(field);
+
+    const char* plus = temp_path("plus.msh");
+    write_between(plus, FIELD_NODES "+5 ", "+0.25", 5, FIELD_REST);
+    sh_mesh* mesh = load_ok(plus);
+    double nodes[15];
+    assert_ok(sh_mesh_get_nodes(mesh, nodes, 15));
+    assert_true(nodes[12] == 0.25);
+    assert_ok(sh_mesh_destroy(mesh));
 }
 
 static void test_empty_files(void** state) {
@@ -647,6 +775,8 @@ int main(void) {
         cmocka_unit_test(test_corrupt_tetgen),
         cmocka_unit_test(test_binary_garbage),
         cmocka_unit_test(test_every_truncation_fails_cleanly),
+        cmocka_unit_test(test_fuzz_regressions_load_cleanly),
+        cmocka_unit_test(test_fuzz_plus_minus_sign_is_no_number),
         cmocka_unit_test(test_empty_files),
         cmocka_unit_test(test_missing_unknown_and_bad_arguments),
         cmocka_unit_test(test_vtu_round_trip_shared_meshes),

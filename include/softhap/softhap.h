@@ -21,10 +21,19 @@
 extern "C" {
 #endif
 
-#if defined(_WIN32)
+/* SH_API marks the library's functions: exported while building it (SOFTHAP_BUILDING),
+ * imported from the DLL by its users on Windows, nothing for a static build (define
+ * SOFTHAP_STATIC when building and using one). */
+#if defined(SOFTHAP_STATIC)
+#define SH_API
+#elif defined(_WIN32) && defined(SOFTHAP_BUILDING)
 #define SH_API __declspec(dllexport)
-#else
+#elif defined(_WIN32)
+#define SH_API __declspec(dllimport)
+#elif defined(SOFTHAP_BUILDING)
 #define SH_API __attribute__((visibility("default")))
+#else
+#define SH_API
 #endif
 
 /* ------------------------------------------------------------------------------------------ */
@@ -279,10 +288,11 @@ typedef enum sh_integrator {
     SH_INTEGRATOR_SYMPLECTIC_EULER = 1,/**< v += dt a, x += dt v (first order, symplectic) */
     SH_INTEGRATOR_RK2 = 2,             /**< explicit midpoint (second order) */
     SH_INTEGRATOR_RK4 = 3,             /**< classical Runge-Kutta (fourth order) */
-    SH_INTEGRATOR_IMPLICIT_EULER = 4   /**< backward Euler, linearised per step (Baraff-Witkin)
+    SH_INTEGRATOR_IMPLICIT_EULER = 4,  /**< backward Euler, linearised per step (Baraff-Witkin)
                                             with optional Newton iterations: unconditionally
                                             stable, first order, dissipative; see
                                             sh_implicit_settings */
+    SH_INTEGRATOR_COUNT = 5            /**< number of kinds, not a kind */
 } sh_integrator;
 
 /** Sparse linear solvers of the implicit integrator and the static solver. */
@@ -291,8 +301,9 @@ typedef enum sh_linear_solver {
     SH_LINEAR_SOLVER_CHOLMOD = 1, /**< SuiteSparse CHOLMOD; symbolic analysis reused while the
                                        sparsity pattern is unchanged */
     SH_LINEAR_SOLVER_LDLT = 2,    /**< Eigen's SimplicialLDLT (no extra dependency) */
-    SH_LINEAR_SOLVER_CG = 3       /**< Eigen's conjugate gradient, warm-started from the last
+    SH_LINEAR_SOLVER_CG = 3,      /**< Eigen's conjugate gradient, warm-started from the last
                                        step's solution */
+    SH_LINEAR_SOLVER_COUNT = 4    /**< number of kinds, not a kind */
 } sh_linear_solver;
 
 /** Settings of the implicit integrator (read only for SH_INTEGRATOR_IMPLICIT_EULER). */
@@ -340,10 +351,11 @@ typedef enum sh_unstable_policy {
     SH_UNSTABLE_REJECT = 0, /**< return SH_ERR_UNSTABLE (explicit, dt above dt_crit) or the
                                  implicit step's error (SH_ERR_NOT_CONVERGED, ...), body state
                                  untouched */
-    SH_UNSTABLE_SUBSTEP = 1 /**< explicit: split the step into equal sub-steps below dt_crit;
+    SH_UNSTABLE_SUBSTEP = 1,/**< explicit: split the step into equal sub-steps below dt_crit;
                                  implicit: retry a step that does not converge in up to
                                  max_substeps sub-steps, then keep the best iterate with
                                  SH_WARN_NOT_CONVERGED (the world always advances) */
+    SH_UNSTABLE_POLICY_COUNT = 2 /**< number of kinds, not a kind */
 } sh_unstable_policy;
 
 /** Constitutive models for tetrahedral elements. */
@@ -351,7 +363,8 @@ typedef enum sh_material_model {
     SH_MATERIAL_LINEAR = 0,       /**< small-strain linear elasticity (not rotation invariant) */
     SH_MATERIAL_STVK = 1,         /**< St. Venant-Kirchhoff on Green-Lagrange strain */
     SH_MATERIAL_COROTATIONAL = 2, /**< linear elasticity in the element's polar rotation frame */
-    SH_MATERIAL_NEOHOOKEAN = 3    /**< stable neo-Hookean (Smith, de Goes, Kim 2018) */
+    SH_MATERIAL_NEOHOOKEAN = 3,   /**< stable neo-Hookean (Smith, de Goes, Kim 2018) */
+    SH_MATERIAL_COUNT = 4         /**< number of kinds, not a kind */
 } sh_material_model;
 
 /** An isotropic material. */
@@ -401,7 +414,8 @@ typedef enum sh_spring_law {
     SH_SPRING_LINEAR = 0,     /**< T = k (l - l0) */
     SH_SPRING_CUBIC = 1,      /**< T = lambda1 d^3 + lambda2 d, d = (l - l0) / l0 */
     SH_SPRING_HYPERBOLIC = 2, /**< T = dx / (a |dx| + b), dx = l - l0 (saturates at 1/a) */
-    SH_SPRING_TABLE = 3       /**< T = curve(d), monotone cubic through (strain, force) rows */
+    SH_SPRING_TABLE = 3,      /**< T = curve(d), monotone cubic through (strain, force) rows */
+    SH_SPRING_LAW_COUNT = 4   /**< number of kinds, not a kind */
 } sh_spring_law;
 
 /** Parameters of a spring law; only the chosen law's fields are read. */
@@ -544,8 +558,9 @@ typedef enum sh_shape_kind {
                                the local z axis */
     SH_SHAPE_BOX = 2,     /**< half_extents along the local axes, centred on the pose */
     SH_SHAPE_CONVEX = 3,  /**< the convex hull of points (local frame); needs SH_FEATURE_CCD */
-    SH_SHAPE_PLANE = 4    /**< obstacles only: the half-space behind the plane through the
+    SH_SHAPE_PLANE = 4,   /**< obstacles only: the half-space behind the plane through the
                                pose's position with outward normal `normal` (world frame) */
+    SH_SHAPE_COUNT = 5    /**< number of kinds, not a kind */
 } sh_shape_kind;
 
 /** A rigid shape. Only the kind's fields are read. */

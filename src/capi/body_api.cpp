@@ -3,6 +3,7 @@
 #include "capi/world_handle.hpp"
 #include "material/material_params.hpp"
 #include "mesh/io/mesh_io.hpp"
+#include "solver/integrator_table.hpp"
 #include "model/fem_body.hpp"
 
 #include <algorithm>
@@ -44,14 +45,13 @@ extern "C" {
 SH_API sh_status sh_body_set_material(sh_world* world, sh_body_id body, const int32_t* elements, int32_t element_count,
                                       const sh_material* material) {
     return capi::guard([&] {
-        Body& b = body_of(world, body);
-        require(b.is_fem(), SH_ERR_UNSUPPORTED, "sh_body_set_material needs an FEM body; this is a mass-spring body");
+        World& w = capi::world_of(world);
+        w.body(body);  // validates the id first
         capi::require_pointer(material, "material");
         validate_material(*material, "sh_body_set_material");
         SH_REQUIRE(element_count >= 0, SH_ERR_INVALID_ARGUMENT, "element_count = %d, must be >= 0", element_count);
         if (element_count > 0) capi::require_pointer(elements, "elements");
-        static_cast<FemBody&>(b).set_material(elements, element_count, *material);
-        if (material->poisson > kLockingPoisson && element_count > 0) ++capi::world_of(world).warnings[SH_WARN_LOCKING];
+        w.set_material(body, elements, element_count, *material);
     });
 }
 
@@ -77,7 +77,7 @@ SH_API sh_status sh_body_get_info(const sh_world* world, sh_body_id body, sh_bod
             info.fixed_node_count += b.kinematic[static_cast<size_t>(i)] ? 1 : 0;
             info.total_mass += b.mass[static_cast<size_t>(i)];
         }
-        info.dt_critical = b.critical_dt();
+        info.dt_critical = critical_step(b, capi::world_of(world).step_settings(body).integrator);
         *out_info = info;
     });
 }
@@ -99,10 +99,7 @@ SH_API sh_status sh_body_set_positions(sh_world* world, sh_body_id body, const d
         Body& b = body_of(world, body);
         require_node_count(b, node_count);
         require_all_finite(positions, b.x.size(), "positions");
-        std::copy(positions, positions + b.x.size(), b.x.begin());
-        for (size_t i = 0; i < b.kinematic.size(); ++i)  // fixed nodes stay fixed where they are put
-            if (b.kinematic[i])
-                for (int k = 0; k < 3; ++k) b.target[3 * i + k] = b.x[3 * i + k];
+        b.set_positions(positions);
     });
 }
 
@@ -111,8 +108,7 @@ SH_API sh_status sh_body_set_velocities(sh_world* world, sh_body_id body, const 
         Body& b = body_of(world, body);
         require_node_count(b, node_count);
         require_all_finite(velocities, b.v.size(), "velocities");
-        for (size_t i = 0; i < b.mass.size(); ++i)
-            for (int k = 0; k < 3; ++k) b.v[3 * i + k] = b.inverse_mass[i] > 0.0 ? velocities[3 * i + k] : 0.0;
+        b.set_velocities(velocities);
     });
 }
 
@@ -120,15 +116,7 @@ SH_API sh_status sh_body_fix_nodes(sh_world* world, sh_body_id body, const int32
     return capi::guard([&] {
         Body& b = body_of(world, body);
         require_node_indices(b, nodes, count);
-        for (int32_t k = 0; k < count; ++k) {
-            const size_t i = static_cast<size_t>(nodes[k]);
-            b.kinematic[i] = 1;
-            for (int c = 0; c < 3; ++c) {
-                b.target[3 * i + c] = b.x[3 * i + c];
-                b.v[3 * i + c] = 0.0;
-            }
-        }
-        b.update_inverse_mass();
+        b.fix_nodes(nodes, count);
     });
 }
 
@@ -136,8 +124,7 @@ SH_API sh_status sh_body_release_nodes(sh_world* world, sh_body_id body, const i
     return capi::guard([&] {
         Body& b = body_of(world, body);
         require_node_indices(b, nodes, count);
-        for (int32_t k = 0; k < count; ++k) b.kinematic[static_cast<size_t>(nodes[k])] = 0;
-        b.update_inverse_mass();
+        b.release_nodes(nodes, count);
     });
 }
 
@@ -147,12 +134,7 @@ SH_API sh_status sh_body_prescribe_positions(sh_world* world, sh_body_id body, c
         Body& b = body_of(world, body);
         require_node_indices(b, nodes, count);
         if (count > 0) require_all_finite(positions, 3 * static_cast<size_t>(count), "positions");
-        for (int32_t k = 0; k < count; ++k) {
-            const size_t i = static_cast<size_t>(nodes[k]);
-            b.kinematic[i] = 1;
-            for (int c = 0; c < 3; ++c) b.target[3 * i + c] = positions[3 * k + c];
-        }
-        b.update_inverse_mass();
+        b.prescribe_positions(nodes, positions, count);
     });
 }
 

@@ -18,7 +18,7 @@ sh_collider_def checked_def(const sh_collider_def* def) {
     capi::require_initialised(def, "def");
     sh_collider_def out = *def;
     const int kind = enum_value(def->shape.kind);
-    SH_REQUIRE(kind >= SH_SHAPE_SPHERE && kind <= SH_SHAPE_PLANE, SH_ERR_INVALID_ARGUMENT,
+    SH_REQUIRE(kind >= 0 && kind < SH_SHAPE_COUNT, SH_ERR_INVALID_ARGUMENT,
                "def->shape.kind = %d is not a sh_shape_kind", kind);
     out.shape.kind = static_cast<sh_shape_kind>(kind);
     return out;

@@ -3,61 +3,85 @@
 #include "core/error.hpp"
 #include "core/memory.hpp"
 
-#include <algorithm>
+#include <atomic>
 #include <mutex>
 
 namespace sh::capi {
 namespace {
 
-struct Entry {
-    HandleKind kind;
-    const void* object;
+constexpr int kIndexBits = 16;
+static_assert(kMaxLiveHandles == 1u << kIndexBits, "a handle's index bits cover the table");
+constexpr uint64_t kIndexMask = kMaxLiveHandles - 1;
+constexpr uint64_t kGenerationMask = (uint64_t{1} << 48) - 1;  // what a 64-bit handle keeps of it
+
+// One slot: tag = generation << 8 | kind while live, 0 while free. Published with release
+// after the object, read with acquire before it, so a reader that sees the tag sees the object.
+struct Slot {
+    std::atomic<uint64_t> tag{0};
+    std::atomic<void*> object{nullptr};
 };
 
-std::mutex g_mutex;
-vec<Entry>* g_entries = nullptr;  // allocated while any object lives, so it follows the allocator
+// Static storage, never freed: a stale handle's slot stays readable for the process's life.
+Slot g_slots[kMaxLiveHandles];
+uint64_t g_generation[kMaxLiveHandles];  // the slot's latest generation (under g_mutex)
+uint32_t g_next_free[kMaxLiveHandles];   // free list links (under g_mutex)
+uint32_t g_free_head = 0;                // the first free slot, or g_used if none
+uint32_t g_used = 0;                     // slots ever handed out: [0, g_used)
+std::mutex g_mutex;                      // creation and destruction only
+
+uint64_t tag_of(uint64_t generation, HandleKind kind) { return generation << 8 | static_cast<uint64_t>(kind); }
+
+uintptr_t value_of(const void* handle) { return reinterpret_cast<uintptr_t>(handle); }
 
 }  // namespace
 
-void register_handle(HandleKind kind, const void* object) {
+const void* register_handle(HandleKind kind, void* object) {
     std::lock_guard<std::mutex> lock(g_mutex);
-    if (!g_entries) g_entries = sh::create<vec<Entry>>();
-    try {
-        g_entries->push_back({kind, object});
-    } catch (...) {
-        if (g_entries->empty()) {
-            sh::destroy(g_entries);
-            g_entries = nullptr;
-        }
-        throw;
+    uint32_t index;
+    if (g_free_head < g_used) {
+        index = g_free_head;
+        g_free_head = g_next_free[index];
+    } else {
+        require(g_used < kMaxLiveHandles, SH_ERR_OUT_OF_MEMORY,
+                format("more than %u meshes, worlds and haptic contexts alive at once", kMaxLiveHandles));
+        index = g_used++;
+        g_free_head = g_used;
     }
+    // Generations start at 1, so that no handle is NULL.
+    const uint64_t generation = g_generation[index] = (g_generation[index] % kGenerationMask) + 1;
+    g_slots[index].object.store(object, std::memory_order_relaxed);
+    g_slots[index].tag.store(tag_of(generation, kind), std::memory_order_release);
     object_created();
+    return reinterpret_cast<const void*>(static_cast<uintptr_t>(generation << kIndexBits | index));
 }
 
-bool unregister_handle(HandleKind kind, const void* object) {
+void* unregister_handle(HandleKind kind, const void* handle) {
     std::lock_guard<std::mutex> lock(g_mutex);
-    if (!g_entries) return false;
-    auto it = std::find_if(g_entries->begin(), g_entries->end(), [&](const Entry& e) {
-        return e.kind == kind && e.object == object;
-    });
-    if (it == g_entries->end()) return false;
-    *it = g_entries->back();
-    g_entries->pop_back();
+    void* object = find_handle(kind, handle);
+    if (!object) return nullptr;
+    const uint32_t index = static_cast<uint32_t>(value_of(handle) & kIndexMask);
+    g_slots[index].tag.store(0, std::memory_order_release);
+    g_slots[index].object.store(nullptr, std::memory_order_relaxed);
+    g_next_free[index] = g_free_head;
+    g_free_head = index;
     object_destroyed();
-    if (g_entries->empty()) {
-        sh::destroy(g_entries);
-        g_entries = nullptr;
-    }
-    return true;
+    return object;
 }
 
-void require_handle(HandleKind kind, const void* object, const char* name) {
-    if (!object) throw Error(SH_ERR_INVALID_HANDLE, format("%s is NULL", name));
-    std::lock_guard<std::mutex> lock(g_mutex);
-    const bool live = g_entries && std::any_of(g_entries->begin(), g_entries->end(), [&](const Entry& e) {
-        return e.kind == kind && e.object == object;
-    });
-    if (!live) throw Error(SH_ERR_INVALID_HANDLE, format("%s is not a live object (destroyed or never created)", name));
+void* find_handle(HandleKind kind, const void* handle) noexcept {
+    const uint64_t value = value_of(handle);
+    const uint64_t index = value & kIndexMask, generation = value >> kIndexBits;
+    if (generation == 0 || generation > kGenerationMask) return nullptr;
+    const Slot& slot = g_slots[index];
+    if (slot.tag.load(std::memory_order_acquire) != tag_of(generation, kind)) return nullptr;
+    return slot.object.load(std::memory_order_relaxed);
+}
+
+void* require_handle(HandleKind kind, const void* handle, const char* name) {
+    if (!handle) throw Error(SH_ERR_INVALID_HANDLE, format("%s is NULL", name));
+    void* object = find_handle(kind, handle);
+    if (!object) throw Error(SH_ERR_INVALID_HANDLE, format("%s is not a live object (destroyed or never created)", name));
+    return object;
 }
 
 }  // namespace sh::capi

@@ -6,18 +6,10 @@
 
 using namespace sh;
 
-struct sh_haptic {
-    sh::HapticContext* context;
-    uint32_t magic;  ///< kLive while alive: a cheap, lock-free sanity check for the haptic step
-};
-
 namespace {
 
-constexpr uint32_t kLive = 0x53484850u;  // "SHHP"
-
 HapticContext& context_of(const sh_haptic* haptic) {
-    capi::require_handle(capi::HandleKind::Haptic, haptic, "haptic");
-    return *haptic->context;
+    return capi::object_of<HapticContext>(capi::HandleKind::Haptic, haptic, "haptic");
 }
 
 sh_haptic_def checked_def(const sh_haptic_def* def) {
@@ -62,40 +54,35 @@ SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_
         SH_REQUIRE(w.is_valid_collider(d.tool, true), SH_ERR_INVALID_HANDLE,
                    "def->tool = 0x%llx is not a live tool of this world", static_cast<unsigned long long>(d.tool));
         HapticContext* context = sh::create<HapticContext>(w, d);
-        sh_haptic* handle = nullptr;
         try {
-            handle = sh::create<sh_haptic>(sh_haptic{context, kLive});
             w.add_hook(context);
-            capi::register_handle(capi::HandleKind::Haptic, handle);
+            *out = static_cast<sh_haptic*>(const_cast<void*>(capi::register_handle(capi::HandleKind::Haptic, context)));
         } catch (...) {
             w.remove_hook(context);
-            sh::destroy(handle);
             sh::destroy(context);
             throw;
         }
-        *out = handle;
     });
 }
 
 SH_API sh_status sh_haptic_destroy(sh_haptic* haptic) {
     return capi::guard([&] {
         if (!haptic) return;
-        if (!capi::unregister_handle(capi::HandleKind::Haptic, haptic))
-            throw Error(SH_ERR_INVALID_HANDLE, "haptic is not a live object (destroyed twice or never created)");
-        if (World* w = haptic->context->world()) w->remove_hook(haptic->context);
-        haptic->magic = 0;
-        sh::destroy(haptic->context);
-        sh::destroy(haptic);
+        auto* context = static_cast<HapticContext*>(capi::unregister_handle(capi::HandleKind::Haptic, haptic));
+        require(context != nullptr, SH_ERR_INVALID_HANDLE, "haptic is not a live object (destroyed twice or never created)");
+        if (World* w = context->world()) w->remove_hook(context);
+        sh::destroy(context);
     });
 }
 
 SH_API sh_status sh_haptic_step(sh_haptic* haptic, const double position[3], const double orientation[4], double dt,
                                 sh_haptic_output* out) {
     // No guard: nothing here throws, and the step must not touch the last-error message's
-    // formatting (it allocates).
-    if (!haptic || haptic->magic != kLive) return SH_ERR_INVALID_HANDLE;
+    // formatting (it allocates). The handle check reads the handle table only.
+    auto* context = static_cast<HapticContext*>(capi::find_handle(capi::HandleKind::Haptic, haptic));
+    if (!context) return SH_ERR_INVALID_HANDLE;
     if (!out) return SH_ERR_INVALID_ARGUMENT;
-    return haptic->context->step(position, orientation, dt, *out);
+    return context->step(position, orientation, dt, *out);
 }
 
 SH_API sh_status sh_haptic_get_warnings(const sh_haptic* haptic, uint64_t out[SH_WARN_COUNT]) {

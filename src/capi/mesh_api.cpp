@@ -7,30 +7,21 @@
 #include <algorithm>
 #include <cmath>
 
-struct sh_mesh {
-    sh::TetMesh mesh;
-};
-
 using namespace sh;
 using capi::HandleKind;
 
 namespace {
 
-const TetMesh& checked_mesh(const sh_mesh* mesh) {
-    capi::require_handle(HandleKind::Mesh, mesh, "mesh");
-    return mesh->mesh;
-}
+const TetMesh& checked_mesh(const sh_mesh* mesh) { return capi::object_of<TetMesh>(HandleKind::Mesh, mesh, "mesh"); }
 
 sh_mesh* publish(TetMesh&& built) {
-    sh_mesh* handle = sh::create<sh_mesh>();
-    handle->mesh = std::move(built);
+    TetMesh* mesh = sh::create<TetMesh>(std::move(built));
     try {
-        capi::register_handle(HandleKind::Mesh, handle);
+        return static_cast<sh_mesh*>(const_cast<void*>(capi::register_handle(HandleKind::Mesh, mesh)));
     } catch (...) {
-        sh::destroy(handle);
+        sh::destroy(mesh);
         throw;
     }
-    return handle;
 }
 
 template <class T>
@@ -99,9 +90,9 @@ SH_API sh_status sh_mesh_transform(const sh_mesh* mesh, double scale, const doub
 SH_API sh_status sh_mesh_destroy(sh_mesh* mesh) {
     return capi::guard([&] {
         if (!mesh) return;
-        require(capi::unregister_handle(HandleKind::Mesh, mesh), SH_ERR_INVALID_HANDLE,
-                "mesh is not a live object (destroyed twice or never created)");
-        sh::destroy(mesh);
+        TetMesh* object = static_cast<TetMesh*>(capi::unregister_handle(HandleKind::Mesh, mesh));
+        require(object != nullptr, SH_ERR_INVALID_HANDLE, "mesh is not a live object (destroyed twice or never created)");
+        sh::destroy(object);
     });
 }
 

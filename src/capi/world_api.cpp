@@ -7,6 +7,7 @@
 #include "mesh/tet_mesh.hpp"
 #include "model/fem_body.hpp"
 #include "model/spring_body.hpp"
+#include "solver/integrator_table.hpp"
 
 using namespace sh;
 using capi::HandleKind;
@@ -14,10 +15,7 @@ using capi::HandleKind;
 namespace sh::capi {
 const TetMesh& mesh_of(const sh_mesh* mesh);
 
-World& world_of(const sh_world* world) {
-    require_handle(HandleKind::World, world, "world");
-    return const_cast<sh_world*>(world)->world;
-}
+World& world_of(const sh_world* world) { return object_of<World>(HandleKind::World, world, "world"); }
 }  // namespace sh::capi
 
 namespace {
@@ -25,7 +23,7 @@ namespace {
 // Checks the implicit integrator's settings.
 sh_implicit_settings checked_implicit_settings(const sh_implicit_settings& in) {
     const int solver = enum_value(in.linear_solver);
-    SH_REQUIRE(solver >= SH_LINEAR_SOLVER_DEFAULT && solver <= SH_LINEAR_SOLVER_CG, SH_ERR_INVALID_ARGUMENT,
+    SH_REQUIRE(solver >= 0 && solver < SH_LINEAR_SOLVER_COUNT, SH_ERR_INVALID_ARGUMENT,
                "def->implicit.linear_solver = %d is not a sh_linear_solver", solver);
     require(solver != SH_LINEAR_SOLVER_CHOLMOD || (sh_build_features() & SH_FEATURE_CHOLMOD), SH_ERR_UNSUPPORTED,
             "def->implicit.linear_solver is SH_LINEAR_SOLVER_CHOLMOD but this library was built without CHOLMOD");
@@ -58,22 +56,27 @@ sh_implicit_settings default_implicit_settings() {
     return s;
 }
 
-// Checks and copies the integration fields that FEM and spring defs share.
+// Checks and copies the step fields that FEM and spring defs share.
 template <class Def>
-IntegrationSettings integration_settings(const Def& def) {
+StepSettings step_settings(const Def& def) {
     const int integrator = enum_value(def.integrator), policy = enum_value(def.on_unstable);
-    const double damping_mass = def.damping_mass, runaway_speed = def.runaway_speed;
-    SH_REQUIRE(integrator >= SH_INTEGRATOR_FORWARD_EULER && integrator <= SH_INTEGRATOR_IMPLICIT_EULER, SH_ERR_INVALID_ARGUMENT, "def->integrator = %d is not a sh_integrator", integrator);
-    SH_REQUIRE(policy == SH_UNSTABLE_REJECT || policy == SH_UNSTABLE_SUBSTEP, SH_ERR_INVALID_ARGUMENT, "def->on_unstable = %d is not a sh_unstable_policy", policy);
-    SH_REQUIRE(std::isfinite(damping_mass) && damping_mass >= 0.0, SH_ERR_INVALID_ARGUMENT, "def->damping_mass = %g 1/s, must be finite and >= 0", damping_mass);
+    const double runaway_speed = def.runaway_speed;
+    SH_REQUIRE(is_integrator(integrator), SH_ERR_INVALID_ARGUMENT, "def->integrator = %d is not a sh_integrator", integrator);
+    SH_REQUIRE(policy >= 0 && policy < SH_UNSTABLE_POLICY_COUNT, SH_ERR_INVALID_ARGUMENT, "def->on_unstable = %d is not a sh_unstable_policy", policy);
     SH_REQUIRE(runaway_speed > 0.0, SH_ERR_INVALID_ARGUMENT, "def->runaway_speed = %g m/s, must be > 0", runaway_speed);
-    IntegrationSettings s;
+    StepSettings s;
     if (integrator == SH_INTEGRATOR_IMPLICIT_EULER) s.implicit = checked_implicit_settings(def.implicit);
     s.integrator = static_cast<sh_integrator>(integrator);
     s.on_unstable = static_cast<sh_unstable_policy>(policy);
-    s.damping_mass = damping_mass;
     s.runaway_speed = runaway_speed;
     return s;
+}
+
+// Checks a def's Rayleigh mass damping (1/s).
+template <class Def>
+double checked_damping_mass(const Def& def) {
+    SH_REQUIRE(std::isfinite(def.damping_mass) && def.damping_mass >= 0.0, SH_ERR_INVALID_ARGUMENT, "def->damping_mass = %g 1/s, must be finite and >= 0", def.damping_mass);
+    return def.damping_mass;
 }
 
 }  // namespace
@@ -95,23 +98,22 @@ SH_API sh_status sh_world_create(const sh_world_def* def, sh_world** out_world) 
         for (int k = 0; k < 3; ++k) capi::require_finite(def->gravity[k], "def->gravity");
         SH_REQUIRE(def->error_estimate == 0 || def->error_estimate == 1, SH_ERR_INVALID_ARGUMENT,
                    "def->error_estimate = %d, must be 0 or 1", def->error_estimate);
-        sh_world* world = sh::create<sh_world>(*def);
+        World* world = sh::create<World>(*def);
         try {
-            capi::register_handle(HandleKind::World, world);
+            *out_world = static_cast<sh_world*>(const_cast<void*>(capi::register_handle(HandleKind::World, world)));
         } catch (...) {
             sh::destroy(world);
             throw;
         }
-        *out_world = world;
     });
 }
 
 SH_API sh_status sh_world_destroy(sh_world* world) {
     return capi::guard([&] {
         if (!world) return;
-        require(capi::unregister_handle(HandleKind::World, world), SH_ERR_INVALID_HANDLE,
-                "world is not a live object (destroyed twice or never created)");
-        sh::destroy(world);
+        World* object = static_cast<World*>(capi::unregister_handle(HandleKind::World, world));
+        require(object != nullptr, SH_ERR_INVALID_HANDLE, "world is not a live object (destroyed twice or never created)");
+        sh::destroy(object);
     });
 }
 
@@ -187,10 +189,9 @@ SH_API sh_status sh_world_add_fem_body(sh_world* world, const sh_fem_body_def* d
         const TetMesh& mesh = capi::mesh_of(def->mesh);
         validate_material(def->material, "def");
         SH_REQUIRE(std::isfinite(def->damping_stiffness) && def->damping_stiffness >= 0.0, SH_ERR_INVALID_ARGUMENT, "def->damping_stiffness = %g s, must be finite and >= 0", def->damping_stiffness);
-        const IntegrationSettings settings =
-            integration_settings(*def);
-        *out_body = w.add_body(sh::create<FemBody>(mesh, def->material, settings, def->damping_stiffness));
-        if (def->material.poisson > kLockingPoisson) ++w.warnings[SH_WARN_LOCKING];
+        const StepSettings settings = step_settings(*def);
+        const double damping_mass = checked_damping_mass(*def);
+        *out_body = w.add_fem_body(mesh, def->material, damping_mass, def->damping_stiffness, settings);
     });
 }
 
@@ -237,9 +238,10 @@ SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_
         else if (mesh && !def->nodes)
             for (size_t i = 0; i < node_count; ++i)
                 if (!mesh->node_used[i]) masses[i] = 0.0;  // orphans stay out of the dynamics
-        const IntegrationSettings settings =
-            integration_settings(*def);
-        *out_body = w.add_body(sh::create<SpringBody>(std::move(nodes), std::move(springs), def->params, masses, settings));
+        const StepSettings settings = step_settings(*def);
+        const double damping_mass = checked_damping_mass(*def);
+        *out_body = w.add_body(sh::create<SpringBody>(std::move(nodes), std::move(springs), def->params, masses, damping_mass),
+                               settings);
     });
 }
 

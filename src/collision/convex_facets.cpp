@@ -1,5 +1,5 @@
-// The facet planes of a convex hull shape: exact, allocation-free point queries.
-#include "collision/shape.hpp"
+// The facet planes of a convex hull: exact, allocation-free point queries.
+#include "collision/convex_hull.hpp"
 
 #include "core/vec3.hpp"
 
@@ -20,7 +20,7 @@ bool has_plane(const vec<double>& planes, const double n[3], double offset, doub
 
 }  // namespace
 
-void Shape::init_convex_planes() {
+void ConvexHull::init_planes() {
     planes_.clear();
     exact_planes_ = false;
     const double* pts = points_.data();

@@ -39,6 +39,17 @@ struct Pose {
         const double d[3] = {world[0] - p[0], world[1] - p[1], world[2] - p[2]};
         unrotate(d, out);
     }
+
+    /// The rotation as a matrix: R[i][j] = (R e_j)_i, its columns the local axes in the world.
+    void rotation_matrix(double R[3][3]) const {
+        for (int j = 0; j < 3; ++j) {
+            double e[3] = {0.0, 0.0, 0.0};
+            e[j] = 1.0;
+            double c[3];
+            rotate(e, c);
+            for (int i = 0; i < 3; ++i) R[i][j] = c[i];
+        }
+    }
 };
 
 /// The pose a fraction s in [0, 1] of the way from a to b: positions linearly, orientations

@@ -13,7 +13,7 @@
 
 namespace sh {
 
-BodyContacts::BodyContacts(const Body& body) : body_(body) {
+BodyContacts::BodyContacts(const Body& body, bool implicit) : body_(body), implicit_(implicit) {
     const size_t n = static_cast<size_t>(body.node_count());
     vec<uint8_t> on_surface(n, 0);
     node_area_.assign(n, 0.0);
@@ -54,8 +54,6 @@ void BodyContacts::clear() {
     candidates_.clear();
     groups_.clear();
 }
-
-bool BodyContacts::implicit_step() const { return body_.settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER; }
 
 StepLaw BodyContacts::step_law(const ContactCandidate& c) const {
     return hunt_crossley_step_law(*c.params, c.start_depth, step_);

@@ -50,8 +50,10 @@ struct ContactCandidate {
 class BodyContacts final : public ExternalField {
 public:
     /// Prepares the body's surface (FEM: its boundary triangles; springs: every node with
-    /// mass). Allocates.
-    explicit BodyContacts(const Body& body);
+    /// mass). implicit: the body's solver minimises an implicit step's potential (contact
+    /// takes the step's law over its depth rate and lagged friction), else it steps explicitly
+    /// (the law at rest, friction as impulses per node after each step). Allocates.
+    BodyContacts(const Body& body, bool implicit);
 
     /// Drops the last step's candidates.
     void clear();
@@ -128,7 +130,7 @@ private:
         int32_t begin, end;  ///< candidates [begin, end): node kinds first, then faces
     };
     /// True if the body is stepped implicitly (the step's law, lagged friction).
-    bool implicit_step() const;
+    bool implicit_step() const { return implicit_; }
     /// Candidate c's law over the step (hunt_crossley_step_law from its start depth); the law
     /// at rest for explicit bodies and static solves (step_ and start_depth are 0 there).
     StepLaw step_law(const ContactCandidate& c) const;
@@ -174,6 +176,7 @@ private:
     void ensure_tet_tree();
 
     const Body& body_;
+    const bool implicit_;  ///< see the constructor
     vec<int32_t> surface_nodes_;   ///< nodes on the surface
     vec<double> node_area_;        ///< per node: a third of its surface triangles' rest area (m^2)
     vec<int32_t> edge_neighbor_;   ///< per surface triangle and edge k (nodes k, k + 1): the

@@ -15,7 +15,7 @@ namespace sh {
 /// Capacities of a context's buffers, from its def.
 struct BufferCapacity {
     int32_t tets, nodes;
-    int32_t blocks() const { return (tets + kLanes - 1) / kLanes + 4; }  ///< one partial per model
+    int32_t blocks() const { return (tets + kLanes - 1) / kLanes + SH_MATERIAL_COUNT; }  ///< one partial per model
     int32_t triangles() const { return 4 * tets; }  ///< each buffer tet has at most 4 surface faces
     int32_t edges() const { return 12 * tets; }     ///< at most 3 per triangle
     int32_t friction_records() const { return nodes; }  ///< friction contacts per sub-step: one per surface node
@@ -27,7 +27,8 @@ struct Buffer {
     sh_body_id body = 0;        ///< the body it was cut from (0: none near the tool)
     bool tool_alive = true;     ///< false once the tool is destroyed
     int32_t node_count = 0, tet_count = 0, triangle_count = 0, surface_node_count = 0, edge_count = 0;
-    int32_t block_begin[5] = {};  ///< blocks of material model m: [block_begin[m], block_begin[m + 1])
+    int32_t block_begin[SH_MATERIAL_COUNT + 1] = {};  ///< blocks of material model m:
+                                                     ///< [block_begin[m], block_begin[m + 1])
     double period = 0.0;          ///< the full-model step the boundary moves across (s); 0 after a
                                   ///< jump (creation, a static solve): the haptic side then
                                   ///< restarts from the full model instead of keeping its state

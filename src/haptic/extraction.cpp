@@ -154,7 +154,7 @@ void HapticContext::select_tets(const FemBody& body, const double center[3], int
     }
 }
 
-void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Buffer& out) {
+void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], double runaway_speed, Buffer& out) {
     const int32_t* elements = body.element_nodes();
     // Local numbers in ascending body order, so that the haptic side can match buffers by a merge.
     int32_t n = 0;
@@ -194,7 +194,7 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
 
     // Blocks per material model, lanes over local numbers, spread like the full model's.
     int32_t block = 0;
-    for (int model = 0; model < 4; ++model) {
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         out.block_begin[model] = block;
         members_.clear();
         for (const int32_t t : chosen_)
@@ -206,7 +206,7 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
         });
         block += static_cast<int32_t>(block_count(members_.size()));
     }
-    out.block_begin[4] = block;
+    out.block_begin[SH_MATERIAL_COUNT] = block;
 
     // The body's surface triangles on a buffer tet.
     const vec<int32_t>& tris = body.surface_triangles;
@@ -266,10 +266,10 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], Bu
     out.surface_node_count = surface;
 
     for (int k = 0; k < 3; ++k) out.gravity[k] = gravity[k];
-    out.damping_mass = body.settings.damping_mass;
+    out.damping_mass = body.damping_mass;
     out.damping_stiffness = body.damping_stiffness();
     out.dt_stable = body.stable_step_of(chosen_.data(), chosen_.size());
-    out.runaway_speed = body.settings.runaway_speed;
+    out.runaway_speed = runaway_speed;
 
     for (const int32_t node : ring_) local_of_[static_cast<size_t>(node)] = -1;
     for (const int32_t t : chosen_) in_buffer_[static_cast<size_t>(t)] = 0;
@@ -323,7 +323,7 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
     if (const BodyContacts* contacts = world.contacts_of(near.body))
         contacts->mark_nodes_of_other_contacts(&tool, other_contact_.data());
     select_tets(*near.fem, near.point, near.triangle, out);
-    fill_buffer(*near.fem, world.gravity, out);
+    fill_buffer(*near.fem, world.gravity, world.step_settings(near.body).runaway_speed, out);
 }
 
 }  // namespace sh

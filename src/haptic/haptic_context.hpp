@@ -72,7 +72,7 @@ private:
     // sim side
     void extract(World& world, double period, Buffer& out);
     void select_tets(const FemBody& body, const double center[3], int32_t seed_triangle, Buffer& out);
-    void fill_buffer(const FemBody& body, const double gravity[3], Buffer& out);
+    void fill_buffer(const FemBody& body, const double gravity[3], double runaway_speed, Buffer& out);
     void ensure_adjacency(const FemBody& body, sh_body_id id);
 
     // haptic side

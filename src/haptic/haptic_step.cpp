@@ -5,7 +5,7 @@
 #include "contact/shape_contact.hpp"
 #include "core/vec3.hpp"
 #include "haptic/haptic_context.hpp"
-#include "material/tet_materials.hpp"
+#include "material/material_table.hpp"
 #include "model/fem_kernel.hpp"
 
 #include <algorithm>

@@ -17,16 +17,9 @@ std::atomic<uint64_t> g_next_pattern_id{1};
 // Largest nodes per element: local indices (3k)^2 - 1 must fit a uint16_t.
 constexpr int kMaxNodesPerElement = 85;
 
-}  // namespace
-
-void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, int nodes_per_element,
-                                 const int32_t* free_index, int32_t node_count, int32_t free_count) {
-    // Start empty, so a failure below (bad input, std::bad_alloc) leaves an empty system.
-    {
-        SparseSystem empty;
-        std::swap(*this, empty);
-    }
-
+// Checks build_pattern's arguments (see the header).
+void check_pattern_input(const int32_t* elements, size_t element_count, int nodes_per_element,
+                         const int32_t* free_index, int32_t node_count, int32_t free_count) {
     SH_REQUIRE(nodes_per_element >= 1 && nodes_per_element <= kMaxNodesPerElement, SH_ERR_INVALID_ARGUMENT,
                "sparse system: nodes_per_element %d is not in [1, %d]", nodes_per_element, kMaxNodesPerElement);
     SH_REQUIRE(node_count >= 0 && free_count >= 0 && free_count <= node_count, SH_ERR_INVALID_ARGUMENT,
@@ -37,11 +30,14 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
     SH_REQUIRE(node_count == 0 || free_index, SH_ERR_INVALID_ARGUMENT, "sparse system: free_index is NULL");
     const size_t k = static_cast<size_t>(nodes_per_element);
     SH_REQUIRE(element_count <= SIZE_MAX / k, SH_ERR_INVALID_ARGUMENT, "sparse system: element count overflows");
+    for (size_t i = 0; i < element_count * k; ++i)
+        SH_REQUIRE(elements[i] >= 0 && elements[i] < node_count, SH_ERR_INVALID_ARGUMENT,
+                   "sparse system: element %zu node %zu is %d, not in [0, %d)", i / k, i % k, elements[i], node_count);
+}
 
+// Free DOF -> global DOF, checking that free_index is one-to-one onto [0, free_count).
+vec<int32_t> free_dofs(const int32_t* free_index, int32_t node_count, int32_t free_count) {
     const size_t nfree = static_cast<size_t>(free_count);
-    const int32_t dofs = 3 * free_count;
-
-    // Free node -> node, checking that free_index is one-to-one onto [0, free_count).
     vec<int32_t> dof_to_global(3 * nfree, -1);
     for (int32_t i = 0; i < node_count; ++i) {
         const int32_t f = free_index[i];
@@ -56,13 +52,20 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
     for (size_t f = 0; f < nfree; ++f)
         SH_REQUIRE(dof_to_global[3 * f] >= 0, SH_ERR_INVALID_ARGUMENT,
                    "sparse system: no node has free index %zu (free_count %d)", f, free_count);
-    for (size_t i = 0; i < element_count * k; ++i)
-        SH_REQUIRE(elements[i] >= 0 && elements[i] < node_count, SH_ERR_INVALID_ARGUMENT,
-                   "sparse system: element %zu node %zu is %d, not in [0, %d)", i / k, i % k, elements[i], node_count);
+    return dof_to_global;
+}
 
-    // Node-block pattern of the strict upper triangle: for free column node J, the sorted free row
-    // nodes I < J sharing an element with it. Counted, filled, then sorted and deduplicated.
-    vec<size_t> block_start(nfree + 1, 0);
+// The node-block pattern of the strict upper triangle: for free column node J, the sorted,
+// distinct free row nodes I < J sharing an element with it, rows[start[J], start[J + 1]).
+struct NodeBlocks {
+    vec<size_t> start;
+    vec<int32_t> rows;
+};
+
+NodeBlocks upper_node_blocks(const int32_t* elements, size_t element_count, size_t k, const int32_t* free_index,
+                             size_t nfree) {
+    NodeBlocks blocks;
+    blocks.start.assign(nfree + 1, 0);
     auto for_each_pair = [&](auto&& visit) {
         for (size_t e = 0; e < element_count; ++e) {
             const int32_t* en = elements + e * k;
@@ -76,55 +79,58 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
             }
         }
     };
-    for_each_pair([&](int32_t, int32_t col) { ++block_start[static_cast<size_t>(col) + 1]; });
-    for (size_t j = 0; j < nfree; ++j) block_start[j + 1] += block_start[j];
-    vec<int32_t> block_rows(block_start[nfree]);
+    // Counted, filled, then sorted and deduplicated per column.
+    for_each_pair([&](int32_t, int32_t col) { ++blocks.start[static_cast<size_t>(col) + 1]; });
+    for (size_t j = 0; j < nfree; ++j) blocks.start[j + 1] += blocks.start[j];
+    blocks.rows.resize(blocks.start[nfree]);
     {
-        vec<size_t> fill(block_start.begin(), block_start.end() - 1);
-        for_each_pair([&](int32_t row, int32_t col) { block_rows[fill[static_cast<size_t>(col)]++] = row; });
+        vec<size_t> fill(blocks.start.begin(), blocks.start.end() - 1);
+        for_each_pair([&](int32_t row, int32_t col) { blocks.rows[fill[static_cast<size_t>(col)]++] = row; });
     }
     size_t unique_blocks = 0;
     for (size_t j = 0; j < nfree; ++j) {
-        int32_t* first = block_rows.data() + block_start[j];
-        int32_t* last = block_rows.data() + block_start[j + 1];
+        int32_t* first = blocks.rows.data() + blocks.start[j];
+        int32_t* last = blocks.rows.data() + blocks.start[j + 1];
         std::sort(first, last);
         last = std::unique(first, last);
         const size_t start = unique_blocks;
-        for (int32_t* p = first; p != last; ++p) block_rows[unique_blocks++] = *p;
-        block_start[j] = start;
+        for (int32_t* p = first; p != last; ++p) blocks.rows[unique_blocks++] = *p;
+        blocks.start[j] = start;
     }
-    block_start[nfree] = unique_blocks;
-    block_rows.resize(unique_blocks);
+    blocks.start[nfree] = unique_blocks;
+    blocks.rows.resize(unique_blocks);
+    return blocks;
+}
 
-    const uint64_t nnz = 6 * static_cast<uint64_t>(nfree) + 9 * static_cast<uint64_t>(unique_blocks);
-    SH_REQUIRE(nnz <= static_cast<uint64_t>(INT32_MAX), SH_ERR_CAPACITY,
-               "sparse system: %" PRIu64 " stored entries exceed 2^31 - 1", nnz);
-
-    // Expand node blocks to DOF columns: column 3J+c holds rows 3I..3I+2 of each block row I < J,
-    // then the diagonal block's rows 3J..3J+c (so the diagonal entry comes last).
-    vec<int32_t> column_starts(static_cast<size_t>(dofs) + 1);
-    vec<int32_t> row_indices(static_cast<size_t>(nnz));
-    {
-        int32_t p = 0;
-        for (size_t j = 0; j < nfree; ++j) {
-            for (int c = 0; c < 3; ++c) {
-                column_starts[3 * j + c] = p;
-                for (size_t b = block_start[j]; b < block_start[j + 1]; ++b)
-                    for (int r = 0; r < 3; ++r) row_indices[static_cast<size_t>(p++)] = 3 * block_rows[b] + r;
-                for (int r = 0; r <= c; ++r) row_indices[static_cast<size_t>(p++)] = 3 * static_cast<int32_t>(j) + r;
-            }
+// Expands node blocks to DOF columns: column 3J+c holds rows 3I..3I+2 of each block row I < J,
+// then the diagonal block's rows 3J..3J+c (so the diagonal entry comes last).
+void expand_columns(const NodeBlocks& blocks, size_t nfree, vec<int32_t>& column_starts, vec<int32_t>& row_indices) {
+    int32_t p = 0;
+    for (size_t j = 0; j < nfree; ++j) {
+        for (int c = 0; c < 3; ++c) {
+            column_starts[3 * j + c] = p;
+            for (size_t b = blocks.start[j]; b < blocks.start[j + 1]; ++b)
+                for (int r = 0; r < 3; ++r) row_indices[static_cast<size_t>(p++)] = 3 * blocks.rows[b] + r;
+            for (int r = 0; r <= c; ++r) row_indices[static_cast<size_t>(p++)] = 3 * static_cast<int32_t>(j) + r;
         }
-        column_starts[static_cast<size_t>(dofs)] = p;
     }
+    column_starts[3 * nfree] = p;
+}
 
-    // Element scatter map, one record per 3x3 block. Local node pair (a, b) with free indices
-    // I <= J maps Ke's block (rows 3a.., columns 3b..) to the global block (3I.., 3J..): entry
-    // (r, s) goes to slot column_start(3J+s) + 3 * (position of I among column J's block rows) + r,
-    // the diagonal block (I == J) coming after all block rows and keeping only r <= s. Pairs with
-    // I > J are left out: their entries lie in the lower triangle (the pair (b, a) supplies them).
-    // That is exactly "local (p, q) is added when g(p) <= g(q)", also for a repeated node.
+}  // namespace
+
+// Element scatter map, one record per 3x3 block. Local node pair (a, b) with free indices
+// I <= J maps Ke's block (rows 3a.., columns 3b..) to the global block (3I.., 3J..): entry
+// (r, s) goes to slot column_start(3J+s) + 3 * (position of I among column J's block rows) + r,
+// the diagonal block (I == J) coming after all block rows and keeping only r <= s. Pairs with
+// I > J are left out: their entries lie in the lower triangle (the pair (b, a) supplies them).
+// That is exactly "local (p, q) is added when g(p) <= g(q)", also for a repeated node.
+void SparseSystem::build_scatter_map(const int32_t* elements, size_t element_count, size_t k,
+                                     const int32_t* free_index, const vec<size_t>& block_start,
+                                     const vec<int32_t>& block_rows, const vec<int32_t>& column_starts,
+                                     vec<size_t>& record_start, vec<BlockRecord>& records) {
     const size_t n3 = 3 * k;
-    vec<size_t> block_record_start(element_count + 1, 0);
+    record_start.assign(element_count + 1, 0);
     auto element_blocks = [&](size_t e, auto&& visit) {
         const int32_t* en = elements + e * k;
         for (size_t a = 0; a < k; ++a) {
@@ -140,34 +146,56 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
     for (size_t e = 0; e < element_count; ++e) {
         size_t count = 0;
         element_blocks(e, [&](size_t, size_t, int32_t, int32_t) { ++count; });
-        block_record_start[e + 1] = block_record_start[e] + count;
+        record_start[e + 1] = record_start[e] + count;
     }
-    vec<BlockRecord> block_records(block_record_start[element_count]);
+    records.resize(record_start[element_count]);
     for (size_t e = 0; e < element_count; ++e) {
-        size_t i = block_record_start[e];
+        size_t i = record_start[e];
         element_blocks(e, [&](size_t a, size_t b, int32_t fi, int32_t fj) {
             const size_t j = static_cast<size_t>(fj);
             const int32_t* rows = block_rows.data() + block_start[j];
             const size_t count = block_start[j + 1] - block_start[j];
             const size_t pos = fi == fj ? count : static_cast<size_t>(std::lower_bound(rows, rows + count, fi) - rows);
-            BlockRecord& rec = block_records[i++];
+            BlockRecord& rec = records[i++];
             for (size_t c = 0; c < 3; ++c) rec.slot[c] = column_starts[3 * j + c] + static_cast<int32_t>(3 * pos);
             rec.local = static_cast<uint16_t>(3 * a * n3 + 3 * b);
             rec.diagonal = fi == fj ? 1 : 0;
         });
     }
+}
 
+void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, int nodes_per_element,
+                                 const int32_t* free_index, int32_t node_count, int32_t free_count) {
+    // Start empty, so a failure below (bad input, std::bad_alloc) leaves an empty system.
+    {
+        SparseSystem empty;
+        std::swap(*this, empty);
+    }
+    check_pattern_input(elements, element_count, nodes_per_element, free_index, node_count, free_count);
+    const size_t k = static_cast<size_t>(nodes_per_element), nfree = static_cast<size_t>(free_count);
+    vec<int32_t> dof_to_global = free_dofs(free_index, node_count, free_count);
+    const NodeBlocks blocks = upper_node_blocks(elements, element_count, k, free_index, nfree);
+    const uint64_t nnz = 6 * static_cast<uint64_t>(nfree) + 9 * static_cast<uint64_t>(blocks.rows.size());
+    SH_REQUIRE(nnz <= static_cast<uint64_t>(INT32_MAX), SH_ERR_CAPACITY,
+               "sparse system: %" PRIu64 " stored entries exceed 2^31 - 1", nnz);
+    vec<int32_t> column_starts(3 * nfree + 1);
+    vec<int32_t> row_indices(static_cast<size_t>(nnz));
+    expand_columns(blocks, nfree, column_starts, row_indices);
+    vec<size_t> record_start;
+    vec<BlockRecord> records;
+    build_scatter_map(elements, element_count, k, free_index, blocks.start, blocks.rows, column_starts, record_start,
+                      records);
     vec<double> values(static_cast<size_t>(nnz), 0.0);
 
-    dof_count_ = dofs;
+    dof_count_ = 3 * free_count;
     element_count_ = element_count;
     column_starts_.swap(column_starts);
     row_indices_.swap(row_indices);
     values_.swap(values);
     dof_to_global_.swap(dof_to_global);
-    local_size_ = static_cast<int32_t>(n3);
-    block_record_start_.swap(block_record_start);
-    block_records_.swap(block_records);
+    local_size_ = static_cast<int32_t>(3 * k);
+    block_record_start_.swap(record_start);
+    block_records_.swap(records);
     pattern_id_ = g_next_pattern_id.fetch_add(1);
 }
 

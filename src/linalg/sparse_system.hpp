@@ -79,6 +79,13 @@ private:
     int32_t local_size_ = 0;  // 3k
     vec<size_t> block_record_start_;
     vec<BlockRecord> block_records_;
+
+    /// The element scatter map (records per element, see sparse_system.cpp) over the node
+    /// blocks (block_start, block_rows) and DOF columns (column_starts) of the pattern.
+    static void build_scatter_map(const int32_t* elements, size_t element_count, size_t k, const int32_t* free_index,
+                                  const vec<size_t>& block_start, const vec<int32_t>& block_rows,
+                                  const vec<int32_t>& column_starts, vec<size_t>& record_start,
+                                  vec<BlockRecord>& records);
 };
 
 }  // namespace sh

@@ -12,6 +12,9 @@ void validate_material(const sh_material& material, const char* context);
 /// Poisson's ratio above which linear (4-node) tets lock: SH_WARN_LOCKING.
 constexpr double kLockingPoisson = 0.45;
 
+/// True if material makes linear tets lock (too stiff when nearly incompressible).
+inline bool locks_linear_tets(const sh_material& material) { return material.poisson > kLockingPoisson; }
+
 /// Lame lambda (Pa) of an isotropic material.
 double lame_lambda(const sh_material& material);
 

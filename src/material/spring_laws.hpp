@@ -1,7 +1,8 @@
-// Force laws of springs: tension as a function of elongation, its slope and its energy.
+// Force laws of springs: tension as a function of elongation, its slope and its energy, each
+// answered by the law's row of the spring-law table (spring_law_kind.hpp).
 #pragma once
 
-#include "core/memory.hpp"
+#include "material/spring_law_kind.hpp"
 
 #include <softhap/softhap.h>
 
@@ -14,26 +15,20 @@ public:
     explicit SpringLaw(const sh_spring_params& params);
 
     /// Tension (N, positive when stretched) of a spring of rest length l0 at length l.
-    double tension(double l, double l0) const;
+    double tension(double l, double l0) const { return row_->tension(data_, l, l0); }
 
     /// d tension / d l (N/m) at length l.
-    double stiffness(double l, double l0) const;
+    double stiffness(double l, double l0) const { return row_->stiffness(data_, l, l0); }
 
     /// Energy stored (J): the integral of tension from l0 to l.
-    double energy(double l, double l0) const;
+    double energy(double l, double l0) const { return row_->energy(data_, l, l0); }
 
     /// Dashpot coefficient c (N s/m).
-    double damping() const { return params_.damping; }
+    double damping() const { return data_.params.damping; }
 
 private:
-    /// Monotone cubic (Fritsch-Carlson) through the table, linear beyond its ends.
-    double curve(double strain) const;
-    double curve_slope(double strain) const;
-    double curve_integral(double strain) const;  ///< integral of curve from strain 0
-
-    sh_spring_params params_;
-    vec<double> strain_, force_, slope_;  ///< table knots and Hermite slopes
-    vec<double> knot_integral_;           ///< integral of curve from strain_[0] to each knot
+    const SpringLawKind* row_;  ///< the law's row of the spring-law table
+    SpringLawData data_;
 };
 
 }  // namespace sh

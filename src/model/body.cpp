@@ -7,7 +7,7 @@
 
 namespace sh {
 
-Body::Body(IntegrationSettings s, vec<double> rest_positions) : settings(s), x(std::move(rest_positions)) {
+Body::Body(vec<double> rest_positions, double alpha) : damping_mass(alpha), x(std::move(rest_positions)) {
     rest = x;
     const size_t n = x.size() / 3;
     v.assign(3 * n, 0.0);
@@ -16,18 +16,49 @@ Body::Body(IntegrationSettings s, vec<double> rest_positions) : settings(s), x(s
     kinematic.assign(n, 0);
     target = x;
     external_force.assign(3 * n, 0.0);
-    IntegratorWorkspace& w = workspace;
-    w.x0.resize(3 * n);
-    w.v0.resize(3 * n);
-    w.xs.resize(3 * n);
-    w.vs.resize(3 * n);
-    for (auto& a : w.a) a.resize(3 * n);
-    w.dx.resize(3 * n);
 }
 
 void Body::update_inverse_mass() {
     for (size_t i = 0; i < mass.size(); ++i)
         inverse_mass[i] = (mass[i] > 0.0 && !kinematic[i]) ? 1.0 / mass[i] : 0.0;
+}
+
+void Body::set_positions(const double* positions) {
+    std::copy(positions, positions + x.size(), x.begin());
+    for (size_t i = 0; i < kinematic.size(); ++i)
+        if (kinematic[i])
+            for (int k = 0; k < 3; ++k) target[3 * i + k] = x[3 * i + k];
+}
+
+void Body::set_velocities(const double* velocities) {
+    for (size_t i = 0; i < mass.size(); ++i)
+        for (int k = 0; k < 3; ++k) v[3 * i + k] = inverse_mass[i] > 0.0 ? velocities[3 * i + k] : 0.0;
+}
+
+void Body::fix_nodes(const int32_t* nodes, int32_t count) {
+    for (int32_t n = 0; n < count; ++n) {
+        const size_t i = static_cast<size_t>(nodes[n]);
+        kinematic[i] = 1;
+        for (int k = 0; k < 3; ++k) {
+            target[3 * i + k] = x[3 * i + k];
+            v[3 * i + k] = 0.0;
+        }
+    }
+    update_inverse_mass();
+}
+
+void Body::release_nodes(const int32_t* nodes, int32_t count) {
+    for (int32_t n = 0; n < count; ++n) kinematic[static_cast<size_t>(nodes[n])] = 0;
+    update_inverse_mass();
+}
+
+void Body::prescribe_positions(const int32_t* nodes, const double* positions, int32_t count) {
+    for (int32_t n = 0; n < count; ++n) {
+        const size_t i = static_cast<size_t>(nodes[n]);
+        kinematic[i] = 1;
+        for (int k = 0; k < 3; ++k) target[3 * i + k] = positions[3 * n + k];
+    }
+    update_inverse_mass();
 }
 
 void Body::set_node_damping(const double* coefficients) {
@@ -36,16 +67,6 @@ void Body::set_node_damping(const double* coefficients) {
     else
         node_damping = vec<double>();
     ++matrix_version;
-}
-
-double Body::critical_dt() const {
-    if (settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER) return INFINITY;  // unconditionally stable
-    // Stability limits on the imaginary axis relative to leapfrog's 2/omega: RK4 reaches
-    // 2*sqrt(2)/omega. Forward Euler and RK2 have no undamped stable step at all (their energy
-    // grows at every dt); they get the leapfrog limit, beyond which growth is explosive.
-    const double factor = settings.integrator == SH_INTEGRATOR_RK4 ? 1.4142135623730951 : 1.0;
-    const double own = factor * stable_step(x.data());
-    return field ? std::min(own, factor * field->stable_step(x.data(), v.data(), mass.data())) : own;
 }
 
 }  // namespace sh

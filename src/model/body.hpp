@@ -13,27 +13,11 @@ namespace sh {
 class ExternalField;
 class SparseSystem;
 
-/// Per-body integration settings shared by FEM and mass-spring bodies.
-struct IntegrationSettings {
-    sh_integrator integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
-    sh_unstable_policy on_unstable = SH_UNSTABLE_SUBSTEP;
-    sh_implicit_settings implicit{};   ///< read for SH_INTEGRATOR_IMPLICIT_EULER
-    double damping_mass = 0.0;   ///< alpha (1/s)
-    double runaway_speed = 1e4;  ///< m/s
-};
-
-/// Scratch arrays of the integrators, sized once when the body is built.
-struct IntegratorWorkspace {
-    vec<double> x0, v0;                 ///< state at the start of the step (rollback)
-    vec<double> xs, vs;                 ///< stage state
-    vec<double> a[4];                   ///< stage accelerations
-    vec<double> dx;                     ///< RK4 accumulated velocity
-};
-
 /// A deformable body. Orphan nodes have zero mass and are never integrated.
 class Body {
 public:
-    Body(IntegrationSettings settings, vec<double> rest_positions);
+    /// A body at rest at rest_positions (3 per node), with Rayleigh mass damping alpha (1/s).
+    Body(vec<double> rest_positions, double damping_mass);
     virtual ~Body() = default;
     Body(const Body&) = delete;
     Body& operator=(const Body&) = delete;
@@ -77,14 +61,27 @@ public:
     /// Starts a new count for inverted_elements (at the start of each step).
     virtual void clear_inverted_elements() {}
 
-    /// Critical step of this body's integrator at the current state (s).
-    double critical_dt() const;
-
     /// True if node i is integrated (has mass, not fixed or prescribed).
     bool is_free(int32_t i) const { return inverse_mass[static_cast<size_t>(i)] > 0.0; }
 
     /// Recomputes inverse_mass from mass and kinematic.
     void update_inverse_mass();
+
+    /// Moves every node to positions (3 per node); fixed and prescribed nodes stay held where
+    /// they are put.
+    void set_positions(const double* positions);
+
+    /// Sets the velocities (3 per node) of the nodes that are integrated; the others keep 0.
+    void set_velocities(const double* velocities);
+
+    /// Holds nodes[0..count) where they are, at rest.
+    void fix_nodes(const int32_t* nodes, int32_t count);
+
+    /// Lets nodes[0..count) move again.
+    void release_nodes(const int32_t* nodes, int32_t count);
+
+    /// Moves nodes[0..count) to positions (3 per node) over the next step and holds them there.
+    void prescribe_positions(const int32_t* nodes, const double* positions, int32_t count);
 
     /// The applied load on global DOF j = 3 node + c: external force plus the node's weight
     /// under gravity g (N).
@@ -92,7 +89,7 @@ public:
 
     /// Viscous mass damping of node (1/s): Rayleigh alpha plus its own node_damping.
     double mass_damping(size_t node) const {
-        return settings.damping_mass + (node_damping.empty() ? 0.0 : node_damping[node]);
+        return damping_mass + (node_damping.empty() ? 0.0 : node_damping[node]);
     }
 
     /// Replaces node_damping by coefficients[node_count()] (1/s), or clears it for null.
@@ -100,7 +97,7 @@ public:
 
     int32_t node_count() const { return static_cast<int32_t>(mass.size()); }
 
-    IntegrationSettings settings;
+    double damping_mass = 0.0;   ///< Rayleigh alpha: viscous damping of every node (1/s)
     vec<double> x, v;            ///< 3 per node (m, m/s)
     vec<double> rest;            ///< the rest shape, 3 per node (m)
     vec<double> mass;            ///< lumped mass per node (kg); 0 for orphans
@@ -117,7 +114,6 @@ public:
     /// Forces from outside the body (contact), attached by the world during a step; null when
     /// nothing touches the body.
     const ExternalField* field = nullptr;
-    IntegratorWorkspace workspace;
 };
 
 }  // namespace sh

@@ -2,7 +2,7 @@
 
 #include "core/error.hpp"
 #include "material/material_params.hpp"
-#include "material/tet_materials.hpp"
+#include "material/material_table.hpp"
 #include "model/fem_kernel.hpp"
 
 #include <Eigen/Dense>
@@ -62,8 +62,8 @@ vec<uint32_t> locality_order(const vec<int32_t>& tets, const vec<double>& p) {
 
 }  // namespace
 
-FemBody::FemBody(const TetMesh& mesh, const sh_material& material, IntegrationSettings s, double damping_stiffness)
-    : Body(s, mesh.nodes), tets_(mesh.tets), damping_stiffness_(damping_stiffness) {
+FemBody::FemBody(const TetMesh& mesh, const sh_material& material, double damping_mass, double damping_stiffness)
+    : Body(mesh.nodes, damping_mass), tets_(mesh.tets), damping_stiffness_(damping_stiffness) {
     surface_triangles = mesh.surface_triangles;
     const size_t tet_count = tets_.size() / 4;
     inverse_rest_.resize(9 * tet_count);
@@ -97,9 +97,9 @@ void FemBody::rebuild(vec<sh_material> materials) {
     for (size_t t = 0; t < tet_count; ++t)
         for (int a = 0; a < 4; ++a) new_mass[static_cast<size_t>(tets_[4 * t + a])] += materials[t].density * volume_[t] / 4.0;
 
-    vec<TetBlock> new_blocks[4];
+    vec<TetBlock> new_blocks[SH_MATERIAL_COUNT];
     const vec<uint32_t> order = locality_order(tets_, x);
-    for (int model = 0; model < 4; ++model) {
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         vec<uint32_t> members;
         for (const uint32_t t : order)
             if (materials[t].model == model) members.push_back(t);
@@ -121,7 +121,7 @@ void FemBody::rebuild(vec<sh_material> materials) {
 
     materials_.swap(materials);
     mass.swap(new_mass);
-    for (int model = 0; model < 4; ++model) blocks_[model].swap(new_blocks[model]);
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) blocks_[model].swap(new_blocks[model]);
     ++matrix_version;
     update_inverse_mass();
 }

@@ -10,10 +10,9 @@ namespace sh {
 /// Explicit tetrahedral FEM body. Elements are grouped by material model into TetBlocks.
 class FemBody final : public Body {
 public:
-    /// Builds the body from mesh's rest shape with one material everywhere. damping_stiffness
-    /// is Rayleigh beta (s).
-    FemBody(const TetMesh& mesh, const sh_material& material, IntegrationSettings settings,
-            double damping_stiffness);
+    /// Builds the body from mesh's rest shape with one material everywhere, Rayleigh damping
+    /// alpha = damping_mass (1/s) and beta = damping_stiffness (s).
+    FemBody(const TetMesh& mesh, const sh_material& material, double damping_mass, double damping_stiffness);
 
     /// Sets the material of the listed elements; recomputes masses, blocks and the stable step.
     void set_material(const int32_t* elements, int32_t count, const sh_material& material);
@@ -55,7 +54,7 @@ private:
     vec<double> inverse_rest_;   ///< Bm = Dm^-1, 9 per tet, row-major
     vec<double> volume_;         ///< V0 per tet
     vec<sh_material> materials_; ///< per tet
-    vec<TetBlock> blocks_[4];    ///< per sh_material_model
+    vec<TetBlock> blocks_[SH_MATERIAL_COUNT];  ///< per sh_material_model
     double damping_stiffness_;
     double stable_step_ = 0.0;   ///< 2/omega_max at rest, with stiffness damping
     vec<double> element_omega2_; ///< per tet: its largest squared frequency (Irons-Treharne)

@@ -1,11 +1,12 @@
 // Tangent stiffness of FEM bodies for the implicit and static solvers:
 // K_e = V0 G^T C G with C = dP/dF (9x9, from each material's differential on the unit basis of F)
 // and G the map from nodal displacements to F (dF_kj / dx_ak = g_a[j], g_a the shape-function
-// gradients). For StVK and neo-Hookean, C is projected to positive semi-definite per element.
+// gradients). For the laws whose C can be indefinite (kProjectTangent in the material table),
+// C is projected to positive semi-definite per element.
 #include "model/fem_body.hpp"
 
 #include "material/material_params.hpp"
-#include "material/tet_materials.hpp"
+#include "material/material_table.hpp"
 #include "linalg/sparse_system.hpp"
 
 #include <Eigen/Dense>
@@ -61,16 +62,16 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
             mu[l] = lame_mu(materials_[t]);
         }
         Matrix9 C[kLanes];
-        switch (model) {
-            case SH_MATERIAL_LINEAR: stress_derivatives<LinearMaterial>(F, lambda, mu, C); break;
-            case SH_MATERIAL_STVK: stress_derivatives<StvkMaterial>(F, lambda, mu, C); break;
-            case SH_MATERIAL_COROTATIONAL: stress_derivatives<CorotationalMaterial>(F, lambda, mu, C); break;
-            default: stress_derivatives<NeoHookeanMaterial>(F, lambda, mu, C); break;
-        }
+        bool project = false;
+        visit_material(model, [&](auto law) {
+            using Law = decltype(law);
+            stress_derivatives<Law>(F, lambda, mu, C);
+            project = Law::kProjectTangent;
+        });
         for (int l = 0; l < count; ++l) {
             const size_t t = static_cast<size_t>(members[l]);
             Matrix9 c = 0.5 * (C[l] + C[l].transpose());
-            if (model == SH_MATERIAL_STVK || model == SH_MATERIAL_NEOHOOKEAN) project_positive(c);
+            if (project) project_positive(c);
             const double* bm = &inverse_rest_[9 * t];
             double g[4][3];
             for (int j = 0; j < 3; ++j) {
@@ -96,8 +97,8 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
         }
     };
 
-    int32_t batch[4][kLanes];
-    int filled[4] = {0, 0, 0, 0};
+    int32_t batch[SH_MATERIAL_COUNT][kLanes];
+    int filled[SH_MATERIAL_COUNT] = {};
     for (size_t t = 0; t < tet_count; ++t) {
         const int model = materials_[t].model;
         batch[model][filled[model]++] = static_cast<int32_t>(t);
@@ -106,7 +107,7 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
             filled[model] = 0;
         }
     }
-    for (int model = 0; model < 4; ++model)
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
         if (filled[model] > 0) process(model, batch[model], filled[model]);
 }
 

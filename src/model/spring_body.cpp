@@ -9,8 +9,8 @@
 namespace sh {
 
 SpringBody::SpringBody(vec<double> nodes, vec<int32_t> springs, const sh_spring_params& params,
-                       const vec<double>& masses, IntegrationSettings s)
-    : Body(s, std::move(nodes)), springs_(std::move(springs)), law_(params) {
+                       const vec<double>& masses, double damping_mass)
+    : Body(std::move(nodes), damping_mass), springs_(std::move(springs)), law_(params) {
     const int32_t n = node_count();
     const size_t spring_count = springs_.size() / 2;
     vec<uint8_t> on_spring(static_cast<size_t>(n), 0);

@@ -9,10 +9,11 @@ namespace sh {
 /// Mass-spring body. Rest lengths are the initial lengths.
 class SpringBody final : public Body {
 public:
-    /// nodes: 3 per node; springs: 2 node indices per spring; masses: one per node (> 0).
-    /// Throws SH_ERR_INVALID_ARGUMENT naming the spring or node that is invalid.
+    /// nodes: 3 per node; springs: 2 node indices per spring; masses: one per node (> 0);
+    /// damping_mass: Rayleigh alpha (1/s). Throws SH_ERR_INVALID_ARGUMENT naming the spring or
+    /// node that is invalid.
     SpringBody(vec<double> nodes, vec<int32_t> springs, const sh_spring_params& params, const vec<double>& masses,
-               IntegrationSettings settings);
+               double damping_mass);
 
     void add_internal_forces(const double* x, const double* v, double* f) const override;
     bool has_internal_damping() const override { return law_.damping() > 0.0; }

@@ -16,28 +16,26 @@ uint64_t link_key(int32_t i, int32_t j) {
 
 }  // namespace
 
-void CoupledSystem::prepare(Body* const* bodies, ImplicitState* const* states, int32_t count,
-                            const sh_implicit_settings& settings) {
+void CoupledSystem::prepare(SteppedBody* const* bodies, int32_t count, const sh_implicit_settings& settings) {
     bool rebuild = !solver || member_count() != count;
     if (member_count() != count) members_.resize(static_cast<size_t>(count));
     int32_t offset = 0;
     for (int32_t m = 0; m < count; ++m) {
         CoupledMember& member = members_[static_cast<size_t>(m)];
-        const int32_t dofs = prepare_implicit_state(*bodies[m], *states[m], bodies[m]->settings.implicit, false);
-        rebuild |= member.body != bodies[m] || member.offset != offset ||
-                   member.pattern_id != states[m]->system.pattern_id();
-        member.body = bodies[m];
-        member.state = states[m];
+        ImplicitState& state = *bodies[m]->implicit;
+        const int32_t dofs = prepare_implicit_state(*bodies[m]->body, state, bodies[m]->settings.implicit, false);
+        rebuild |= member.stepped != bodies[m] || member.offset != offset || member.pattern_id != state.system.pattern_id();
+        member.stepped = bodies[m];
         member.offset = offset;
-        states[m]->factor_valid = false;  // its system holds this solve's values from now on
+        state.factor_valid = false;  // its system holds this solve's values from now on
         offset += dofs;
     }
     if (rebuild)
         for (CoupledMember& member : members_) {
-            const int32_t n = member.body->node_count();
+            const int32_t n = member.body().node_count();
             member.joint_index.assign(static_cast<size_t>(n), -1);
             for (int32_t i = 0; i < n; ++i) {
-                const int32_t f = member.state->free_index[static_cast<size_t>(i)];
+                const int32_t f = member.state().free_index[static_cast<size_t>(i)];
                 if (f >= 0) member.joint_index[static_cast<size_t>(i)] = member.offset / 3 + f;
             }
         }
@@ -53,18 +51,18 @@ void CoupledSystem::prepare(Body* const* bodies, ImplicitState* const* states, i
 
 uint64_t CoupledSystem::matrix_version() const {
     uint64_t version = 0;
-    for (const CoupledMember& m : members_) version += m.body->matrix_version;
+    for (const CoupledMember& m : members_) version += m.body().matrix_version;
     return version;
 }
 
 void CoupledSystem::collect_links() {
     needed_.clear();
     for (const CoupledMember& a : members_) {
-        if (!a.body->field) continue;
+        if (!a.body().field) continue;
         for (const CoupledMember& b : members_) {
             if (&a == &b) continue;
             pairs_.clear();
-            a.body->field->add_coupling_pattern(*b.body, a.joint_index.data(), b.joint_index.data(), pairs_);
+            a.body().field->add_coupling_pattern(b.body(), a.joint_index.data(), b.joint_index.data(), pairs_);
             for (size_t p = 0; p < pairs_.size(); p += 2) needed_.push_back(link_key(pairs_[p], pairs_[p + 1]));
         }
     }
@@ -78,7 +76,7 @@ void CoupledSystem::build(vec<uint64_t>& links, const sh_implicit_settings& sett
     int32_t nodes = 0;
     vec<int32_t> elements;
     for (const CoupledMember& m : members_) {
-        const SparseSystem& own = m.state->system;
+        const SparseSystem& own = m.state().system;
         const vec<int32_t>& starts = own.column_starts();
         const vec<int32_t>& rows = own.row_indices();
         const int32_t base = m.offset / 3;
@@ -104,7 +102,7 @@ void CoupledSystem::build(vec<uint64_t>& links, const sh_implicit_settings& sett
     const vec<int32_t>& starts = joint.column_starts();
     const vec<int32_t>& rows = joint.row_indices();
     for (CoupledMember& m : members_) {
-        const SparseSystem& own = m.state->system;
+        const SparseSystem& own = m.state().system;
         m.slots.resize(own.row_indices().size());
         for (int32_t column = 0; column < own.dof_count(); ++column)
             for (int32_t p = own.column_starts()[static_cast<size_t>(column)];
@@ -127,22 +125,22 @@ void CoupledSystem::build(vec<uint64_t>& links, const sh_implicit_settings& sett
     delta.swap(d);
     previous_v.swap(p);
     factor_valid = false;
-    for (CoupledMember& m : members_) m.pattern_id = m.state->system.pattern_id();
+    for (CoupledMember& m : members_) m.pattern_id = m.state().system.pattern_id();
 }
 
 void CoupledSystem::add_member_values(const CoupledMember& m) {
-    const vec<double>& own = m.state->system.values();
+    const vec<double>& own = m.state().system.values();
     double* joint = system.values().data();
     for (size_t p = 0; p < own.size(); ++p) joint[m.slots[p]] += own[p];
 }
 
 void CoupledSystem::add_coupling(double stiffness_scale, double damping_scale, bool at_rest) {
     for (const CoupledMember& a : members_) {
-        if (!a.body->field) continue;
+        if (!a.body().field) continue;
         for (const CoupledMember& b : members_)
             if (&a != &b)
-                a.body->field->add_coupling_tangent(a.body->x.data(), at_rest ? nullptr : a.body->v.data(), stiffness_scale,
-                                                    damping_scale, a.joint_index.data(), *b.body, b.joint_index.data(),
+                a.body().field->add_coupling_tangent(a.body().x.data(), at_rest ? nullptr : a.body().v.data(), stiffness_scale,
+                                                    damping_scale, a.joint_index.data(), b.body(), b.joint_index.data(),
                                                     system);
     }
 }

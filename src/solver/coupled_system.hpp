@@ -12,12 +12,15 @@ namespace sh {
 
 /// A body of a CoupledSystem.
 struct CoupledMember {
-    Body* body = nullptr;
-    ImplicitState* state = nullptr;  ///< its own system, filled before it is added in
+    SteppedBody* stepped = nullptr;  ///< the body; its implicit state holds its own system,
+                                     ///< filled before it is added in
     int32_t offset = 0;              ///< its first DOF in the joint system
     vec<int32_t> joint_index;        ///< per node: its free-node index in the joint system, or -1
     vec<int32_t> slots;              ///< per value slot of its own system: the joint value slot
     uint64_t pattern_id = 0;         ///< its own system's pattern when the joint one was built
+
+    Body& body() const { return *stepped->body; }
+    ImplicitState& state() const { return *stepped->implicit; }
 };
 
 /// The joint system of bodies solved together. Its pattern is the union of the members' own
@@ -25,12 +28,11 @@ struct CoupledMember {
 /// across calls (and grown) while it covers what they need.
 class CoupledSystem : public NewtonSystem {
 public:
-    /// Takes bodies[0..count) with their implicit states as members, in that order: prepares
-    /// each state's own pattern (without a solver of its own) and rebuilds the joint pattern,
-    /// solver (from settings) and symbolic analysis if the members, their free nodes or their
-    /// sizes changed, or if their fields now couple nodes the pattern has no block for.
-    void prepare(Body* const* bodies, ImplicitState* const* states, int32_t count,
-                 const sh_implicit_settings& settings);
+    /// Takes bodies[0..count) (each with its implicit state) as members, in that order:
+    /// prepares each state's own pattern (without a solver of its own) and rebuilds the joint
+    /// pattern, solver (from settings) and symbolic analysis if the members, their free nodes
+    /// or their sizes changed, or if their fields now couple nodes the pattern has no block for.
+    void prepare(SteppedBody* const* bodies, int32_t count, const sh_implicit_settings& settings);
 
     int32_t member_count() const { return static_cast<int32_t>(members_.size()); }
     CoupledMember& member(int32_t m) { return members_[static_cast<size_t>(m)]; }

@@ -1,6 +1,7 @@
 #include "solver/explicit_integrator.hpp"
 
 #include "model/external_field.hpp"
+#include "solver/integrator_table.hpp"
 #include "solver/node_checks.hpp"
 #include "solver/step_support.hpp"
 
@@ -35,72 +36,55 @@ inline __m512d spread_gravity(const double g[3], int r) {
 #endif
 
 
-// y = x + h z over n values.
-void axpy(double* y, const double* x, double h, const double* z, size_t n) {
-    for (size_t i = 0; i < n; ++i) y[i] = x[i] + h * z[i];
-}
-
-void integrate(Body& body, double h, const double g[3]) {
-    IntegratorWorkspace& w = body.workspace;
+// One step of h of the explicit Runge-Kutta method t: stage i's state is the start plus h
+// times the a[i][j]-weighted earlier stages' derivatives, its derivative (its velocity, the
+// accelerations there) is kept, and the end is the start plus h times the b-weighted sum.
+void runge_kutta(Body& body, IntegratorWorkspace& w, const ButcherTableau& t, double h, const double g[3]) {
     double* x = body.x.data();
     double* v = body.v.data();
     const size_t n = body.x.size();
-    double* a0 = w.a[0].data();
-    switch (body.settings.integrator) {
-        case SH_INTEGRATOR_FORWARD_EULER:
-            compute_accelerations(body, x, v, g, a0);
-            for (size_t i = 0; i < n; ++i) {
-                x[i] += h * v[i];
-                v[i] += h * a0[i];
+    for (int i = 0; i < t.stages; ++i) {
+        double* xs = w.xs.data();
+        double* vs = w.stage_v[i].data();
+        for (size_t k = 0; k < n; ++k) {
+            double dx = 0.0, dv = 0.0;
+            for (int j = 0; j < i; ++j) {
+                dx += t.a[i][j] * w.stage_v[j][k];
+                dv += t.a[i][j] * w.stage_a[j][k];
             }
-            break;
-        case SH_INTEGRATOR_SYMPLECTIC_EULER:
-            compute_accelerations(body, x, v, g, a0);
-            for (size_t i = 0; i < n; ++i) {
-                v[i] += h * a0[i];
-                x[i] += h * v[i];
-            }
-            break;
-        case SH_INTEGRATOR_RK2: {  // explicit midpoint
-            double *xs = w.xs.data(), *vs = w.vs.data(), *a1 = w.a[1].data();
-            compute_accelerations(body, x, v, g, a0);
-            axpy(xs, x, 0.5 * h, v, n);
-            axpy(vs, v, 0.5 * h, a0, n);
-            compute_accelerations(body, xs, vs, g, a1);
-            for (size_t i = 0; i < n; ++i) {
-                x[i] += h * vs[i];
-                v[i] += h * a1[i];
-            }
-            break;
+            xs[k] = x[k] + h * dx;
+            vs[k] = v[k] + h * dv;
         }
-        case SH_INTEGRATOR_RK4: {
-            double *xs = w.xs.data(), *vs = w.vs.data(), *dx = w.dx.data(), *dv = w.a[3].data();
-            double *a1 = w.a[1].data(), *a2 = w.a[2].data();
-            compute_accelerations(body, x, v, g, a0);                 // k1 = (v, a0)
-            axpy(xs, x, 0.5 * h, v, n);
-            axpy(vs, v, 0.5 * h, a0, n);
-            for (size_t i = 0; i < n; ++i) dx[i] = v[i] + 2.0 * vs[i];
-            compute_accelerations(body, xs, vs, g, a1);               // k2 = (vs, a1)
-            axpy(xs, x, 0.5 * h, vs, n);
-            axpy(vs, v, 0.5 * h, a1, n);
-            for (size_t i = 0; i < n; ++i) dx[i] += 2.0 * vs[i];
-            compute_accelerations(body, xs, vs, g, a2);               // k3 = (vs, a2)
-            for (size_t i = 0; i < n; ++i) dv[i] = a0[i] + 2.0 * a1[i] + 2.0 * a2[i];
-            axpy(xs, x, h, vs, n);
-            axpy(vs, v, h, a2, n);
-            for (size_t i = 0; i < n; ++i) dx[i] += vs[i];
-            compute_accelerations(body, xs, vs, g, a1);               // k4 = (vs, a1)
-            for (size_t i = 0; i < n; ++i) {
-                x[i] += h / 6.0 * dx[i];
-                v[i] += h / 6.0 * (dv[i] + a1[i]);
-            }
-            break;
+        compute_accelerations(body, xs, vs, g, w.stage_a[i].data());
+    }
+    for (size_t k = 0; k < n; ++k) {
+        double dx = 0.0, dv = 0.0;
+        for (int i = 0; i < t.stages; ++i) {
+            dx += t.b[i] * w.stage_v[i][k];
+            dv += t.b[i] * w.stage_a[i][k];
         }
-        case SH_INTEGRATOR_IMPLICIT_EULER:  // stepped by step_implicit, never here
-            break;
+        x[k] += h * dx;
+        v[k] += h * dv;
     }
 }
 
+// One symplectic Euler step of h: v += h a(x, v), then x += h v.
+void symplectic_euler(Body& body, IntegratorWorkspace& w, double h, const double g[3]) {
+    double* a = w.stage_a[0].data();
+    compute_accelerations(body, body.x.data(), body.v.data(), g, a);
+    for (size_t k = 0; k < body.x.size(); ++k) {
+        body.v[k] += h * a[k];
+        body.x[k] += h * body.v[k];
+    }
+}
+
+void integrate(SteppedBody& stepped, double h, const double g[3]) {
+    const IntegratorKind& kind = integrator_kind(stepped.settings.integrator);
+    if (kind.scheme == StepScheme::RungeKutta)
+        runge_kutta(*stepped.body, stepped.workspace, kind.tableau, h, g);
+    else if (kind.scheme == StepScheme::SymplecticEuler)
+        symplectic_euler(*stepped.body, stepped.workspace, h, g);
+}
 
 }  // namespace
 
@@ -113,7 +97,7 @@ void compute_accelerations(const Body& body, const double* x, const double* v, c
     const double* fe = body.external_force.data();
     size_t i = 0;
 #if defined(__AVX512F__)
-    const double alpha = body.settings.damping_mass;
+    const double alpha = body.damping_mass;
     const bool per_node = !body.node_damping.empty();
     const __m512d gv[3] = {spread_gravity(g, 0), spread_gravity(g, 1), spread_gravity(g, 2)};
     const __m512d zero = _mm512_setzero_pd(), alpha_v = _mm512_set1_pd(alpha);
@@ -160,11 +144,12 @@ struct EulerPass {
     const double* __restrict node_damping;
     double alpha, h, limit2, g[3];
 
-    EulerPass(Body& body, double step, const double gravity[3])
-        : x(body.x.data()), v(body.v.data()), x0(body.workspace.x0.data()), v0(body.workspace.v0.data()),
-          f(body.workspace.a[0].data()), fe(body.external_force.data()), inv_mass(body.inverse_mass.data()),
-          node_damping(PerNodeDamping ? body.node_damping.data() : nullptr), alpha(body.settings.damping_mass),
-          h(step), limit2(body.settings.runaway_speed * body.settings.runaway_speed),
+    EulerPass(SteppedBody& stepped, double step, const double gravity[3])
+        : x(stepped.body->x.data()), v(stepped.body->v.data()), x0(stepped.workspace.x0.data()),
+          v0(stepped.workspace.v0.data()), f(stepped.workspace.stage_a[0].data()),
+          fe(stepped.body->external_force.data()), inv_mass(stepped.body->inverse_mass.data()),
+          node_damping(PerNodeDamping ? stepped.body->node_damping.data() : nullptr), alpha(stepped.body->damping_mass),
+          h(step), limit2(stepped.settings.runaway_speed * stepped.settings.runaway_speed),
           g{gravity[0], gravity[1], gravity[2]} {}
 
     // Node i alone; true if it is free and insane.
@@ -239,8 +224,8 @@ struct EulerPass {
 
 namespace {
 
-void roll_back(Body& body, BodyStepResult& result) {
-    restore_start_state(body);
+void roll_back(SteppedBody& stepped, BodyStepResult& result) {
+    restore_start_state(stepped);
     result.stable = false;
     result.status = SH_ERR_UNSTABLE;
     result.reason = kRolledBackReason;
@@ -248,13 +233,14 @@ void roll_back(Body& body, BodyStepResult& result) {
 
 }  // namespace
 
-BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
+BodyStepResult step_explicit(SteppedBody& stepped, double dt, const double g[3]) {
+    Body& body = *stepped.body;
     BodyStepResult result;
-    result.dt_critical = body.critical_dt();
+    result.dt_critical = critical_step(body, stepped.settings.integrator);
     double substeps = 1.0;
     if (dt > result.dt_critical) {
         substeps = std::ceil(dt / result.dt_critical);
-        if (body.settings.on_unstable == SH_UNSTABLE_REJECT || !(substeps <= kMaxSubsteps)) {
+        if (stepped.settings.on_unstable == SH_UNSTABLE_REJECT || !(substeps <= kMaxSubsteps)) {
             result.stable = false;
             result.rejected = true;
             result.status = SH_ERR_UNSTABLE;
@@ -263,10 +249,11 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
     }
     result.substeps = static_cast<int32_t>(substeps);
 
-    IntegratorWorkspace& w = body.workspace;
-    const sh_integrator integrator = body.settings.integrator;
-    if (result.substeps == 1 &&
-        (integrator == SH_INTEGRATOR_SYMPLECTIC_EULER || integrator == SH_INTEGRATOR_FORWARD_EULER)) {
+    IntegratorWorkspace& w = stepped.workspace;
+    const IntegratorKind& kind = integrator_kind(stepped.settings.integrator);
+    const bool symplectic = kind.scheme == StepScheme::SymplecticEuler;
+    const bool forward_euler = kind.scheme == StepScheme::RungeKutta && kind.tableau.stages == 1;
+    if (result.substeps == 1 && (symplectic || forward_euler)) {
         // The real-time case, in two passes over the nodes besides the forces. Kinematic nodes'
         // start velocities wait in w.vs (stage state, unused by the Euler methods).
         for_each_kinematic(body.kinematic, [&](size_t i) {
@@ -276,7 +263,7 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
                 body.v[j] = (body.target[j] - body.x[j]) / dt;
             }
         });
-        double* f = w.a[0].data();
+        double* f = w.stage_a[0].data();
         std::fill(f, f + body.x.size(), 0.0);
         body.add_internal_forces(body.x.data(), body.v.data(), f);
         if (body.field) {
@@ -284,10 +271,9 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
             body.field->add_forces(body.x.data(), body.v.data(), f);
         }
         const bool per_node = !body.node_damping.empty();
-        const bool symplectic = integrator == SH_INTEGRATOR_SYMPLECTIC_EULER;
         const size_t n = body.mass.size();
-        const bool sane = symplectic ? (per_node ? EulerPass<true, true>(body, dt, g).run(n) : EulerPass<true, false>(body, dt, g).run(n))
-                                     : (per_node ? EulerPass<false, true>(body, dt, g).run(n) : EulerPass<false, false>(body, dt, g).run(n));
+        const bool sane = symplectic ? (per_node ? EulerPass<true, true>(stepped, dt, g).run(n) : EulerPass<true, false>(stepped, dt, g).run(n))
+                                     : (per_node ? EulerPass<false, true>(stepped, dt, g).run(n) : EulerPass<false, false>(stepped, dt, g).run(n));
         if (sane && body.field) body.field->end_explicit_step(dt, symplectic, body.x.data(), body.v.data());
         for_each_kinematic(body.kinematic, [&](size_t i) {
             for (int k = 0; k < 3; ++k) {
@@ -296,27 +282,27 @@ BodyStepResult step_explicit(Body& body, double dt, const double g[3]) {
                 body.x[j] = body.target[j];
             }
         });
-        if (!sane) roll_back(body, result);
+        if (!sane) roll_back(stepped, result);
         return result;
     }
 
-    save_start_state(body);
+    save_start_state(stepped);
     begin_kinematic_motion(body, dt);
 
     const double h = dt / substeps;
     // Friction's velocity change also moves the nodes by h times it, as if it acted through the
     // sub-step (symplectic Euler's positions take the end velocities; for RK methods it is a
     // first-order splitting); forward Euler's positions take the start velocities.
-    const bool move_positions = integrator != SH_INTEGRATOR_FORWARD_EULER;
+    const bool move_positions = !forward_euler;
     for (int32_t s = 0; s < result.substeps; ++s) {
         if (body.field) body.field->begin_explicit_step();
-        integrate(body, h, g);
+        integrate(stepped, h, g);
         if (body.field) body.field->end_explicit_step(h, move_positions, body.x.data(), body.v.data());
     }
 
     end_kinematic_motion(body);
 
-    if (!body_state_is_sane(body)) roll_back(body, result);
+    if (!body_state_is_sane(stepped)) roll_back(stepped, result);
     return result;
 }
 

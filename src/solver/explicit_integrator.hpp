@@ -1,8 +1,10 @@
-// Explicit time stepping of one body: forward Euler, symplectic Euler, RK2, RK4, with the
-// critical-step policy (reject or sub-step) and rollback of non-finite or runaway states.
+// Explicit time stepping of one body by its row of the integrator table (a Runge-Kutta
+// tableau or symplectic Euler), with the critical-step policy (reject or sub-step) and
+// rollback of non-finite or runaway states.
 #pragma once
 
 #include "model/body.hpp"
+#include "solver/stepped_body.hpp"
 
 #include <cstdint>
 
@@ -27,8 +29,9 @@ struct BodyStepResult {
 };
 
 
-/// Advances body by dt (s) under gravity (m/s^2). Allocation-free.
-BodyStepResult step_explicit(Body& body, double dt, const double gravity[3]);
+/// Advances stepped's body by dt (s) under gravity (m/s^2) with its explicit integrator.
+/// Allocation-free.
+BodyStepResult step_explicit(SteppedBody& stepped, double dt, const double gravity[3]);
 
 /// Accelerations a (3 per node) at state (x, v): internal, external and gravity forces over
 /// mass, minus viscous damping; zero for fixed, prescribed and orphan nodes.

@@ -164,6 +164,9 @@ private:
     bool factorize_and_solve(bool& failed);
     void take_update(double scale);
     bool line_search(double slope, bool fresh);
+    int iteration_cap() const;
+    double residual_scale() const;
+    void keep_velocities();
     bool iterate(bool& solver_failed);
     BodyStepResult finish(bool converged, bool solver_failed, bool keep_best);
     BodyStepResult fail(sh_status status, const char* reason);
@@ -196,8 +199,10 @@ private:
 // start (x0, v0) or now; scale gets the terms' magnitudes.
 double NewtonStep::mechanical_energy(bool at_start, double& scale) const {
     double kinetic = 0.0;
-    group_.each([&](const Body& body, const ImplicitState& state, size_t) {
-        const double* v = at_start ? body.workspace.v0.data() : body.v.data();
+    group_.each([&](const SteppedBody& stepped, size_t) {
+        const Body& body = *stepped.body;
+        const ImplicitState& state = *stepped.implicit;
+        const double* v = at_start ? stepped.workspace.v0.data() : body.v.data();
         for (const int32_t j : state.system.dof_to_global()) {
             const size_t k = static_cast<size_t>(j);
             kinetic += 0.5 * body.mass[k / 3] * v[k] * v[k];
@@ -221,7 +226,8 @@ bool NewtonStep::energy_rose(double fraction) const {
 // Diagonal of the bodies' bounding box at the current iterate (m).
 double NewtonStep::extent() const {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    group_.each([&](const Body& body, const ImplicitState&, size_t) {
+    group_.each([&](const SteppedBody& stepped, size_t) {
+        const Body& body = *stepped.body;
         for (size_t j = 0; j < body.x.size(); ++j) {
             lo[j % 3] = std::min(lo[j % 3], body.x[j]);
             hi[j % 3] = std::max(hi[j % 3], body.x[j]);
@@ -236,16 +242,17 @@ void NewtonStep::begin() {
     work_done_ = false;
     energy_checked_ = false;
     first_evaluation_ = true;
-    group_.each([&](Body& body, ImplicitState&, size_t) {
-        save_start_state(body);
+    group_.each([&](SteppedBody& stepped, size_t) {
+        Body& body = *stepped.body;
+        save_start_state(stepped);
         begin_kinematic_motion(body, dt_);
         for (size_t j = 0; j < body.v.size() && !work_done_; ++j) work_done_ = body.kinematic[j / 3] && body.v[j] != 0.0;
         work_done_ = work_done_ || (body.field && body.field->does_work());
         // The internal damping's lagged base: elastic forces at the start state.
         if (!body.has_internal_damping()) return;
-        vec<double>& base = body.workspace.a[1];
+        vec<double>& base = stepped.workspace.stage_a[1];
         std::fill(base.begin(), base.end(), 0.0);
-        body.add_internal_forces(body.workspace.x0.data(), nullptr, base.data());
+        body.add_internal_forces(stepped.workspace.x0.data(), nullptr, base.data());
     });
     if (!work_done_) energy0_ = mechanical_energy(true, energy_scale0_);
     reuse_ = s_.factor_reuse > 0.0 && ns_.solver->is_direct();
@@ -258,14 +265,17 @@ void NewtonStep::begin() {
 // Every body moves first: the forces between bodies solved together see both ends.
 void NewtonStep::evaluate() {
     const double h = dt_;
-    group_.each([&](Body& body, ImplicitState&, size_t) {
-        for (size_t j = 0; j < body.x.size(); ++j) body.x[j] = body.workspace.x0[j] + h * body.v[j];
+    group_.each([&](SteppedBody& stepped, size_t) {
+        Body& body = *stepped.body;
+        for (size_t j = 0; j < body.x.size(); ++j) body.x[j] = stepped.workspace.x0[j] + h * body.v[j];
     });
     Potential phi;
     double sum2 = 0.0, push2 = 0.0;
     r_max_ = 0.0;
-    group_.each([&](Body& body, ImplicitState& state, size_t offset) {
-        double* f = body.workspace.a[0].data();
+    group_.each([&](SteppedBody& stepped, size_t offset) {
+        Body& body = *stepped.body;
+        ImplicitState& state = *stepped.implicit;
+        double* f = stepped.workspace.stage_a[0].data();
         std::fill(f, f + body.x.size(), 0.0);
         // The field first: the step's first evaluation measures its push (iterate()).
         if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
@@ -274,10 +284,10 @@ void NewtonStep::evaluate() {
         body.add_internal_forces(body.x.data(), nullptr, f);
         double* damping = nullptr;  // -D0 v, the lagged internal damping force
         if (body.has_internal_damping()) {
-            damping = body.workspace.a[2].data();
+            damping = stepped.workspace.stage_a[2].data();
             std::fill(damping, damping + body.x.size(), 0.0);
-            body.add_internal_forces(body.workspace.x0.data(), body.v.data(), damping);
-            const double* base = body.workspace.a[1].data();
+            body.add_internal_forces(stepped.workspace.x0.data(), body.v.data(), damping);
+            const double* base = stepped.workspace.stage_a[1].data();
             for (size_t j = 0; j < body.x.size(); ++j) damping[j] -= base[j];
         }
         const double elastic = body.elastic_energy(body.x.data());
@@ -287,7 +297,7 @@ void NewtonStep::evaluate() {
         const vec<int32_t>& global = state.system.dof_to_global();
         for (size_t d = 0; d < global.size(); ++d) {
             const size_t j = static_cast<size_t>(global[d]), node = j / 3;
-            const double m = body.mass[node], v = body.v[j], dv = v - body.workspace.v0[j];
+            const double m = body.mass[node], v = body.v[j], dv = v - stepped.workspace.v0[j];
             const double c = body.mass_damping(node);
             const double load = body.applied_load(j, g_), fd = damping ? damping[j] : 0.0;
             const double r_d = m * dv + h * m * c * v - h * (f[j] + fd + load);
@@ -321,8 +331,8 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
     try {
         if (!factor_current_ || stale_solves_ == kMaxStaleSolves) {
             ns_.factor_valid = false;
-            ns_.roundoff_floor = group_.assemble([&](Body& b, ImplicitState& st) { return assemble_member(b, st); }, dt_ * dt_,
-                                                 dt_, false);
+            ns_.roundoff_floor = group_.assemble([&](SteppedBody& m) { return assemble_member(*m.body, *m.implicit); },
+                                                 dt_ * dt_, dt_, false);
             ns_.solver->factorize(ns_.system);
             result_.factorize_seconds += ns_.solver->factorize_seconds;
             ++result_.factorizations;
@@ -348,7 +358,9 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
 // v = previous_v + scale delta, then evaluate().
 void NewtonStep::take_update(double scale) {
     largest_change_ = largest_speed_ = 0.0;
-    group_.each([&](Body& body, ImplicitState& state, size_t offset) {
+    group_.each([&](SteppedBody& stepped, size_t offset) {
+        Body& body = *stepped.body;
+        ImplicitState& state = *stepped.implicit;
         const vec<int32_t>& global = state.system.dof_to_global();
         for (size_t d = 0; d < global.size(); ++d) {
             double& v = body.v[static_cast<size_t>(global[d])];
@@ -389,7 +401,7 @@ bool NewtonStep::line_search(double slope, bool fresh) {
 }
 
 BodyStepResult NewtonStep::fail(sh_status status, const char* reason) {
-    group_.each([](Body& body, ImplicitState&, size_t) { restore_start_state(body); });
+    group_.each([](SteppedBody& stepped, size_t) { restore_start_state(stepped); });
     ns_.factor_valid = false;  // built at an iterate that went wrong
     result_.stable = false;
     result_.status = status;
@@ -411,21 +423,38 @@ BodyStepResult NewtonStep::run(bool keep_best) {
     return finish(converged, solver_failed, keep_best);
 }
 
+// Newton iterations the step may take. Contacts switch on and off within a step, which a
+// single update cannot follow: a body in contact iterates.
+int NewtonStep::iteration_cap() const {
+    bool in_contact = false;
+    group_.each([&](const SteppedBody& stepped, size_t) { in_contact |= stepped.body->field != nullptr; });
+    return std::max(in_contact ? kContactNewtonIterations : 1, s_.newton_max_iterations);
+}
+
+// The residual's scale: the first one, or the impulse of the loads over the step, the field's
+// push at the first iterate counted with f_ext. A body held still against a tool balances that
+// push: relative to the tiny residual of a step that starts at rest, the tolerance would sit
+// below what the contact's and friction's kinks let Newton reach.
+double NewtonStep::residual_scale() const {
+    const double loads = std::hypot(group_.applied_load_norm(g_), field_push_);
+    return std::max(r_, dt_ * loads);
+}
+
+// ns_.previous_v := the free velocities of the current iterate (the line search's start).
+void NewtonStep::keep_velocities() {
+    group_.each([&](SteppedBody& stepped, size_t offset) {
+        const vec<int32_t>& global = stepped.implicit->system.dof_to_global();
+        for (size_t d = 0; d < global.size(); ++d)
+            ns_.previous_v[offset + d] = stepped.body->v[static_cast<size_t>(global[d])];
+    });
+}
+
 // The Newton loop from the evaluated start iterate; true if it converged. solver_failed: it
 // stopped because the linear solver failed.
 bool NewtonStep::iterate(bool& solver_failed) {
-    // Contacts switch on and off within a step, which a single update cannot follow: a body
-    // in contact iterates.
-    bool in_contact = false;
-    group_.each([&](const Body& body, const ImplicitState&, size_t) { in_contact |= body.field != nullptr; });
-    int max_iterations = std::max(in_contact ? kContactNewtonIterations : 1, s_.newton_max_iterations);
+    int max_iterations = iteration_cap();
     bool linearised = max_iterations == 1;
-    // The residual's scale: the first one, or the impulse of the loads over the step, the
-    // field's push at the first iterate counted with f_ext. A body held still against a tool balances that push:
-    // relative to the tiny residual of a step that starts at rest, the tolerance would sit
-    // below what the contact's and friction's kinks let Newton reach.
-    const double loads = std::hypot(group_.applied_load_norm(g_), field_push_);
-    const double residual0 = std::max(r_, dt_ * loads);
+    const double residual0 = residual_scale();
     const double gravity_norm = std::sqrt(g_[0] * g_[0] + g_[1] * g_[1] + g_[2] * g_[2]);
     // A linearised step's updates with a kept factorisation go on until both norms are down
     // by factor_reuse (the max norm keeps a small badly-solved region from hiding in the sum).
@@ -449,10 +478,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
             solver_failed = true;
             return false;
         }
-        group_.each([&](Body& body, ImplicitState& state, size_t offset) {
-            const vec<int32_t>& global = state.system.dof_to_global();
-            for (size_t d = 0; d < global.size(); ++d) ns_.previous_v[offset + d] = body.v[static_cast<size_t>(global[d])];
-        });
+        keep_velocities();
         double slope = 0.0;  // d Phi / d scale along delta, at scale 0
         for (size_t d = 0; d < ns_.delta.size(); ++d) slope += ns_.residual[d] * ns_.delta[d];
         const bool fresh = fresh_;
@@ -510,9 +536,10 @@ BodyStepResult NewtonStep::finish(bool converged, bool solver_failed, bool keep_
     result_.not_converged = !converged;
     result_.status = SH_OK;
     bool sane = true;
-    group_.each([&](Body& body, ImplicitState&, size_t) {
+    group_.each([&](SteppedBody& stepped, size_t) {
+        Body& body = *stepped.body;
         end_kinematic_motion(body);
-        sane = sane && body_state_is_sane(body);
+        sane = sane && body_state_is_sane(stepped);
     });
     if (!sane) return fail(SH_ERR_UNSTABLE, kRolledBackReason);
     if (!energy_checked_ && energy_rose(kEnergyGrowth)) {
@@ -543,15 +570,16 @@ BodyStepResult run_step(const NewtonGroup& group, const sh_implicit_settings& s,
 
 }  // namespace
 
-BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double g[3], bool keep_best) {
-    prepare_implicit_state(body, state, body.settings.implicit);
-    return run_step(NewtonGroup::alone(body, state), body.settings.implicit, dt, g, keep_best);
+BodyStepResult step_implicit(SteppedBody& stepped, double dt, const double g[3], bool keep_best) {
+    if (!stepped.implicit) stepped.implicit = sh::create<ImplicitState>();
+    prepare_implicit_state(*stepped.body, *stepped.implicit, stepped.settings.implicit);
+    return run_step(NewtonGroup::alone(stepped), stepped.settings.implicit, dt, g, keep_best);
 }
 
 BodyStepResult step_implicit_coupled(CoupledSystem& system, double dt, const double g[3], bool keep_best) {
-    sh_implicit_settings s = system.member(0).body->settings.implicit;
+    sh_implicit_settings s = system.member(0).stepped->settings.implicit;
     for (int32_t m = 1; m < system.member_count(); ++m) {
-        const sh_implicit_settings& other = system.member(m).body->settings.implicit;
+        const sh_implicit_settings& other = system.member(m).stepped->settings.implicit;
         s.newton_tolerance = std::min(s.newton_tolerance, other.newton_tolerance);
         s.newton_max_iterations = std::max(s.newton_max_iterations, other.newton_max_iterations);
     }

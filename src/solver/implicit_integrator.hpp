@@ -9,6 +9,7 @@
 
 #include "model/body.hpp"
 #include "solver/explicit_integrator.hpp"
+#include "solver/stepped_body.hpp"
 #include "linalg/linear_solver.hpp"
 #include "linalg/sparse_system.hpp"
 
@@ -42,8 +43,8 @@ struct ImplicitState : NewtonSystem {
     int32_t free_count = -1;    ///< -1: pattern not built yet
 };
 
-/// Advances body by dt with backward Euler. With a direct solver and
-/// settings.implicit.factor_reuse > 0 a factorisation is kept across iterations and steps: an
+/// Advances stepped's body by dt with backward Euler; its implicit state is made on the first
+/// call. With a direct solver and settings.implicit.factor_reuse > 0 a factorisation is kept across iterations and steps: an
 /// update solved with a kept one is accepted if it at least halves the residual (2-norm and
 /// max-norm), else discarded and solved again with a factorisation at the same iterate; a
 /// linearised step goes on with kept-factorisation updates until the residual is down by
@@ -53,8 +54,7 @@ struct ImplicitState : NewtonSystem {
 /// state (SH_ERR_UNSTABLE) the body is restored and result.status says why.
 /// keep_best: a Newton loop that does not converge keeps its last iterate, the lowest
 /// incremental potential it reached (result.not_converged), instead of failing.
-BodyStepResult step_implicit(Body& body, ImplicitState& state, double dt, const double gravity[3],
-                             bool keep_best = false);
+BodyStepResult step_implicit(SteppedBody& stepped, double dt, const double gravity[3], bool keep_best = false);
 
 /// step_implicit for the members of system (prepared), as one Newton loop on their joint
 /// residual: every member has contact (at least 20 iterations), the tolerance is the strictest

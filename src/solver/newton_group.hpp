@@ -18,45 +18,45 @@ inline double sum_roundoff(double scale) { return 64.0 * std::numeric_limits<dou
 
 /// A body alone, whose own system is the one solved, or the members of a CoupledSystem.
 struct NewtonGroup {
-    Body* body;              ///< alone (null when coupled)
-    ImplicitState* state;    ///< alone (null when coupled)
-    CoupledSystem* coupled;  ///< together (null when alone)
-    NewtonSystem& newton;    ///< the system solved
+    SteppedBody* alone_body;  ///< alone (null when coupled); its implicit state is the system
+    CoupledSystem* coupled;   ///< together (null when alone)
+    NewtonSystem& newton;     ///< the system solved
 
-    static NewtonGroup alone(Body& body, ImplicitState& state) { return NewtonGroup{&body, &state, nullptr, state}; }
-    static NewtonGroup together(CoupledSystem& system) { return NewtonGroup{nullptr, nullptr, &system, system}; }
+    static NewtonGroup alone(SteppedBody& stepped) { return NewtonGroup{&stepped, nullptr, *stepped.implicit}; }
+    static NewtonGroup together(CoupledSystem& system) { return NewtonGroup{nullptr, &system, system}; }
 
-    /// Calls visit(body, state, offset) for each body, offset its first DOF in newton.
+    /// Calls visit(stepped, offset) for each body, offset its first DOF in newton.
     template <class Visit>
     void each(Visit&& visit) const {
         if (!coupled) {
-            visit(*body, *state, size_t{0});
+            visit(*alone_body, size_t{0});
             return;
         }
         for (int32_t m = 0; m < coupled->member_count(); ++m) {
             const CoupledMember& member = coupled->member(m);
-            visit(*member.body, *member.state, static_cast<size_t>(member.offset));
+            visit(*member.stepped, static_cast<size_t>(member.offset));
         }
     }
 
-    /// Assembles the system solved: assemble_member(body, state) fills each body's own system
-    /// and returns its force round-off; coupled, the members' systems are added into the joint
+    /// Assembles the system solved: assemble_member(stepped) fills each body's own system and
+    /// returns its force round-off; coupled, the members' systems are added into the joint
     /// one with their coupling blocks (stiffness_scale K + damping_scale D, at rest or not).
     /// Returns the round-off of the forces.
     template <class AssembleMember>
     double assemble(AssembleMember&& assemble_member, double stiffness_scale, double damping_scale, bool at_rest) const {
-        if (!coupled) return assemble_member(*body, *state);
-        return coupled->assemble([&](CoupledMember& m) { return assemble_member(*m.body, *m.state); }, stiffness_scale,
+        if (!coupled) return assemble_member(*alone_body);
+        return coupled->assemble([&](CoupledMember& m) { return assemble_member(*m.stepped); }, stiffness_scale,
                                  damping_scale, at_rest);
     }
 
-    uint64_t matrix_version() const { return coupled ? coupled->matrix_version() : body->matrix_version; }
+    uint64_t matrix_version() const { return coupled ? coupled->matrix_version() : alone_body->body->matrix_version; }
 
     /// |f_ext + m g| over the free DOFs (N).
     double applied_load_norm(const double g[3]) const {
         double sum = 0.0;
-        each([&](const Body& b, const ImplicitState& s, size_t) {
-            for (const int32_t j : s.system.dof_to_global()) {
+        each([&](const SteppedBody& m, size_t) {
+            const Body& b = *m.body;
+            for (const int32_t j : m.implicit->system.dof_to_global()) {
                 const double load = b.applied_load(static_cast<size_t>(j), g);
                 sum += load * load;
             }
@@ -70,10 +70,11 @@ struct NewtonGroup {
     double potential_energy(const double g[3], double load_factor, bool at_start, double& scale) const {
         double total = 0.0;
         scale = 0.0;
-        each([&](const Body& b, const ImplicitState& s, size_t) {
-            const double* x = at_start ? b.workspace.x0.data() : b.x.data();
+        each([&](const SteppedBody& m, size_t) {
+            const Body& b = *m.body;
+            const double* x = at_start ? m.workspace.x0.data() : b.x.data();
             double work = 0.0;
-            for (const int32_t j : s.system.dof_to_global()) {
+            for (const int32_t j : m.implicit->system.dof_to_global()) {
                 const size_t k = static_cast<size_t>(j);
                 work += b.applied_load(k, g) * x[k];
             }

@@ -44,10 +44,12 @@ double assemble_static_tangent(Body& body, ImplicitState& state, double shift) {
 }
 
 // Out-of-balance force f(x) + load_factor * (f_ext + m g) on the free DOFs into out, and its
-// norm. Each body's workspace.a[0] is scratch.
+// norm. Each body's workspace.stage_a[0] is scratch.
 double out_of_balance(const NewtonGroup& group, const double g[3], double load_factor, vec<double>& out) {
-    group.each([&](Body& body, ImplicitState& state, size_t offset) {
-        vec<double>& force = body.workspace.a[0];
+    group.each([&](SteppedBody& stepped, size_t offset) {
+        Body& body = *stepped.body;
+        ImplicitState& state = *stepped.implicit;
+        vec<double>& force = stepped.workspace.stage_a[0];
         std::fill(force.begin(), force.end(), 0.0);
         body.add_internal_forces(body.x.data(), nullptr, force.data());
         if (body.field) body.field->add_forces(body.x.data(), nullptr, force.data());
@@ -65,7 +67,8 @@ double out_of_balance(const NewtonGroup& group, const double g[3], double load_f
 // Newton-Raphson with line search for the group's bodies, their states prepared.
 void solve_group(const NewtonGroup& group, const double g[3], const sh_static_def& def, sh_static_report& report) {
     NewtonSystem& ns = group.newton;
-    group.each([](Body& body, ImplicitState&, size_t) {
+    group.each([](SteppedBody& stepped, size_t) {
+        Body& body = *stepped.body;
         end_kinematic_motion(body);  // fixed and prescribed nodes on their targets
         std::fill(body.v.begin(), body.v.end(), 0.0);
     });
@@ -83,8 +86,8 @@ void solve_group(const NewtonGroup& group, const double g[3], const sh_static_de
         bool converged = r <= def.tolerance;
         double floor = 0.0;
         for (int32_t iteration = 0; iteration < def.max_iterations && !converged; ++iteration) {
-            const auto assemble_member = [&](Body& body, ImplicitState& state) {
-                return assemble_static_tangent(body, state, kFloatingShift * std::min(r, 1.0));
+            const auto assemble_member = [&](SteppedBody& stepped) {
+                return assemble_static_tangent(*stepped.body, *stepped.implicit, kFloatingShift * std::min(r, 1.0));
             };
             // Below the round-off of the internal forces the residual cannot fall further.
             floor = std::max(floor, group.assemble(assemble_member, 1.0, 0.0, true) / load_norm);
@@ -94,17 +97,20 @@ void solve_group(const NewtonGroup& group, const double g[3], const sh_static_de
             for (size_t d = 0; d < residual.size(); ++d) slope -= residual[d] * step[d];
             double scale = 0.0;
             const double energy0 = group.potential_energy(g, factor, false, scale), r0 = r;
-            group.each([](Body& body, ImplicitState&, size_t) {
-                std::copy(body.x.begin(), body.x.end(), body.workspace.xs.begin());
+            group.each([](SteppedBody& stepped, size_t) {
+                Body& body = *stepped.body;
+                std::copy(body.x.begin(), body.x.end(), stepped.workspace.xs.begin());
             });
             double alpha = 1.0;
             bool accepted = false;
             for (int trial = 0; trial < 30 && !accepted; ++trial, alpha *= 0.5) {
-                group.each([&](Body& body, ImplicitState& state, size_t offset) {
+                group.each([&](SteppedBody& stepped, size_t offset) {
+                    Body& body = *stepped.body;
+                    ImplicitState& state = *stepped.implicit;
                     const vec<int32_t>& global = state.system.dof_to_global();
                     for (size_t d = 0; d < global.size(); ++d) {
                         const size_t j = static_cast<size_t>(global[d]);
-                        body.x[j] = body.workspace.xs[j] + alpha * step[offset + d];
+                        body.x[j] = stepped.workspace.xs[j] + alpha * step[offset + d];
                     }
                 });
                 r = out_of_balance(group, g, factor, residual) / load_norm;
@@ -117,8 +123,9 @@ void solve_group(const NewtonGroup& group, const double g[3], const sh_static_de
                                                      (r < r0 && energy <= energy0 + sum_roundoff(scale)));
             }
             if (!accepted) {  // no step helped: stay where the iteration was
-                group.each([](Body& body, ImplicitState&, size_t) {
-                    std::copy(body.workspace.xs.begin(), body.workspace.xs.end(), body.x.begin());
+                group.each([](SteppedBody& stepped, size_t) {
+                    Body& body = *stepped.body;
+                    std::copy(stepped.workspace.xs.begin(), stepped.workspace.xs.end(), body.x.begin());
                 });
                 r = out_of_balance(group, g, factor, residual) / load_norm;
             }
@@ -147,24 +154,31 @@ sh_implicit_settings static_solver_settings(const sh_static_def& def) {
 
 }  // namespace
 
-void solve_static_body(Body& body, const double g[3], const sh_static_def& def, sh_static_report& report) {
-    require(is_anchored(body), SH_ERR_SOLVER,
+void solve_static_body(SteppedBody& stepped, const double g[3], const sh_static_def& def, sh_static_report& report) {
+    require(is_anchored(*stepped.body), SH_ERR_SOLVER,
             "a body has no fixed or prescribed node: it can float freely, so its stiffness is singular and it has "
             "no static equilibrium (fix or prescribe nodes first)");
     ImplicitState state;
-    prepare_implicit_state(body, state, static_solver_settings(def));
-    solve_group(NewtonGroup::alone(body, state), g, def, report);
+    ImplicitState* const states[1] = {&state};
+    SteppedBody* const bodies[1] = {&stepped};
+    const LentImplicitStates lent(bodies, states, 1);
+    prepare_implicit_state(*stepped.body, state, static_solver_settings(def));
+    solve_group(NewtonGroup::alone(stepped), g, def, report);
 }
 
-void solve_static_coupled(CoupledSystem& system, Body* const* bodies, ImplicitState* const* states, int32_t count,
-                          const double g[3], const sh_static_def& def, sh_static_report& report) {
+void solve_static_coupled(CoupledSystem& system, SteppedBody* const* bodies, int32_t count, const double g[3],
+                          const sh_static_def& def, sh_static_report& report) {
     bool anchored = false;
-    for (int32_t m = 0; m < count; ++m) anchored |= is_anchored(*bodies[m]);
+    for (int32_t m = 0; m < count; ++m) anchored |= is_anchored(*bodies[m]->body);
     require(anchored, SH_ERR_SOLVER,
             "bodies in contact with each other have no fixed or prescribed node among them: they can float "
             "freely, so their stiffness is singular and they have no static equilibrium (fix or prescribe nodes "
             "of one of them first)");
-    system.prepare(bodies, states, count, static_solver_settings(def));
+    vec<ImplicitState> fresh(static_cast<size_t>(count));  // as for a body alone
+    vec<ImplicitState*> states;
+    for (ImplicitState& state : fresh) states.push_back(&state);
+    const LentImplicitStates lent(bodies, states.data(), count);
+    system.prepare(bodies, count, static_solver_settings(def));
     solve_group(NewtonGroup::together(system), g, def, report);
 }
 

@@ -3,27 +3,27 @@
 // stepping.
 #pragma once
 
-#include "model/body.hpp"
+#include "solver/stepped_body.hpp"
 
 #include <softhap/softhap.h>
 
 namespace sh {
 
 class CoupledSystem;
-struct ImplicitState;
 
-/// Moves body to equilibrium under gravity and its external forces, its fixed and prescribed
-/// nodes on their targets, velocities zeroed. Appends to report (iterations, history, residual).
+/// Moves stepped's body to equilibrium under gravity and its external forces, its fixed and
+/// prescribed nodes on their targets, velocities zeroed, with a fresh implicit state of its
+/// own (the body's is left as it was). Appends to report (iterations, history, residual).
 /// Throws SH_ERR_SOLVER (singular or indefinite K) or SH_ERR_NOT_CONVERGED; the caller restores
-/// the body (its start state is saved in the workspace).
-void solve_static_body(Body& body, const double gravity[3], const sh_static_def& def, sh_static_report& report);
+/// the body (save_start_state before the call). The workspace's stage arrays are scratch.
+void solve_static_body(SteppedBody& stepped, const double gravity[3], const sh_static_def& def, sh_static_report& report);
 
-/// solve_static_body for bodies[0..count) (with fresh implicit states) coupled through system:
+/// solve_static_body for bodies[0..count) (each with a fresh implicit state) coupled through system:
 /// one Newton loop on their joint out-of-balance force and potential. At least one of them must
 /// have a fixed or prescribed node; one without any is held by its contacts with the others,
 /// and the directions they leave free (sliding along frictionless contact) are held by a tiny
 /// shift of its tangent's diagonal, so that the solve ends at the equilibrium nearest its start.
-void solve_static_coupled(CoupledSystem& system, Body* const* bodies, ImplicitState* const* states, int32_t count,
-                          const double gravity[3], const sh_static_def& def, sh_static_report& report);
+void solve_static_coupled(CoupledSystem& system, SteppedBody* const* bodies, int32_t count, const double gravity[3],
+                          const sh_static_def& def, sh_static_report& report);
 
 }  // namespace sh

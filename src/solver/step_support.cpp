@@ -8,14 +8,25 @@
 
 namespace sh {
 
-void save_start_state(Body& body) {
-    std::copy(body.x.begin(), body.x.end(), body.workspace.x0.begin());
-    std::copy(body.v.begin(), body.v.end(), body.workspace.v0.begin());
+void IntegratorWorkspace::resize(int32_t node_count) {
+    const size_t n = 3 * static_cast<size_t>(node_count);
+    for (vec<double>* array : {&x0, &v0, &xs, &vs}) array->resize(n);
+    for (int i = 0; i < kMaxStages; ++i) {
+        stage_v[i].resize(n);
+        stage_a[i].resize(n);
+    }
 }
 
-void restore_start_state(Body& body) {
-    std::copy(body.workspace.x0.begin(), body.workspace.x0.end(), body.x.begin());
-    std::copy(body.workspace.v0.begin(), body.workspace.v0.end(), body.v.begin());
+void save_start_state(SteppedBody& stepped) {
+    const Body& body = *stepped.body;
+    std::copy(body.x.begin(), body.x.end(), stepped.workspace.x0.begin());
+    std::copy(body.v.begin(), body.v.end(), stepped.workspace.v0.begin());
+}
+
+void restore_start_state(SteppedBody& stepped) {
+    Body& body = *stepped.body;
+    std::copy(stepped.workspace.x0.begin(), stepped.workspace.x0.end(), body.x.begin());
+    std::copy(stepped.workspace.v0.begin(), stepped.workspace.v0.end(), body.v.begin());
 }
 
 void begin_kinematic_motion(Body& body, double dt) {
@@ -48,15 +59,17 @@ void end_kinematic_motion(Body& body) {
         if (body.kinematic[i] || !(body.mass[i] > 0.0)) settle(i);
 }
 
-bool body_state_is_sane(const Body& body) {
-    const double limit2 = body.settings.runaway_speed * body.settings.runaway_speed;
+bool body_state_is_sane(const SteppedBody& stepped) {
+    const Body& body = *stepped.body;
+    const double runaway_speed = stepped.settings.runaway_speed;
+    const double limit2 = runaway_speed * runaway_speed;
     const size_t n = body.mass.size();
     const double* x = body.x.data();
     const double* v = body.v.data();
     bool insane = false;
     size_t i = 0;
 #if defined(__AVX512F__)
-    const __m512d v_bound = _mm512_set1_pd(0.57 * body.settings.runaway_speed);
+    const __m512d v_bound = _mm512_set1_pd(0.57 * runaway_speed);
     for (; i + 8 <= n; i += 8) {
         __mmask8 flagged = 0;
         for (int r = 0; r < 3; ++r)

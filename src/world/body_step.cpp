@@ -6,10 +6,9 @@
 
 namespace sh {
 
-BodyStepResult step_body(Body& body, ImplicitState*& implicit, double dt, const double gravity[3], bool keep_best) {
-    if (body.settings.integrator != SH_INTEGRATOR_IMPLICIT_EULER) return step_explicit(body, dt, gravity);
-    if (!implicit) implicit = sh::create<ImplicitState>();
-    return step_implicit(body, *implicit, dt, gravity, keep_best);
+BodyStepResult step_body(SteppedBody& stepped, double dt, const double gravity[3], bool keep_best) {
+    if (stepped.settings.integrator != SH_INTEGRATOR_IMPLICIT_EULER) return step_explicit(stepped, dt, gravity);
+    return step_implicit(stepped, dt, gravity, keep_best);
 }
 
 void add_step_figures(sh_step_report& r, const BodyStepResult& result) {

@@ -4,15 +4,13 @@
 
 #include "model/body.hpp"
 #include "solver/explicit_integrator.hpp"
+#include "solver/stepped_body.hpp"
 
 namespace sh {
 
-struct ImplicitState;
-
-/// Advances body by dt with its integrator. implicit is the body's implicit solver state,
-/// created here on the first implicit step (and kept by the caller). keep_best: an implicit
-/// step that does not converge keeps its best iterate (see step_implicit).
-BodyStepResult step_body(Body& body, ImplicitState*& implicit, double dt, const double gravity[3], bool keep_best);
+/// Advances stepped's body by dt with its integrator. keep_best: an implicit step that does
+/// not converge keeps its best iterate (see step_implicit).
+BodyStepResult step_body(SteppedBody& stepped, double dt, const double gravity[3], bool keep_best);
 
 /// Adds the figures of one solve (a body's step, or an island's) to r: critical step,
 /// sub-steps, Newton and linear-solver counts and times, the sub-stepping warning.

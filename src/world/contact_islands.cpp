@@ -78,22 +78,22 @@ void World::step_islands(double h, sh_step_report& r, vec<uint8_t>& skip) {
     for (int32_t i = 0; i < islands.island_count(); ++i) {
         const uint32_t* members = islands.members(i);
         const int32_t count = islands.member_count(i);
+        islands.stepped.clear();
         islands.bodies.clear();
-        islands.states.clear();
         islands.doublings.clear();
         islands.ids.clear();
         bool keep_best = false;  // the island's last attempt is that of any member's
         for (int32_t m = 0; m < count; ++m) {
             Slot& slot = slots_[members[m]];
             keep_best |= slot.keep_best;
-            if (!slot.implicit) slot.implicit = sh::create<ImplicitState>();
-            islands.bodies.push_back(slot.body);
-            islands.states.push_back(slot.implicit);
+            if (!slot.stepped->implicit) slot.stepped->implicit = sh::create<ImplicitState>();
+            islands.stepped.push_back(slot.stepped);
+            islands.bodies.push_back(slot.body());
             islands.doublings.push_back(slot.doubling);
             islands.ids.push_back(id_of(members[m]));
         }
         CoupledSystem& system = islands.system(islands.ids.data(), count);
-        system.prepare(islands.bodies.data(), islands.states.data(), count, islands.bodies[0]->settings.implicit);
+        system.prepare(islands.stepped.data(), count, islands.stepped[0]->settings.implicit);
         bool half_steps_stable = false;
         if (error_estimate_) {
             const ScopedTimer timer(r.error_estimate_seconds);
@@ -120,15 +120,10 @@ void World::solve_static_islands(const sh_static_def& def, sh_static_report& r) 
     for (int32_t i = 0; i < islands.island_count(); ++i) {
         const uint32_t* members = islands.members(i);
         const int32_t count = islands.member_count(i);
-        vec<ImplicitState> states(static_cast<size_t>(count));  // fresh, as for a body alone
-        islands.bodies.clear();
-        islands.states.clear();
-        for (int32_t m = 0; m < count; ++m) {
-            islands.bodies.push_back(slots_[members[m]].body);
-            islands.states.push_back(&states[static_cast<size_t>(m)]);
-        }
+        islands.stepped.clear();
+        for (int32_t m = 0; m < count; ++m) islands.stepped.push_back(slots_[members[m]].stepped);
         CoupledSystem system;
-        solve_static_coupled(system, islands.bodies.data(), islands.states.data(), count, gravity, def, r);
+        solve_static_coupled(system, islands.stepped.data(), count, gravity, def, r);
     }
 }
 

@@ -13,7 +13,7 @@
 namespace sh {
 
 class CoupledSystem;
-struct ImplicitState;
+struct SteppedBody;
 struct StepDoubling;
 
 class ContactIslands {
@@ -53,8 +53,8 @@ public:
     vec<Link> links;  ///< the pairs (with contact candidates) group() joins, filled by the caller
 
     // One island's members as the caller gathers them (scratch).
+    vec<SteppedBody*> stepped;
     vec<Body*> bodies;
-    vec<ImplicitState*> states;
     vec<StepDoubling*> doublings;
     vec<sh_body_id> ids;
 

@@ -32,11 +32,17 @@ void end_half_steps(Body& body, StepDoubling& scratch, bool keep_positions) {
     std::copy(scratch.start_v.begin(), scratch.start_v.end(), body.v.begin());
 }
 
-bool take_half_steps(Body& body, StepDoubling& scratch, double dt, const double gravity[3]) {
-    Body* bodies[1] = {&body};
+bool take_half_steps(SteppedBody& stepped, StepDoubling& scratch, double dt, const double gravity[3]) {
+    Body* bodies[1] = {stepped.body};
     StepDoubling* scratches[1] = {&scratch};
-    return take_half_steps_together(bodies, scratches, 1, dt,
-                                    [&](double h) { return step_body(body, scratch.implicit, h, gravity, false).stable; });
+    const auto half_step = [&](double h) { return step_body(stepped, h, gravity, false).stable; };
+    if (stepped.settings.integrator != SH_INTEGRATOR_IMPLICIT_EULER)
+        return take_half_steps_together(bodies, scratches, 1, dt, half_step);
+    // The half steps keep their own factorisation, so that the full step's stays.
+    if (!scratch.implicit) scratch.implicit = sh::create<ImplicitState>();
+    SteppedBody* const lent_to[1] = {&stepped};
+    const LentImplicitStates lent(lent_to, &scratch.implicit, 1);
+    return take_half_steps_together(bodies, scratches, 1, dt, half_step);
 }
 
 double largest_half_step_difference(const Body& body, const StepDoubling& scratch) {

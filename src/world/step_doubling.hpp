@@ -4,6 +4,7 @@
 
 #include "core/memory.hpp"
 #include "model/body.hpp"
+#include "solver/stepped_body.hpp"
 
 #include <cstdint>
 
@@ -53,8 +54,9 @@ bool take_half_steps_together(Body* const* bodies, StepDoubling* const* scratch,
     return stable;
 }
 
-/// take_half_steps_together for one body with its own integrator (and scratch.implicit).
-bool take_half_steps(Body& body, StepDoubling& scratch, double dt, const double gravity[3]);
+/// take_half_steps_together for one body with its own integrator (an implicit one with
+/// scratch.implicit as its state).
+bool take_half_steps(SteppedBody& stepped, StepDoubling& scratch, double dt, const double gravity[3]);
 
 /// Largest distance between a node of body and its position in scratch.half_x (m).
 double largest_half_step_difference(const Body& body, const StepDoubling& scratch);

@@ -5,6 +5,8 @@
 #include "contact/collider.hpp"
 #include "core/clock.hpp"
 #include "core/error.hpp"
+#include "material/material_params.hpp"
+#include "model/fem_body.hpp"
 #include "solver/explicit_integrator.hpp"
 #include "solver/implicit_integrator.hpp"
 #include "solver/static_solver.hpp"
@@ -51,18 +53,20 @@ World::~World() {
 }
 
 void World::destroy_slot(Slot& slot) {
-    sh::destroy(slot.body);
-    sh::destroy(slot.implicit);
+    if (slot.stepped) {
+        sh::destroy(slot.body());
+        sh::destroy(slot.stepped->implicit);
+    }
+    sh::destroy(slot.stepped);
     sh::destroy(slot.doubling);
     sh::destroy(slot.contacts);
-    slot.body = nullptr;
-    slot.implicit = nullptr;
+    slot.stepped = nullptr;
     slot.doubling = nullptr;
     slot.contacts = nullptr;
     slot.saved = vec<double>();
 }
 
-sh_body_id World::add_body(Body* body) {
+sh_body_id World::add_body(Body* body, const StepSettings& settings) {
     uint32_t index;
     if (!free_slots_.empty()) {
         index = free_slots_.back();
@@ -79,27 +83,26 @@ sh_body_id World::add_body(Body* body) {
         index = static_cast<uint32_t>(slots_.size() - 1);
     }
     StepDoubling* doubling = nullptr;
-    if (error_estimate_) {
-        try {
-            doubling = sh::create<StepDoubling>(body->x.size());
-        } catch (...) {
-            free_slots_.push_back(index);
-            sh::destroy(body);
-            throw;
-        }
-    }
+    SteppedBody* stepped = nullptr;
     Slot& slot = slots_[index];
     try {
-        // Room for the step's start state and attempt flags, so that a step allocates nothing.
+        if (error_estimate_) doubling = sh::create<StepDoubling>(body->x.size());
+        // Room for the step's start state, scratch and attempt flags, so that a step allocates
+        // nothing.
+        stepped = sh::create<SteppedBody>();
+        stepped->workspace.resize(body->node_count());
         slot.saved.reserve(body->x.size() + body->v.size());
         skip_.reserve(slots_.size());
     } catch (...) {
         free_slots_.push_back(index);
+        sh::destroy(stepped);
         sh::destroy(doubling);
         sh::destroy(body);
         throw;
     }
-    slot.body = body;
+    stepped->body = body;
+    stepped->settings = settings;
+    slot.stepped = stepped;
     slot.doubling = doubling;
     slot.generation = next_generation();
     return id_of(index);
@@ -108,7 +111,7 @@ sh_body_id World::add_body(Body* body) {
 bool World::is_valid(sh_body_id id) const {
     if (id == SH_NULL_BODY) return false;
     const uint32_t index = slot_of(id);
-    return index < slots_.size() && slots_[index].body && slots_[index].generation == generation_of(id);
+    return index < slots_.size() && slots_[index].body() && slots_[index].generation == generation_of(id);
 }
 
 Body& World::body(sh_body_id id) const {
@@ -117,7 +120,26 @@ Body& World::body(sh_body_id id) const {
                     id == SH_NULL_BODY ? std::string("body id is null (0)")
                                        : format("body id 0x%llx is not a live body of this world (removed or never created)",
                                                 static_cast<unsigned long long>(id)));
-    return *slots_[slot_of(id)].body;
+    return *slots_[slot_of(id)].body();
+}
+
+sh_body_id World::add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
+                               double damping_stiffness, const StepSettings& settings) {
+    const sh_body_id id = add_body(sh::create<FemBody>(mesh, material, damping_mass, damping_stiffness), settings);
+    if (locks_linear_tets(material)) ++warnings[SH_WARN_LOCKING];
+    return id;
+}
+
+void World::set_material(sh_body_id id, const int32_t* elements, int32_t count, const sh_material& material) {
+    Body& b = body(id);
+    require(b.is_fem(), SH_ERR_UNSUPPORTED, "sh_body_set_material needs an FEM body; this is a mass-spring body");
+    static_cast<FemBody&>(b).set_material(elements, count, material);
+    if (locks_linear_tets(material) && count > 0) ++warnings[SH_WARN_LOCKING];
+}
+
+const StepSettings& World::step_settings(sh_body_id id) const {
+    body(id);  // validates
+    return slots_[slot_of(id)].stepped->settings;
 }
 
 void World::remove_body(sh_body_id id) {
@@ -203,18 +225,18 @@ void World::step_bodies(double h, sh_step_report& r, vec<uint8_t>& skip) {
     const bool coupled = group_islands(true, &skip);
     for (size_t index = 0; index < slots_.size(); ++index) {
         Slot& slot = slots_[index];
-        if (!slot.body || skip[index]) continue;
+        if (!slot.body() || skip[index]) continue;
         if (coupled && islands_->island_of(index) >= 0) continue;
         bool half_steps_stable = false;
         if (slot.doubling) {
             const ScopedTimer timer(r.error_estimate_seconds);
-            half_steps_stable = take_half_steps(*slot.body, *slot.doubling, h, gravity);
+            half_steps_stable = take_half_steps(*slot.stepped, *slot.doubling, h, gravity);
         }
-        slot.body->clear_inverted_elements();
-        const BodyStepResult result = step_body(*slot.body, slot.implicit, h, gravity, slot.keep_best);
+        slot.body()->clear_inverted_elements();
+        const BodyStepResult result = step_body(*slot.stepped, h, gravity, slot.keep_best);
         if (slot.doubling) {
             if (half_steps_stable && result.stable && r.error_estimate >= 0.0)
-                r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*slot.body, *slot.doubling));
+                r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*slot.body(), *slot.doubling));
             else
                 r.error_estimate = -1.0;
         }
@@ -227,7 +249,7 @@ void World::step_bodies(double h, sh_step_report& r, vec<uint8_t>& skip) {
 
 void World::note_result(size_t index, const BodyStepResult& result, sh_step_report& r, vec<uint8_t>& skip) {
     Slot& slot = slots_[index];
-    if (slot.body->inverted_elements() > 0) r.warnings |= 1u << SH_WARN_INVERTED;
+    if (slot.body()->inverted_elements() > 0) r.warnings |= 1u << SH_WARN_INVERTED;
     if (result.not_converged) r.warnings |= 1u << SH_WARN_NOT_CONVERGED;
     if (result.stable) return;
     skip[index] = 1;  // the body sits out the rest of this attempt
@@ -243,7 +265,7 @@ bool World::group_islands(bool implicit_only, const vec<uint8_t>* failed) {
         const uint32_t a = slot_of(pair.a), b = slot_of(pair.b);
         const auto eligible = [&](uint32_t index) {
             return !(failed && (*failed)[index]) &&
-                   (!implicit_only || slots_[index].body->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER);
+                   (!implicit_only || slots_[index].stepped->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER);
         };
         if (pair.has_candidates && eligible(a) && eligible(b)) islands_->links.push_back({a, b});
     }
@@ -253,9 +275,11 @@ bool World::group_islands(bool implicit_only, const vec<uint8_t>* failed) {
 uint32_t World::detect_contacts(double h, double travel_fraction, double extra_reach) {
     uint32_t warning_bits = 0;
     for (Slot& slot : slots_) {
-        if (!slot.body) continue;
-        Body& body = *slot.body;
-        if (!slot.contacts) slot.contacts = sh::create<BodyContacts>(body);
+        if (!slot.body()) continue;
+        Body& body = *slot.body();
+        if (!slot.contacts)
+            slot.contacts =
+                sh::create<BodyContacts>(body, slot.stepped->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER);
         BodyContacts& contacts = *slot.contacts;
         contacts.clear();
         // How far a node may go in the (sub)step: twice its speed's reach, plus a little.
@@ -286,7 +310,7 @@ uint32_t World::detect_contacts(double h, double travel_fraction, double extra_r
     for (ColliderSlot& c : colliders_)
         if (c.collider) std::swap(c.collider->pose, c.collider->previous);
     for (Slot& slot : slots_)
-        if (slot.body) slot.body->field = slot.contacts->finish_detection(h);
+        if (slot.body()) slot.body()->field = slot.contacts->finish_detection(h);
     for (ColliderSlot& c : colliders_)
         if (c.collider) std::swap(c.collider->pose, c.collider->previous);
     return warning_bits;
@@ -297,9 +321,9 @@ int32_t World::finish_contacts() {
         if (c.collider) c.collider->state = sh_contact_state{};
     int32_t count = 0;
     for (Slot& slot : slots_) {
-        if (!slot.body || !slot.contacts) continue;
-        if (slot.body->field) count += slot.contacts->accumulate_reactions();
-        slot.body->field = nullptr;
+        if (!slot.body() || !slot.contacts) continue;
+        if (slot.body()->field) count += slot.contacts->accumulate_reactions();
+        slot.body()->field = nullptr;
     }
     for (ColliderSlot& c : colliders_) {
         if (!c.collider) continue;
@@ -323,7 +347,7 @@ void World::step(double dt, sh_step_report* report) {
         run_attempts(dt, r);
     } catch (...) {
         for (Slot& slot : slots_)
-            if (slot.body) slot.body->field = nullptr;
+            if (slot.body()) slot.body()->field = nullptr;
         throw;
     }
     if (has_contact()) {
@@ -338,7 +362,7 @@ void World::step(double dt, sh_step_report* report) {
     for (StepHook* hook : hooks_) hook->after_step(*this, dt);
     const Slot* failed = nullptr;
     for (const Slot& slot : slots_)
-        if (slot.body && slot.failed) {
+        if (slot.body() && slot.failed) {
             ++r.unstable_body_count;
             if (!failed) failed = &slot;
         }
@@ -375,14 +399,14 @@ int32_t World::begin_colliders(double dt) {
 }
 
 void World::save_step_start(Slot& slot) {
-    slot.saved.assign(slot.body->x.begin(), slot.body->x.end());
-    slot.saved.insert(slot.saved.end(), slot.body->v.begin(), slot.body->v.end());
+    slot.saved.assign(slot.body()->x.begin(), slot.body()->x.end());
+    slot.saved.insert(slot.saved.end(), slot.body()->v.begin(), slot.body()->v.end());
 }
 
 void World::restore_step_start(Slot& slot) {
-    const size_t n = slot.body->x.size();
-    std::copy(slot.saved.begin(), slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.body->x.begin());
-    std::copy(slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.saved.end(), slot.body->v.begin());
+    const size_t n = slot.body()->x.size();
+    std::copy(slot.saved.begin(), slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.body()->x.begin());
+    std::copy(slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.saved.end(), slot.body()->v.begin());
 }
 
 // The step as attempts of 1, 2, 4, ... times the contact sub-steps: a body whose attempt
@@ -396,20 +420,21 @@ void World::run_attempts(double dt, sh_step_report& r) {
     skip_.assign(slots_.size(), 0);
     for (Slot& slot : slots_) {
         slot.failed = false;
-        if (slot.body && base > 1) save_step_start(slot);
+        if (slot.body() && base > 1) save_step_start(slot);
     }
     for (int32_t factor = 1;; factor *= 2) {
         for (Slot& slot : slots_)
-            if (slot.body) slot.keep_best = sub_steps_on_failure(*slot.body) && 2 * factor > retry_limit(*slot.body);
+            if (slot.body())
+                slot.keep_best = sub_steps_on_failure(slot.stepped->settings) && 2 * factor > retry_limit(slot.stepped->settings);
         run_substeps(dt, base * factor, r);
         bool retry = false;
         for (size_t index = 0; index < slots_.size(); ++index) {
             Slot& slot = slots_[index];
-            if (!slot.body) continue;
+            if (!slot.body()) continue;
             skip_[index] = 1;  // done, unless it retries
             if (!slot.failed) continue;
             if (base * factor > 1) restore_step_start(slot);
-            if (2 * factor > retry_limit(*slot.body)) continue;  // final: reported by step()
+            if (2 * factor > retry_limit(slot.stepped->settings)) continue;  // final: reported by step()
             if (base * factor == 1) save_step_start(slot);
             slot.failed = false;
             skip_[index] = 0;
@@ -421,14 +446,11 @@ void World::run_attempts(double dt, sh_step_report& r) {
     }
 }
 
-bool World::sub_steps_on_failure(const Body& body) {
-    const IntegrationSettings& s = body.settings;
+bool World::sub_steps_on_failure(const StepSettings& s) {
     return s.integrator == SH_INTEGRATOR_IMPLICIT_EULER && s.on_unstable == SH_UNSTABLE_SUBSTEP;
 }
 
-int32_t World::retry_limit(const Body& body) {
-    return sub_steps_on_failure(body) ? body.settings.implicit.max_substeps : 1;
-}
+int32_t World::retry_limit(const StepSettings& s) { return sub_steps_on_failure(s) ? s.implicit.max_substeps : 1; }
 
 // substeps equal sub-steps of the bodies not in skip_, each tool moving its share of the step
 // from its start pose, with contact detection before each.
@@ -458,7 +480,7 @@ void World::run_substeps(double dt, int32_t substeps, sh_step_report& r) {
 
 void World::add_energies(sh_step_report& r) const {
     for (const Slot& slot : slots_) {
-        const Body* body = slot.body;
+        const Body* body = slot.body();
         if (!body) continue;
         for (int32_t i = 0; i < body->node_count(); ++i) {
             const double m = body->mass[static_cast<size_t>(i)];
@@ -475,7 +497,7 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
     const double start = now_seconds();
     sh_static_report r{};
     for (Slot& slot : slots_)
-        if (slot.body) save_start_state(*slot.body);
+        if (slot.body()) save_start_state(*slot.stepped);
     for (StepHook* hook : hooks_) hook->before_step(*this);
     try {
         if (has_contact()) {
@@ -488,15 +510,15 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
                 for (int k = 0; k < 3; ++k) c.collider->velocity[k] = c.collider->angular[k] = 0.0;
             }
             for (Slot& slot : slots_)
-                if (slot.body) std::fill(slot.body->v.begin(), slot.body->v.end(), 0.0);
+                if (slot.body()) std::fill(slot.body()->v.begin(), slot.body()->v.end(), 0.0);
         }
         double reach = 0.0, extent = 0.0;
         for (const ColliderSlot& c : colliders_)
             if (c.collider && c.collider->shape.kind() != SH_SHAPE_PLANE) reach = std::max(reach, c.collider->shape.inner_radius());
         for (const Slot& slot : slots_) {
-            if (!slot.body) continue;
+            if (!slot.body()) continue;
             Aabb box;
-            for (size_t j = 0; j < slot.body->x.size(); j += 3) box.add(&slot.body->x[j]);
+            for (size_t j = 0; j < slot.body()->x.size(); j += 3) box.add(&slot.body()->x[j]);
             for (int k = 0; k < 3; ++k) extent = std::max(extent, box.hi[k] - box.lo[k]);
         }
         reach = std::max(reach, 0.05 * extent);
@@ -504,15 +526,15 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
         if (has_contact()) detect_contacts(0.0, 0.0, reach);  // h = 0: the contact law at rest
         const bool coupled = group_islands(false, nullptr);
         for (size_t index = 0; index < slots_.size(); ++index)
-            if (slots_[index].body && !(coupled && islands_->island_of(index) >= 0))
-                solve_static_body(*slots_[index].body, gravity, def, r);
+            if (slots_[index].body() && !(coupled && islands_->island_of(index) >= 0))
+                solve_static_body(*slots_[index].stepped, gravity, def, r);
         if (coupled) solve_static_islands(def, r);
         if (has_contact()) finish_contacts();
     } catch (...) {
         for (Slot& slot : slots_)
-            if (slot.body) {
-                slot.body->field = nullptr;
-                restore_start_state(*slot.body);
+            if (slot.body()) {
+                slot.body()->field = nullptr;
+                restore_start_state(*slot.stepped);
             }
         r.wall_seconds = now_seconds() - start;
         if (report) *report = r;  // what was tried, for the host's diagnosis

@@ -4,6 +4,7 @@
 #include "core/memory.hpp"
 #include "model/body.hpp"
 #include "solver/explicit_integrator.hpp"
+#include "solver/stepped_body.hpp"
 #include "world/step_hook.hpp"
 
 #include <softhap/softhap.h>
@@ -13,6 +14,7 @@
 namespace sh {
 
 class BodyContacts;
+struct TetMesh;
 class ContactIslands;
 struct Collider;
 struct ImplicitState;
@@ -26,8 +28,21 @@ public:
     World(const World&) = delete;
     World& operator=(const World&) = delete;
 
-    /// Takes ownership of body (made with sh::create) and returns its new id.
-    sh_body_id add_body(Body* body);
+    /// Takes ownership of body (made with sh::create), to be stepped with settings; returns
+    /// its new id.
+    sh_body_id add_body(Body* body, const StepSettings& settings);
+
+    /// Adds an FEM body made from mesh with one material (see FemBody), stepped with settings;
+    /// counts SH_WARN_LOCKING if the material locks linear tets. Returns its id.
+    sh_body_id add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
+                            double damping_stiffness, const StepSettings& settings);
+
+    /// Gives elements[0..count) of FEM body id material (SH_ERR_UNSUPPORTED for a spring body);
+    /// counts SH_WARN_LOCKING if it locks linear tets.
+    void set_material(sh_body_id id, const int32_t* elements, int32_t count, const sh_material& material);
+
+    /// How body id is stepped; throws SH_ERR_INVALID_HANDLE like body().
+    const StepSettings& step_settings(sh_body_id id) const;
 
     /// Destroys the body; its id becomes stale. Throws SH_ERR_INVALID_HANDLE if not live.
     void remove_body(sh_body_id id);
@@ -76,7 +91,7 @@ public:
     template <class Visit>
     void for_each_body(Visit&& visit) const {
         for (size_t index = 0; index < slots_.size(); ++index)
-            if (slots_[index].body) visit(id_of(index), *slots_[index].body);
+            if (slots_[index].body()) visit(id_of(index), *slots_[index].body());
     }
 
     double gravity[3];
@@ -84,8 +99,9 @@ public:
 
 private:
     struct Slot {
-        Body* body = nullptr;
-        ImplicitState* implicit = nullptr;  ///< built on the first implicit step
+        SteppedBody* stepped = nullptr;     ///< the body with its step settings and scratch;
+                                            ///< null for a free slot
+        Body* body() const { return stepped ? stepped->body : nullptr; }
         StepDoubling* doubling = nullptr;   ///< with error_estimate_ only
         BodyContacts* contacts = nullptr;   ///< built on the first step with contact
         vec<double> saved;                  ///< x then v at the step's start, for attempts
@@ -114,11 +130,12 @@ private:
     void restore_step_start(Slot& slot);
     /// Runs the step's attempts (see world.cpp).
     void run_attempts(double dt, sh_step_report& r);
-    /// True if a failed step of body is retried in sub-steps and its last attempt keeps its
-    /// best iterate (an implicit body with policy SH_UNSTABLE_SUBSTEP).
-    static bool sub_steps_on_failure(const Body& body);
-    /// How many sub-steps (times the contact sub-steps) a step of body may be retried in.
-    static int32_t retry_limit(const Body& body);
+    /// True if a failed step of a body stepped with s is retried in sub-steps and its last
+    /// attempt keeps its best iterate (an implicit body with policy SH_UNSTABLE_SUBSTEP).
+    static bool sub_steps_on_failure(const StepSettings& s);
+    /// How many sub-steps (times the contact sub-steps) a step of a body stepped with s may be
+    /// retried in.
+    static int32_t retry_limit(const StepSettings& s);
     /// Steps the bodies not in skip_ through substeps equal sub-steps of dt.
     void run_substeps(double dt, int32_t substeps, sh_step_report& r);
     /// Steps every body not in skip by h, adding to r; a body that fails joins skip.

@@ -95,8 +95,8 @@ def test_every_header_function_is_declared():
 
 def _python_constants():
     """{C name: value} of every enum constant and macro the bindings mirror."""
-    constants = {"SH_VERSION": _lib.SH_VERSION, "SH_WARN_COUNT": _lib.SH_WARN_COUNT,
-                 "SH_STATIC_HISTORY": _lib.SH_STATIC_HISTORY}
+    constants = {"SH_VERSION": _lib.SH_VERSION, "SH_STATIC_HISTORY": _lib.SH_STATIC_HISTORY}
+    constants.update({name: value for name, value in vars(_lib).items() if re.fullmatch(r"SH_\w+_COUNT", name)})
     for enum_class in (_lib.Status, _lib.WarningKind, _lib.FeatureKind, _lib.HapticFault):
         constants.update({member.name: int(member) for member in enum_class})
     for prefix, table in [

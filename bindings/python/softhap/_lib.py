@@ -87,6 +87,9 @@ class FeatureKind(enum.IntEnum):
     SH_FEATURE_CCD = 2
 
 
+# Each enum of kinds as {name: value}, the name being the C constant's lower-case suffix
+# ("rk4" for SH_INTEGRATOR_RK4), followed by its SH_*_COUNT sentinel: the number of kinds, not
+# a kind. Adding a kind to the header adds its name here.
 INTEGRATORS = {
     "forward_euler": 0,
     "symplectic_euler": 1,
@@ -94,6 +97,7 @@ INTEGRATORS = {
     "rk4": 3,
     "implicit_euler": 4,
 }
+SH_INTEGRATOR_COUNT = len(INTEGRATORS)
 
 LINEAR_SOLVERS = {
     "default": 0,
@@ -101,6 +105,7 @@ LINEAR_SOLVERS = {
     "ldlt": 2,
     "cg": 3,
 }
+SH_LINEAR_SOLVER_COUNT = len(LINEAR_SOLVERS)
 
 SH_STATIC_HISTORY = 64
 
@@ -108,6 +113,7 @@ UNSTABLE_POLICIES = {
     "reject": 0,
     "substep": 1,
 }
+SH_UNSTABLE_POLICY_COUNT = len(UNSTABLE_POLICIES)
 
 MATERIAL_MODELS = {
     "linear": 0,
@@ -115,6 +121,7 @@ MATERIAL_MODELS = {
     "corotational": 2,
     "neohookean": 3,
 }
+SH_MATERIAL_COUNT = len(MATERIAL_MODELS)
 
 SPRING_LAWS = {
     "linear": 0,
@@ -122,6 +129,7 @@ SPRING_LAWS = {
     "hyperbolic": 2,
     "table": 3,
 }
+SH_SPRING_LAW_COUNT = len(SPRING_LAWS)
 
 SHAPE_KINDS = {
     "sphere": 0,
@@ -130,6 +138,7 @@ SHAPE_KINDS = {
     "convex": 3,
     "plane": 4,
 }
+SH_SHAPE_COUNT = len(SHAPE_KINDS)
 
 # ------------------------------------------------------------------------------------------------
 # Structs. Enums are C ints; sh_body_id, sh_tool_id and sh_obstacle_id are uint64_t; opaque

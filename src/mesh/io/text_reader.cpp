@@ -15,9 +15,10 @@ bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' |
 
 char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
 
-// Drops one leading '+' (std::from_chars does not accept it) unless it stands alone.
+// Drops one leading '+' (std::from_chars does not accept it) unless it stands alone or comes
+// before a '-', which from_chars would then take as the sign: "+-1" is not a number.
 std::string_view without_plus(std::string_view token) {
-    if (token.size() > 1 && token[0] == '+') token.remove_prefix(1);
+    if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
     return token;
 }
 

@@ -1,8 +1,7 @@
-// Shape::deepest_excess: how far a shape's contact potential over a surface edge or triangle
-// exceeds the linear interpolant of its nodes' own potentials, the quantity the contact
-// potential's face and edge terms take (contact/shape_contact.cpp). One solver per shape
-// kind, chosen through one table; the sphere's is exact.
-#include "collision/shape.hpp"
+// The excess of a ball's contact potential over a surface edge or triangle: how far the
+// potential exceeds the linear interpolant of the nodes' own potentials, the quantity the
+// contact potential's face and edge terms take (contact/shape_contact.cpp).
+#include "collision/ball_excess.hpp"
 
 #include "core/vec3.hpp"
 
@@ -12,23 +11,7 @@
 namespace sh {
 namespace {
 
-// A simplex in the shape's local frame: count (2 or 3) points and their nodes' energies (J).
-struct LocalSimplex {
-    double p[3][3];
-    double energy[3];
-    int count;
-};
-
-// A candidate maximiser in the local frame.
-struct LocalExcess {
-    double value = -INFINITY;  ///< J
-    double depth = 0.0;        ///< m
-    double w[3] = {0.0, 0.0, 0.0};
-    double x[3] = {0.0, 0.0, 0.0};
-    double n[3] = {0.0, 0.0, 1.0};     ///< unit push
-    double push[3] = {0.0, 0.0, 0.0};  ///< N
-};
-
+// The nodes' energies interpolated at weights w (J).
 double interpolated_energy(const LocalSimplex& s, const double w[3]) {
     double e = 0.0;
     for (int i = 0; i < s.count; ++i) e += w[i] * s.energy[i];
@@ -154,6 +137,8 @@ void ball_inside_triangle(const LocalSimplex& s, const DepthPotential& psi, cons
     ball_candidate(s, psi, centre, radius, x, w, best);
 }
 
+}  // namespace
+
 LocalExcess ball_excess(const LocalSimplex& s, const DepthPotential& psi, const double centre[3], double radius) {
     LocalExcess best;
     if (s.count == 3) ball_inside_triangle(s, psi, centre, radius, best);
@@ -162,45 +147,6 @@ LocalExcess ball_excess(const LocalSimplex& s, const DepthPotential& psi, const 
         ball_on_segment(s, psi, centre, radius, i, (i + 1) % s.count, best);
     }
     return best;
-}
-
-LocalExcess sphere_excess(const Shape& shape, const LocalSimplex& s, const DepthPotential& psi) {
-    const double centre[3] = {0.0, 0.0, 0.0};
-    return ball_excess(s, psi, centre, shape.radius());
-}
-
-LocalExcess no_excess(const Shape&, const LocalSimplex&, const DepthPotential&) { return LocalExcess{}; }
-
-using ExcessSolver = LocalExcess (*)(const Shape&, const LocalSimplex&, const DepthPotential&);
-
-// Per shape kind, in the order of sh_shape_kind.
-// Capsules, boxes and convex hulls have none yet: their nodes carry their contact (the best
-// ball along a capsule's axis and the vertices of a polytope's facet arrangement both make
-// the maximum jump or kink where its maximiser changes, which Newton does not survive).
-constexpr ExcessSolver kExcessSolvers[] = {sphere_excess, no_excess, no_excess, no_excess, no_excess};
-
-}  // namespace
-
-bool Shape::deepest_excess(const Pose& pose, const double* const points[3], const double node_energy[3], int count,
-                           const DepthPotential& psi, SimplexExcess& out) const {
-    static_assert(SH_SHAPE_SPHERE == 0 && SH_SHAPE_CAPSULE == 1 && SH_SHAPE_BOX == 2 && SH_SHAPE_CONVEX == 3 &&
-                      SH_SHAPE_PLANE == 4,
-                  "kExcessSolvers follows sh_shape_kind");
-    LocalSimplex s;
-    s.count = count;
-    for (int i = 0; i < count; ++i) {
-        pose.to_local(points[i], s.p[i]);
-        s.energy[i] = node_energy[i];
-    }
-    const LocalExcess e = kExcessSolvers[static_cast<int>(kind_)](*this, s, psi);
-    if (!(e.value > 0.0) || !std::isfinite(e.value)) return false;
-    out.value = e.value;
-    out.depth = e.depth;
-    for (int k = 0; k < 3; ++k) out.weights[k] = k < count ? e.w[k] : 0.0;
-    pose.to_world(e.x, out.point);
-    pose.rotate(e.n, out.normal);
-    pose.rotate(e.push, out.push);
-    return true;
 }
 
 }  // namespace sh

@@ -1,0 +1,53 @@
+// The sphere kind: radius around the pose's position. A row of the shape table.
+#include "collision/ball_excess.hpp"
+#include "collision/shape_kind.hpp"
+#include "collision/unit_vector.hpp"
+#include "core/vec3.hpp"
+
+namespace sh {
+namespace {
+
+void sphere_init(const sh_shape& def, ShapeGeometry& g) {
+    g.radius = checked_radius(def);
+    g.inner_radius = g.radius;
+}
+
+void sphere_bounds(const ShapeGeometry& g, const Pose& pose, double margin, double lo[3], double hi[3]) {
+    const double reach[3] = {g.radius, g.radius, g.radius};
+    centred_bounds(pose, reach, margin, lo, hi);
+}
+
+void sphere_support(const ShapeGeometry& g, const Pose& pose, const double dir[3], double out[3]) {
+    double u[3] = {dir[0], dir[1], dir[2]};
+    if (!normalize3(u)) {
+        const double ex[3] = {1.0, 0.0, 0.0};
+        pose.rotate(ex, u);
+    }
+    for (int k = 0; k < 3; ++k) out[k] = pose.p[k] + g.radius * u[k];
+}
+
+bool sphere_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth, double normal[3]) {
+    double d[3] = {x[0] - pose.p[0], x[1] - pose.p[1], x[2] - pose.p[2]};
+    const double dist = norm3(d);
+    depth = g.radius - dist;
+    if (!(depth > 0.0)) return false;
+    if (dist > 1e-12 * g.radius && normalize3(d)) {
+        for (int k = 0; k < 3; ++k) normal[k] = d[k];
+    } else {  // at the centre: any direction; the local x axis
+        const double ex[3] = {1.0, 0.0, 0.0};
+        pose.rotate(ex, normal);
+    }
+    return true;
+}
+
+LocalExcess sphere_excess(const ShapeGeometry& g, const LocalSimplex& s, const DepthPotential& psi) {
+    const double centre[3] = {0.0, 0.0, 0.0};
+    return ball_excess(s, psi, centre, g.radius);
+}
+
+}  // namespace
+
+extern const ShapeKind kSphereShape = {SH_SHAPE_SPHERE, "sphere",       sphere_init,      sphere_bounds,
+                                       sphere_support,  sphere_penetrate, sphere_excess};
+
+}  // namespace sh

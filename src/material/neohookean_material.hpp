@@ -1,0 +1,87 @@
+// Stable neo-Hookean elasticity (Smith, de Goes, Kim 2018), a row of the material table
+// (material_table.hpp).
+#pragma once
+
+#include "material/isotropic_law.hpp"
+
+#include <softhap/softhap.h>
+
+#include <cmath>
+
+namespace sh {
+
+/// psi = m/2 (Ic - 3) + l/2 (J - a)^2 - m/2 log(Ic + 1) - psi(I), a = 1 + 3m/(4l),
+/// with m = 4/3 mu and l = lambda + 5/6 mu so that small strains match linear elasticity.
+struct NeoHookeanMaterial {
+    /// Its sh_material_model.
+    static constexpr sh_material_model kModel = SH_MATERIAL_NEOHOOKEAN;
+    /// dP/dF is indefinite away from rest: projected per element.
+    static constexpr bool kProjectTangent = true;
+
+    /// Cofactor matrix, Ic = |F|^2 and J = det F, reused by differential().
+    struct State {
+        Mat3L cof;
+        Lanes ic, j;
+    };
+    /// det F, as stress() computed it.
+    static SH_INLINE Lanes jacobian(const Mat3L&, const State& state) { return state.j; }
+    /// m, l and alpha; alpha only depends on the ratio mu/lambda, and lanes with lambda = mu = 0
+    /// (block padding) get alpha = 1 so that they stay finite (and, having zero moduli, inert).
+    static SH_INLINE void parameters(Lanes lambda, Lanes mu, Lanes& m, Lanes& l, Lanes& alpha) {
+        m = (4.0 / 3.0) * mu;
+        l = lambda + (5.0 / 6.0) * mu;
+        alpha = select(l != 0.0, 1.0 + 0.75 * m / l, splat(1.0));
+    }
+    /// det F from its cofactor matrix (first row expansion).
+    static SH_INLINE Lanes det_from_cofactor(const Mat3L& F, const Mat3L& cof) {
+        return F.m[0][0] * cof.m[0][0] + F.m[0][1] * cof.m[0][1] + F.m[0][2] * cof.m[0][2];
+    }
+    /// P(F); keeps cof F, Ic and J in state.
+    static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State& state) {
+        Lanes m, l, alpha;
+        parameters(lambda, mu, m, l, alpha);
+        state.ic = ddot(F, F);
+        state.cof = cofactor(F);
+        state.j = det_from_cofactor(F, state.cof);
+        return combine(m * (1.0 - 1.0 / (state.ic + 1.0)), F, l * (state.j - alpha), state.cof);
+    }
+    /// dP(F)[dF].
+    static SH_INLINE Mat3L differential(const Mat3L& F, const State& state, const Mat3L& dF, Lanes lambda, Lanes mu) {
+        Lanes m, l, alpha;
+        parameters(lambda, mu, m, l, alpha);
+        const Lanes inv = 1.0 / (state.ic + 1.0);
+        // d cof(F)[dF]: cofactor is bilinear, so its differential is cof(F + dF) - cof(F) - cof(dF).
+        Mat3L F_plus = F;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) F_plus.m[i][j] += dF.m[i][j];
+        const Mat3L c_plus = cofactor(F_plus), c_d = cofactor(dF);
+        Mat3L dcof;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) dcof.m[i][j] = c_plus.m[i][j] - state.cof.m[i][j] - c_d.m[i][j];
+        const Mat3L a = combine(m * (1.0 - inv), dF, 2.0 * m * inv * inv * ddot(F, dF), F);
+        const Mat3L b = combine(l * ddot(state.cof, dF), state.cof, l * (state.j - alpha), dcof);
+        Mat3L r;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][j] + b.m[i][j];
+        return r;
+    }
+    /// psi(F).
+    static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) {
+        Lanes m, l, alpha;
+        parameters(lambda, mu, m, l, alpha);
+        // Written in H = F - I so that no O(lambda) constants cancel near rest:
+        // Ic - 3 = 2 tr H + |H|^2, J - 1 = tr H + i2(H) + det H,
+        // (J - a)^2 - (1 - a)^2 = (J - 1)(J - 1 + 2 (1 - a)).
+        const Mat3L H = add_diagonal(F, splat(-1.0));
+        const Lanes tr = trace(H), hh = ddot(H, H);
+        Lanes h2 = Lanes{};  // tr(H H)
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) h2 += H.m[i][j] * H.m[j][i];
+        const Lanes ic3 = 2.0 * tr + hh, j1 = tr + 0.5 * (tr * tr - h2) + det(H);
+        Lanes logs;
+        for (int k = 0; k < kLanes; ++k) logs[k] = std::log1p(0.25 * ic3[k]);
+        return 0.5 * m * (ic3 - logs) + 0.5 * l * j1 * (j1 + 2.0 * (1.0 - alpha));
+    }
+};
+
+}  // namespace sh

@@ -61,6 +61,6 @@ bool box_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3], 
 
 // No excess solver: the vertices of a box's facet arrangement make the maximum jump or kink
 // where its maximiser changes, which Newton does not survive; the nodes carry its contact.
-extern const ShapeKind kBoxShape = {SH_SHAPE_BOX, "box", box_init, box_bounds, box_support, box_penetrate, no_excess};
+extern const ShapeKind kBoxShape = {SH_SHAPE_BOX, "box", false, box_init, box_bounds, box_support, box_penetrate, no_excess};
 
 }  // namespace sh

@@ -60,7 +60,7 @@ bool capsule_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[
 
 // No excess solver: the best ball along the axis makes the maximum kink where its maximiser
 // changes, which Newton does not survive; the nodes carry the capsule's contact.
-extern const ShapeKind kCapsuleShape = {SH_SHAPE_CAPSULE, "capsule",         capsule_init, capsule_bounds,
+extern const ShapeKind kCapsuleShape = {SH_SHAPE_CAPSULE, "capsule", false,         capsule_init, capsule_bounds,
                                         capsule_support,  capsule_penetrate, no_excess};
 
 }  // namespace sh

@@ -62,7 +62,7 @@ bool convex_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3
 
 // No excess solver: the vertices of a polytope's facet arrangement make the maximum jump or
 // kink where its maximiser changes, which Newton does not survive; the nodes carry its contact.
-extern const ShapeKind kConvexShape = {SH_SHAPE_CONVEX, "convex",         convex_init, convex_bounds,
+extern const ShapeKind kConvexShape = {SH_SHAPE_CONVEX, "convex", false,         convex_init, convex_bounds,
                                        convex_support,  convex_penetrate, no_excess};
 
 }  // namespace sh

@@ -54,7 +54,7 @@ bool plane_penetrate(const ShapeGeometry&, const Pose& pose, const double x[3], 
 }  // namespace
 
 // No excess solver: a plane's depth is linear, so its nodes carry all of it.
-extern const ShapeKind kPlaneShape = {SH_SHAPE_PLANE, "plane",         plane_init, plane_bounds,
+extern const ShapeKind kPlaneShape = {SH_SHAPE_PLANE, "plane", true,         plane_init, plane_bounds,
                                       plane_support,  plane_penetrate, no_excess};
 
 Pose plane_pose(const double point[3], const double normal[3]) {

@@ -15,6 +15,10 @@ Shape::Shape(const sh_shape& def) : row_(&shape_kind(enum_value(def.kind))), kin
     row_->init(def, geometry_);
 }
 
+bool Shape::is_half_space() const { return row_->half_space; }
+
+bool Shape::has_excess() const { return row_->excess != no_excess; }
+
 void Shape::bounds(const Pose& pose, double margin, double lo[3], double hi[3]) const {
     row_->bounds(geometry_, pose, margin, lo, hi);
 }

@@ -55,6 +55,12 @@ public:
 
     sh_shape_kind kind() const { return kind_; }
 
+    /// True for an unbounded half-space (a plane; see ShapeKind::half_space).
+    bool is_half_space() const;
+
+    /// True if the kind has an excess solver (deepest_excess can be > 0).
+    bool has_excess() const;
+
     /// Half the thinnest width of the shape (m): a point moving less than this per query
     /// cannot cross it unseen. INFINITY for a plane. For a convex hull it is an estimate (the
     /// thinnest width over a fixed set of sampled directions, so never below the exact value).

@@ -35,6 +35,9 @@ struct LocalExcess {
 struct ShapeKind {
     sh_shape_kind kind;  ///< the row's index in the table
     const char* name;    ///< as the Python bindings spell it
+    /// An unbounded half-space (a plane): obstacles only, posed from a point and a normal, its
+    /// depth linear (its nodes carry all of its contact), nothing to sub-step its motion by.
+    bool half_space;
     /// Validates the kind's fields of def (SH_ERR_INVALID_ARGUMENT naming the field) and fills
     /// its fields of g, inner_radius included.
     void (*init)(const sh_shape& def, ShapeGeometry& g);

@@ -47,7 +47,7 @@ LocalExcess sphere_excess(const ShapeGeometry& g, const LocalSimplex& s, const D
 
 }  // namespace
 
-extern const ShapeKind kSphereShape = {SH_SHAPE_SPHERE, "sphere",       sphere_init,      sphere_bounds,
+extern const ShapeKind kSphereShape = {SH_SHAPE_SPHERE, "sphere", false,       sphere_init,      sphere_bounds,
                                        sphere_support,  sphere_penetrate, sphere_excess};
 
 }  // namespace sh

@@ -48,8 +48,8 @@ Pose checked_pose(const double position[3], const double orientation[4], const c
 
 namespace {
 
-Pose initial_pose(const sh_collider_def& def) {
-    if (def.shape.kind == SH_SHAPE_PLANE) {
+Pose initial_pose(const sh_collider_def& def, const Shape& shape) {
+    if (shape.is_half_space()) {
         for (int k = 0; k < 3; ++k)
             SH_REQUIRE(std::isfinite(def.position[k]), SH_ERR_INVALID_ARGUMENT, "position[%d] = %g is not finite", k,
                        def.position[k]);
@@ -61,10 +61,10 @@ Pose initial_pose(const sh_collider_def& def) {
 }  // namespace
 
 Collider::Collider(const sh_collider_def& def, bool tool) : shape(def.shape), is_tool(tool), params(def.contact) {
-    require(!(tool && def.shape.kind == SH_SHAPE_PLANE), SH_ERR_INVALID_ARGUMENT,
+    require(!(tool && shape.is_half_space()), SH_ERR_INVALID_ARGUMENT,
             "shape.kind = SH_SHAPE_PLANE: a plane can only be an obstacle, not a tool");
     validate_contact_params(params, "contact");
-    pose = initial_pose(def);
+    pose = initial_pose(def, shape);
     start = pose;
     previous = pose;
     target = pose;
@@ -92,7 +92,7 @@ void Collider::begin_step(double dt) {
 }
 
 double Collider::travel() const {
-    if (shape.kind() == SH_SHAPE_PLANE) return 0.0;
+    if (shape.is_half_space()) return 0.0;
     double move = 0.0, dot = 0.0;
     for (int k = 0; k < 3; ++k) move += (target.p[k] - start.p[k]) * (target.p[k] - start.p[k]);
     for (int k = 0; k < 4; ++k) dot += target.q[k] * start.q[k];

@@ -41,7 +41,7 @@ bool BodyContacts::detect(Collider& collider, double reach) {
         query.lo[k] = lo[k];
         query.hi[k] = hi[k];
     }
-    const bool plane = collider.shape.kind() == SH_SHAPE_PLANE;
+    const bool plane = collider.shape.is_half_space();
     double normal[3] = {0.0, 0.0, 1.0};
     const double local_z[3] = {0.0, 0.0, 1.0};
     if (plane) collider.pose.rotate(local_z, normal);

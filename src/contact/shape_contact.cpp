@@ -91,7 +91,7 @@ double resolved_band(const Collider& collider) { return 0.02 * collider.shape.in
 
 bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
                           int count, double weight, ContactPoint& out) {
-    if (collider.shape.kind() == SH_SHAPE_PLANE || !(weight > 0.0)) return false;
+    if (!collider.shape.has_excess() || !(weight > 0.0)) return false;
     const StepLawPotential psi(collider.params, law);
     double node_energy[3], node_push[3][3], node_normal[3][3];
     const double* points[3];

@@ -514,7 +514,7 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
         }
         double reach = 0.0, extent = 0.0;
         for (const ColliderSlot& c : colliders_)
-            if (c.collider && c.collider->shape.kind() != SH_SHAPE_PLANE) reach = std::max(reach, c.collider->shape.inner_radius());
+            if (c.collider && !c.collider->shape.is_half_space()) reach = std::max(reach, c.collider->shape.inner_radius());
         for (const Slot& slot : slots_) {
             if (!slot.body()) continue;
             Aabb box;

@@ -154,9 +154,10 @@ void HapticContext::select_tets(const FemBody& body, const double center[3], int
     }
 }
 
-void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], double runaway_speed, Buffer& out) {
+// Local node numbers of the chosen tets (local_of_, ring_), in ascending body order, so that
+// the haptic side can match buffers by a merge.
+void HapticContext::number_nodes(const FemBody& body, Buffer& out) {
     const int32_t* elements = body.element_nodes();
-    // Local numbers in ascending body order, so that the haptic side can match buffers by a merge.
     int32_t n = 0;
     ring_.clear();
     for (const int32_t t : chosen_)
@@ -171,7 +172,11 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], do
     for (const int32_t node : ring_) local_of_[static_cast<size_t>(node)] = n++;
     out.node_count = n;
     out.tet_count = static_cast<int32_t>(chosen_.size());
+}
 
+// The nodes' ids, start and end positions, masses, and which are interior.
+void HapticContext::fill_nodes(const FemBody& body, Buffer& out) {
+    const int32_t n = out.node_count;
     const bool have_start = out.period > 0.0 && x_before_body_ == out.body && x_before_.size() == body.x.size();
     const double* start = have_start ? x_before_.data() : body.x.data();
     for (int32_t i = 0; i < n; ++i) {
@@ -191,8 +196,12 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], do
                               body.is_free(node) && !other_contact_[static_cast<size_t>(node)];
         out.inverse_mass[i] = interior ? 1.0 / out.mass[i] : 0.0;
     }
+}
 
-    // Blocks per material model, lanes over local numbers, spread like the full model's.
+// The tets' kernel blocks per material model, lanes over local numbers, spread like the full
+// model's.
+void HapticContext::fill_blocks(const FemBody& body, Buffer& out) {
+    const int32_t* elements = body.element_nodes();
     int32_t block = 0;
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         out.block_begin[model] = block;
@@ -207,8 +216,11 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], do
         block += static_cast<int32_t>(block_count(members_.size()));
     }
     out.block_begin[SH_MATERIAL_COUNT] = block;
+}
 
-    // The body's surface triangles on a buffer tet.
+// The body's surface triangles that lie on a buffer tet, in local numbers.
+void HapticContext::fill_triangles(const FemBody& body, Buffer& out) {
+    const int32_t* elements = body.element_nodes();
     const vec<int32_t>& tris = body.surface_triangles;
     int32_t count = 0;
     for (size_t t = 0; t < tris.size(); t += 3) {
@@ -234,7 +246,12 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], do
         ++count;
     }
     out.triangle_count = count;
-    // The buffer surface's edges, each once (the contact potential's edge terms).
+}
+
+// The buffer surface's edges, each once (the contact potential's edge terms), the rest sizes
+// of its triangles and edges, and its nodes.
+void HapticContext::fill_surface_features(const FemBody& body, Buffer& out) {
+    const int32_t count = out.triangle_count, n = out.node_count;
     neighbor_.resize(3 * static_cast<size_t>(count));
     pair_triangles_across_edges(out.triangles, static_cast<size_t>(count), neighbor_.data());
     int32_t edges = 0;
@@ -264,7 +281,14 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], do
     for (int32_t i = 0; i < n; ++i)
         if (out.surface_nodes[i]) out.surface_nodes[surface++] = i;  // compacts in place: surface <= i
     out.surface_node_count = surface;
+}
 
+void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], double runaway_speed, Buffer& out) {
+    number_nodes(body, out);
+    fill_nodes(body, out);
+    fill_blocks(body, out);
+    fill_triangles(body, out);
+    fill_surface_features(body, out);
     for (int k = 0; k < 3; ++k) out.gravity[k] = gravity[k];
     out.damping_mass = body.damping_mass;
     out.damping_stiffness = body.damping_stiffness();

@@ -73,6 +73,11 @@ private:
     void extract(World& world, double period, Buffer& out);
     void select_tets(const FemBody& body, const double center[3], int32_t seed_triangle, Buffer& out);
     void fill_buffer(const FemBody& body, const double gravity[3], double runaway_speed, Buffer& out);
+    void number_nodes(const FemBody& body, Buffer& out);
+    void fill_nodes(const FemBody& body, Buffer& out);
+    void fill_blocks(const FemBody& body, Buffer& out);
+    void fill_triangles(const FemBody& body, Buffer& out);
+    void fill_surface_features(const FemBody& body, Buffer& out);
     void ensure_adjacency(const FemBody& body, sh_body_id id);
 
     // haptic side

@@ -33,7 +33,7 @@ def guided_stack(world, damping_mass=0.0):
             point[axis] += sign * (SIDE / 2 - 1e-7)  # 0.1 um into the cube
             normal = np.zeros(3)
             normal[axis] = -sign
-            world.add_obstacle("plane", point=point, normal=normal, stiffness=100.0, exponent=1.0)
+            world.add_obstacle("plane", position=point, normal=normal, stiffness=100.0, exponent=1.0)
     return block, cube, base
 
 

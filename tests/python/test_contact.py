@@ -95,12 +95,12 @@ def test_shape_kinds_match_c(cc, tmp_path):
 
 # Obstacles whose top surface is the plane z = 0 right under the particle at the origin.
 RESTING_SURFACES = {
-    "plane": dict(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0)),
-    "box": dict(center=(0.0, 0.0, -0.05), half_extents=(0.1, 0.1, 0.05)),
-    "sphere": dict(center=(0.0, 0.0, -0.05), radius=0.05),
-    "capsule": dict(center=(0.0, 0.0, -0.08), radius=0.03, half_length=0.05),
+    "plane": dict(position=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0)),
+    "box": dict(position=(0.0, 0.0, -0.05), half_extents=(0.1, 0.1, 0.05)),
+    "sphere": dict(position=(0.0, 0.0, -0.05), radius=0.05),
+    "capsule": dict(position=(0.0, 0.0, -0.08), radius=0.03, half_length=0.05),
     "convex": dict(
-        center=(0.0, 0.0, -0.05),
+        position=(0.0, 0.0, -0.05),
         points=[[x, y, z] for x in (-0.1, 0.1) for y in (-0.1, 0.1) for z in (-0.05, 0.05)],
     ),
 }
@@ -143,7 +143,7 @@ def test_tilted_plane_pushes_along_its_normal():
     normal = np.array([0.3, -0.4, 1.0]) / np.linalg.norm([0.3, -0.4, 1.0])
     origin = np.array([0.0, 0.0, -0.01])
     with softhap.World(gravity=(0, 0, 0)) as world:
-        plane = world.add_obstacle("plane", point=origin, normal=normal * 7.0,
+        plane = world.add_obstacle("plane", position=origin, normal=normal * 7.0,
                                    stiffness=stiffness, exponent=exponent)
         lateral = np.array([0.01, 0.02, 0.0])
         lateral -= np.dot(lateral, normal) * normal  # along the plane
@@ -552,10 +552,11 @@ def test_python_side_argument_errors_are_value_errors():
             world.add_tool("sphere", half_extents=(1, 1, 1))
         with pytest.raises(ValueError, match="normal"):
             world.add_obstacle("box", half_extents=(1, 1, 1), normal=(0, 0, 1))
-        with pytest.raises(ValueError, match="center"):
-            world.add_obstacle("plane", center=(0, 0, 0))
-        with pytest.raises(ValueError, match="point"):
-            world.add_obstacle("sphere", point=(0, 0, 0))
+        with pytest.raises(ValueError, match="orientation"):
+            world.add_obstacle("plane", orientation=(1, 0, 0, 0))  # a plane has only its normal
+        for old in ("point", "center"):  # every obstacle is placed with position= since 0.6
+            with pytest.raises(TypeError, match=old):
+                world.add_obstacle("plane", **{old: (0, 0, 0)})
         with pytest.raises(ValueError, match="friction"):
             world.add_tool("sphere", friction=0.3, static_friction=0.5)
         with pytest.raises(ValueError, match="points"):

@@ -244,7 +244,7 @@ def test_nodes_on_a_table_stay_with_the_full_model():
         box_mesh((0.02, 0.02, TOP), (6, 6, 3)), model="linear", young=5e3, poisson=0.3, density=1000.0,
         damping_mass=40.0,
     )
-    world.add_obstacle("plane", point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), stiffness=1e3, exponent=1.0)
+    world.add_obstacle("plane", position=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), stiffness=1e3, exponent=1.0)
     tool = world.add_tool("sphere", radius=RADIUS, position=(0.01, 0.01, 0.05), stiffness=100.0, exponent=1.0, damping=0.0)
     for _ in range(300):
         world.step(1e-3)

@@ -161,7 +161,7 @@ def test_static_tet_matches_textbook_stiffness():
         body.fix_nodes([0, 2, 3])
         forces = np.zeros((4, 3))
         forces[1] = force
-        body.apply_forces(forces)
+        body.set_external_forces(forces)
         report = world.solve_static()
         assert report.converged
         np.testing.assert_allclose(body.positions[1], UNIT_TET[1] + u1, rtol=1e-9)

@@ -82,18 +82,18 @@ def test_external_force_accelerates_particle_and_none_clears_it():
     m, f, dt, n = 0.002, 0.01, 0.01, 30
     with softhap.World(gravity=(0, 0, 0)) as world:
         body = particle(world, z0=0.0, mass=m, integrator="rk4")
-        body.apply_forces([[f, 0.0, 0.0]])
+        body.set_external_forces([[f, 0.0, 0.0]])
         for _ in range(n):
             world.step(dt)
         t = n * dt
         np.testing.assert_allclose(body.positions[0], [f * t * t / (2 * m), 0, 0], atol=1e-12)
         np.testing.assert_allclose(body.velocities[0], [f * t / m, 0, 0], atol=1e-12)
-        body.apply_forces(None)
+        body.set_external_forces(None)
         v = body.velocities
         world.step(dt)
         np.testing.assert_allclose(body.velocities, v, atol=1e-15)  # force cleared
         with pytest.raises(ValueError):
-            body.apply_forces([[1.0, 2.0]])
+            body.set_external_forces([[1.0, 2.0]])
 
 
 def test_per_node_damping_decays_velocity_exponentially():

@@ -106,7 +106,7 @@ def test_body_of_a_closed_world_raises_instead_of_crashing():
         body.elastic_forces,
         body.elastic_energy,
         lambda: body.fix_nodes([0]),
-        lambda: body.apply_forces(None),
+        lambda: body.set_external_forces(None),
         lambda: body.set_node_damping(None),
         lambda: body.set_material([0], young=1e3),
         lambda: body.write_vtu("never.vtu"),
@@ -255,7 +255,7 @@ def test_repr_and_ids():
 def test_non_finite_state_is_rolled_back():
     with softhap.World(gravity=(0.0, 0.0, 0.0)) as world:
         body = world.add_spring_body([[0.0, 0.0, 1.0]], mass=1e-3)
-        body.apply_forces([[1e308, 0.0, 0.0]])  # finite, but a = F / m overflows to inf
+        body.set_external_forces([[1e308, 0.0, 0.0]])  # finite, but a = F / m overflows to inf
         with pytest.raises(softhap.Error) as info:
             world.step(0.01)
         assert info.value.status_name == "SH_ERR_UNSTABLE"
@@ -263,5 +263,5 @@ def test_non_finite_state_is_rolled_back():
         np.testing.assert_array_equal(body.positions, [[0.0, 0.0, 1.0]])
         np.testing.assert_array_equal(body.velocities, [[0.0, 0.0, 0.0]])
         assert world.warnings["SH_WARN_UNSTABLE"] == 1
-        body.apply_forces(None)
+        body.set_external_forces(None)
         world.step(0.01)  # usable again

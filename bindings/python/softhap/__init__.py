@@ -15,6 +15,10 @@ The C library is found through $SOFTHAP_LIBRARY, else libsofthap.so next to this
 call raises softhap.Error with the status and sh_last_error_message().
 """
 
+from __future__ import annotations
+
+from typing import FrozenSet
+
 from ._errors import Error, status_name
 from ._lib import SH_VERSION, FeatureKind, HapticFault, Status, WarningKind, version_string
 from ._loaded import lib as _c_library
@@ -23,7 +27,8 @@ from ._record import BodyInfo, MeshInfo, StaticReport, StepReport
 from .contact import ContactState, Obstacle, Tool
 from .haptic import Haptic, HapticResult
 from .mesh import Mesh
-from .world import Body, World
+from .body import Body
+from .world import World
 
 __version__ = version_string(SH_VERSION)
 
@@ -31,13 +36,13 @@ __version__ = version_string(SH_VERSION)
 library_path = _c_library.softhap_path
 
 
-def version():
+def version() -> int:
     """Version of the loaded C library in the SH_VERSION encoding (MAJOR*1000000 + MINOR*1000
     + PATCH); equal to softhap.SH_VERSION, since import refuses a mismatch."""
     return int(_c_library.sh_version())
 
 
-def build_features():
+def build_features() -> FrozenSet[str]:
     """The optional components compiled into the loaded library, as a frozenset of names
     ("SH_FEATURE_CHOLMOD", "SH_FEATURE_CCD") from the sh_build_features() bit mask."""
     bits = int(_c_library.sh_build_features())

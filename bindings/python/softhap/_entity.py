@@ -1,6 +1,13 @@
 """The identity shared by Body, Tool and Obstacle: a generation-checked id in a World."""
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, cast
+
 from ._loaded import closed_error, lib
+
+if TYPE_CHECKING:
+    from .world import World
 
 
 class WorldEntity:
@@ -11,35 +18,35 @@ class WorldEntity:
     the entity's data; the object keeps its World alive.
     """
 
-    _kind = None
-    _is_valid = None
+    _kind: str = ""
+    _is_valid: str = ""
 
-    def __init__(self, world, entity_id):
+    def __init__(self, world: World, entity_id: int) -> None:
         """Wrap the id entity_id of world (use the World's add_* methods rather than this)."""
         self._world = world
         self._id = int(entity_id)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return "<softhap.%s id=%#x>" % (type(self).__name__, self._id)
 
     @property
-    def world(self):
+    def world(self) -> World:
         """The World this entity belongs to."""
         return self._world
 
     @property
-    def id(self):
+    def id(self) -> int:
         """The generation-checked id (an int; 0 is the null id)."""
         return self._id
 
     @property
-    def is_valid(self):
+    def is_valid(self) -> bool:
         """True while the id names a live entity of an open world."""
         if self._world.closed:
             return False
         return bool(getattr(lib, self._is_valid)(self._world._handle, self._id))
 
-    def _world_handle(self, function):
+    def _world_handle(self, function: str) -> int:
         if self._world.closed:
             raise closed_error("world of this %s" % self._kind, function)
-        return self._world._handle
+        return cast(int, self._world._handle)  # not None: the world is open

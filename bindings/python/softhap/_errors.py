@@ -1,9 +1,13 @@
 """softhap.Error: the exception every failing C call raises."""
 
+from __future__ import annotations
+
+from typing import Any, Optional, Tuple
+
 from ._lib import Status
 
 
-def status_name(status):
+def status_name(status: int) -> str:
     """Return the C enum name of a status code ("SH_ERR_PARSE"), or "SH_STATUS_<n>" if unknown."""
     try:
         return Status(status).name
@@ -25,7 +29,9 @@ class Error(Exception):
             of what was tried when the library filled it; None otherwise.
     """
 
-    def __init__(self, status, message, function=None, report=None):
+    def __init__(
+        self, status: int, message: str, function: Optional[str] = None, report: Any = None
+    ) -> None:
         """Make an error for status (an sh_status value) with the given detail message."""
         try:
             status = Status(status)
@@ -38,11 +44,11 @@ class Error(Exception):
         self.report = report
         super().__init__(self._describe())
 
-    def __reduce__(self):
+    def __reduce__(self) -> Tuple[type, Tuple[int, str, Optional[str], Any]]:
         """Pickle support (for multiprocessing): rebuild from the same fields."""
         return (type(self), (int(self.status), self.message, self.function, self.report))
 
-    def _describe(self):
+    def _describe(self) -> str:
         where = "%s: " % self.function if self.function else ""
         if self.message:
             return "%s%s: %s" % (where, self.status_name, self.message)

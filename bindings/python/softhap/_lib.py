@@ -1,14 +1,17 @@
 """Low-level ctypes layer: finds and loads libsofthap, checks its version, mirrors the C structs
 and declares the prototype of every function of include/softhap/softhap.h.
 
-Nothing here is public API; the classes in softhap.mesh and softhap.world wrap it. The struct
-definitions below must match the header field for field (tests/python/test_structs.py checks
-their sizes and offsets against a C compiler).
+Nothing here is public API; the classes of softhap.mesh, world, body, contact and haptic wrap
+it. The struct definitions below must match the header field for field
+(tests/python/test_structs.py checks their sizes and offsets against a C compiler).
 """
+
+from __future__ import annotations
 
 import ctypes
 import enum
 import os
+from typing import List, Mapping, Optional, Tuple
 from ctypes import (
     POINTER,
     Structure,
@@ -35,7 +38,7 @@ LIBRARY_FILE_NAME = "libsofthap.so"
 LIBRARY_ENV_VAR = "SOFTHAP_LIBRARY"
 
 
-def version_string(encoded):
+def version_string(encoded: int) -> str:
     """Return "MAJOR.MINOR.PATCH" for a version in the SH_VERSION encoding."""
     encoded = int(encoded)
     return "%d.%d.%d" % (encoded // 1000000, (encoded // 1000) % 1000, encoded % 1000)
@@ -541,7 +544,11 @@ PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 REPO_DIR = os.path.dirname(os.path.dirname(os.path.dirname(PACKAGE_DIR)))
 
 
-def library_candidates(environ=None, package_dir=None, repo_dir=None):
+def library_candidates(
+    environ: Optional[Mapping[str, str]] = None,
+    package_dir: Optional[str] = None,
+    repo_dir: Optional[str] = None,
+) -> List[Tuple[str, str]]:
     """Return the list of (path, origin) places where the library is looked for, in order.
 
     1. the environment variable SOFTHAP_LIBRARY, if set (then it is the only candidate);
@@ -560,7 +567,11 @@ def library_candidates(environ=None, package_dir=None, repo_dir=None):
     ]
 
 
-def find_library(environ=None, package_dir=None, repo_dir=None):
+def find_library(
+    environ: Optional[Mapping[str, str]] = None,
+    package_dir: Optional[str] = None,
+    repo_dir: Optional[str] = None,
+) -> str:
     """Return the path of the libsofthap.so to load, or raise ImportError saying where it looked.
 
     If SOFTHAP_LIBRARY is set it must name an existing file: it is never silently ignored.
@@ -577,7 +588,7 @@ def find_library(environ=None, package_dir=None, repo_dir=None):
     )
 
 
-def load_library(path=None, expected_version=None):
+def load_library(path: Optional[str] = None, expected_version: Optional[int] = None) -> ctypes.CDLL:
     """Load libsofthap from path (default: find_library()), check its version, declare prototypes.
 
     Raises ImportError if the file cannot be loaded, if sh_version() differs from the
@@ -630,5 +641,5 @@ def load_library(path=None, expected_version=None):
             "softhap: the C library %r (version %s) does not export: %s"
             % (path, version_string(found), ", ".join(missing))
         )
-    lib.softhap_path = path
+    lib.softhap_path = path  # type: ignore[attr-defined]
     return lib

@@ -1,13 +1,22 @@
 """Record: a dict whose keys can also be read as attributes (report["substeps"] or
 report.substeps). Used for mesh info, body info and step reports."""
 
+from __future__ import annotations
+
 import ctypes
+from typing import Any, FrozenSet, Type, TypeVar
+
+import numpy as np
+
+from ._lib import WarningKind, sh_static_report, sh_step_report
+
+_R = TypeVar("_R", bound="Record")
 
 
 class Record(dict):
     """A dict of named values, also readable as attributes."""
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> Any:
         try:
             return self[name]
         except KeyError:
@@ -15,19 +24,19 @@ class Record(dict):
                 "%s has no field %r (fields: %s)" % (type(self).__name__, name, ", ".join(self))
             ) from None
 
-    def __dir__(self):
+    def __dir__(self) -> list:
         return list(super().__dir__()) + list(self.keys())
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         items = ", ".join("%s=%r" % item for item in self.items())
         return "%s(%s)" % (type(self).__name__, items)
 
 
-def record_of(cls, raw, **overrides):
+def record_of(cls: Type[_R], raw: ctypes.Structure, **overrides: Any) -> _R:
     """A cls holding every field of the ctypes struct raw under its C name (arrays as tuples),
     with the values in overrides replacing or adding fields."""
     values = {}
-    for name, _ in raw._fields_:
+    for name, *_ in raw._fields_:
         value = getattr(raw, name)
         values[name] = tuple(value) if isinstance(value, ctypes.Array) else value
     values.update(overrides)
@@ -62,3 +71,26 @@ class StaticReport(Record):
     """What World.solve_static did (sh_static_report): iterations, load_steps, converged
     (bool), residual (final largest relative residual), residual_history (array of the relative
     residual after each iteration) and wall_seconds (s)."""
+
+
+def warning_names(bits: int) -> FrozenSet[str]:
+    """The names of the sh_warning kinds whose bit (1 << kind) is set in bits."""
+    return frozenset(kind.name for kind in WarningKind if bits & (1 << int(kind)))
+
+
+def step_report(raw: sh_step_report) -> StepReport:
+    """The StepReport of a filled sh_step_report."""
+    return record_of(StepReport, raw, warnings=warning_names(raw.warnings), warning_bits=int(raw.warnings))
+
+
+def static_report(raw: sh_static_report) -> StaticReport:
+    """The StaticReport of a filled sh_static_report (its history cut to history_count)."""
+    count = max(0, min(int(raw.history_count), len(raw.residual_history)))
+    return StaticReport(
+        iterations=raw.iterations,
+        load_steps=raw.load_steps,
+        converged=bool(raw.converged),
+        residual=raw.residual,
+        residual_history=np.array(raw.residual_history[:count], dtype=np.float64),
+        wall_seconds=raw.wall_seconds,
+    )

@@ -1,20 +1,35 @@
 """softhap.Tool (an sh_tool_id: a rigid tool posed by the host) and softhap.Obstacle (an
-sh_obstacle_id: a static rigid obstacle) of a World, and their ContactState.
+sh_obstacle_id: a static rigid obstacle) of a World, their ContactState, and the World methods
+that add them and set contact between bodies (World.add_tool, add_obstacle, set_body_contact
+and clear_body_contact, defined here in WorldContacts, which World inherits).
 
-Both are made by World.add_tool and World.add_obstacle. Like a Body, they are ids in their
-world: they keep the World alive, and raise softhap.Error (SH_ERR_INVALID_HANDLE) once
-destroyed or once the world is closed.
+Like a Body, a Tool or Obstacle is an id in its world: it keeps the World alive, and raises
+softhap.Error (SH_ERR_INVALID_HANDLE) once destroyed or once the world is closed.
+
+The keyword defaults are the C library's, as in softhap.world (checked by
+tests/python/test_defaults.py); those marked with default() are read by some kinds only, or
+clash with friction=, and are rejected when given where they do not apply.
 """
 
+from __future__ import annotations
+
 import ctypes
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Tuple, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from . import _arrays
-from ._lib import sh_contact_state
+from . import _arrays, _defs
+from ._defs import default
 from ._entity import WorldEntity
+from ._handle import OwnedHandle
+from ._lib import sh_contact_state
 from ._loaded import check, lib
 from ._record import Record, record_of
+from .body import Body, body_id_in
+
+if TYPE_CHECKING:
+    from .world import World
 
 
 class ContactState(Record):
@@ -25,7 +40,7 @@ class ContactState(Record):
     times the node's share of surface area)."""
 
 
-def _contact_state(raw):
+def _contact_state(raw: sh_contact_state) -> ContactState:
     return record_of(
         ContactState,
         raw,
@@ -41,21 +56,21 @@ class _Collider(WorldEntity):
     A subclass sets _kind, _is_valid, _get_contact (the C function reading its state) and
     _destroy (the C function removing it)."""
 
-    _get_contact = None
-    _destroy = None
+    _get_contact: str = ""
+    _destroy: str = ""
 
     @property
-    def valid(self):
+    def valid(self) -> bool:
         """Same as is_valid."""
         return self.is_valid
 
-    def destroy(self):
+    def destroy(self) -> None:
         """Remove it from its world; its id becomes stale."""
         handle = self._world_handle(self._destroy)
         check(getattr(lib, self._destroy)(handle, self._id), self._destroy)
 
     @property
-    def contact_state(self):
+    def contact_state(self) -> ContactState:
         """The ContactState after the last step (or World.solve_static): force, torque (arrays,
         the reaction on the tool or obstacle, world frame), contact_count, max_depth (m) and
         penetration_volume (m^3)."""
@@ -66,27 +81,27 @@ class _Collider(WorldEntity):
         return _contact_state(raw)
 
     @property
-    def force(self):
+    def force(self) -> np.ndarray:
         """Reaction force (N) on it after the last step, a (3,) array (world frame)."""
         return self.contact_state["force"]
 
     @property
-    def torque(self):
+    def torque(self) -> np.ndarray:
         """Reaction torque (N m) on it about its position after the last step, a (3,) array."""
         return self.contact_state["torque"]
 
     @property
-    def contacts(self):
+    def contacts(self) -> int:
         """Number of contact points in the last step."""
         return self.contact_state["contact_count"]
 
     @property
-    def max_depth(self):
+    def max_depth(self) -> float:
         """Deepest penetration (m) in the last step."""
         return self.contact_state["max_depth"]
 
     @property
-    def penetration_volume(self):
+    def penetration_volume(self) -> float:
         """Volume (m^3) of body material inside it after the last step (approximate)."""
         return self.contact_state["penetration_volume"]
 
@@ -107,7 +122,7 @@ class Tool(_Collider):
     _destroy = "sh_tool_destroy"
 
     @property
-    def pose(self):
+    def pose(self) -> Tuple[np.ndarray, np.ndarray]:
         """(position, orientation): the pose the next step takes the tool to, as numpy arrays
         of 3 (m) and 4 (unit quaternion w, x, y, z) (sh_tool_get_pose)."""
         handle = self._world_handle("sh_tool_get_pose")
@@ -121,7 +136,7 @@ class Tool(_Collider):
         )
         return position, orientation
 
-    def set_pose(self, position, orientation=(1.0, 0.0, 0.0, 0.0)):
+    def set_pose(self, position: ArrayLike, orientation: ArrayLike = (1.0, 0.0, 0.0, 0.0)) -> None:
         """Pose the tool for the next step: position (3 floats, m, world) and orientation (a
         unit quaternion (w, x, y, z); it is normalised). The step moves the tool from its last
         pose to this one. A non-finite position or a zero or non-finite quaternion raises
@@ -136,7 +151,7 @@ class Tool(_Collider):
             "sh_tool_set_pose",
         )
 
-    def set_velocity(self, linear, angular=(0.0, 0.0, 0.0)):
+    def set_velocity(self, linear: ArrayLike, angular: ArrayLike = (0.0, 0.0, 0.0)) -> None:
         """Give the tool's velocity for the next step instead of deriving it from successive
         poses: linear (m/s) of its position and angular (rad/s), world frame. Only the
         contact's damping and friction see it."""
@@ -150,7 +165,7 @@ class Tool(_Collider):
             "sh_tool_set_velocity",
         )
 
-    def wrench(self):
+    def wrench(self) -> Tuple[np.ndarray, np.ndarray]:
         """(force, torque): the reaction on the tool after the last step, two (3,) arrays
         (N and N m about the tool's position, world frame; sh_tool_get_wrench)."""
         handle = self._world_handle("sh_tool_get_wrench")
@@ -178,3 +193,151 @@ class Obstacle(_Collider):
     _is_valid = "sh_obstacle_is_valid"
     _get_contact = "sh_obstacle_get_contact"
     _destroy = "sh_obstacle_destroy"
+
+
+class WorldContacts(OwnedHandle):
+    """The World methods that add tools and obstacles and set contact between bodies: World
+    inherits them from this base class, which lives here beside the Tool and Obstacle they
+    make. Not used on its own."""
+
+    def add_tool(
+        self,
+        kind: str,
+        radius: float = default(5e-3),
+        half_length: float = default(0.0),
+        half_extents: Optional[ArrayLike] = None,
+        points: Optional[ArrayLike] = None,
+        position: ArrayLike = (0.0, 0.0, 0.0),
+        orientation: ArrayLike = (1.0, 0.0, 0.0, 0.0),
+        stiffness: float = 1e4,
+        exponent: float = 1.5,
+        damping: float = 0.2,
+        static_friction: float = default(0.0),
+        dynamic_friction: float = default(0.0),
+        slip_velocity: float = 1e-3,
+        capacity: int = 4096,
+        friction: Optional[float] = None,
+    ) -> Tool:
+        """Add a rigid tool posed by the host (sh_tool_create) and return its Tool.
+
+        kind and its shape parameters (only the kind's are accepted; the defaults are those
+        of sh_collider_def_default):
+            "sphere": radius (m), centred on the pose;
+            "capsule": radius and half_length (m) of the segment along local z;
+            "box": half_extents, 3 half widths along the local axes (m; no default);
+            "convex": points, an (n, 3) array (m, local frame, n >= 4, not all in one plane;
+            no default; needs a library built with libccd, else SH_ERR_UNSUPPORTED);
+            "plane" is an obstacle only: the C library rejects it as a tool.
+        position (m, world) and orientation (unit quaternion (w, x, y, z)): the initial pose.
+        The contact law against every body (sh_contact_params, defaults of
+        sh_contact_params_default): stiffness lambda (N/m^n), exponent n and damping alpha
+            (s/m) of the Hunt-Crossley force F = lambda x^n (1 + 3/2 alpha x');
+            static_friction mu_s and dynamic_friction mu_d (mu_s >= mu_d is required, so set
+            both, or use friction=mu for mu_s = mu_d = mu; None: not used); slip_velocity
+            (m/s) below which friction is viscous; capacity (most contact points kept per
+            step).
+        Unknown names raise ValueError; invalid values raise softhap.Error
+        (SH_ERR_INVALID_ARGUMENT, the message naming the field).
+        """
+        arguments = dict(locals())
+        world = cast("World", self)
+        return Tool(world, self._create_collider("sh_tool_create", kind, arguments, position, orientation))
+
+    def add_obstacle(
+        self,
+        kind: str,
+        radius: float = default(5e-3),
+        half_length: float = default(0.0),
+        half_extents: Optional[ArrayLike] = None,
+        points: Optional[ArrayLike] = None,
+        normal: ArrayLike = default((0.0, 0.0, 1.0)),
+        position: ArrayLike = (0.0, 0.0, 0.0),
+        orientation: ArrayLike = default((1.0, 0.0, 0.0, 0.0)),
+        stiffness: float = 1e4,
+        exponent: float = 1.5,
+        damping: float = 0.2,
+        static_friction: float = default(0.0),
+        dynamic_friction: float = default(0.0),
+        slip_velocity: float = 1e-3,
+        capacity: int = 4096,
+        friction: Optional[float] = None,
+    ) -> Obstacle:
+        """Add a static rigid obstacle (sh_obstacle_create) and return its Obstacle.
+
+        kind and its shape parameters (only the kind's are accepted; the defaults are those
+        of sh_collider_def_default):
+            "plane": the outward normal (world frame); the plane passes through position and
+            the obstacle is the half-space behind it (a plane takes no orientation);
+            "sphere", "capsule", "box" and "convex": as World.add_tool.
+        position (m, world) and orientation (unit quaternion (w, x, y, z)): its pose.
+        The contact law (stiffness, exponent, damping, static_friction, dynamic_friction,
+        friction, slip_velocity, capacity): as World.add_tool.
+        Unknown names raise ValueError; invalid values raise softhap.Error.
+        """
+        arguments = dict(locals())
+        if kind == "plane" and _defs.given(orientation):
+            raise ValueError(
+                "orientation= is not a parameter of a 'plane' obstacle (it takes: position=, "
+                "normal=)"
+            )
+        world = cast("World", self)
+        return Obstacle(
+            world, self._create_collider("sh_obstacle_create", kind, arguments, position, orientation)
+        )
+
+    def _create_collider(
+        self,
+        function: str,
+        kind: str,
+        arguments: Mapping[str, Any],
+        position: Optional[ArrayLike],
+        orientation: Optional[ArrayLike],
+    ) -> int:
+        """The id that C function (sh_tool_create or sh_obstacle_create) gives the collider of
+        shape kind, its keyword arguments and its pose."""
+        handle = self._require_handle(function)
+        definition, arrays = _defs.collider_def(kind, arguments, position, orientation)
+        collider = ctypes.c_uint64()
+        check(
+            getattr(lib, function)(handle, ctypes.byref(definition), ctypes.byref(collider)),
+            function,
+        )
+        del arrays  # the C library has copied the points
+        return collider.value
+
+    def set_body_contact(
+        self,
+        body_a: Body,
+        body_b: Body,
+        stiffness: float = 1e4,
+        exponent: float = 1.5,
+        damping: float = 0.2,
+        static_friction: float = default(0.0),
+        dynamic_friction: float = default(0.0),
+        slip_velocity: float = 1e-3,
+        capacity: int = 4096,
+        friction: Optional[float] = None,
+    ) -> None:
+        """Enable contact between two different FEM bodies of this world with the given
+        contact law (sh_world_set_body_contact; keywords and defaults as World.add_tool);
+        calling it again replaces the law. Each step the surface nodes of each body inside
+        the other are pushed out through the other's nearest surface triangle. A mass-spring
+        body raises softhap.Error (SH_ERR_UNSUPPORTED).
+        """
+        arguments = dict(locals())
+        handle = self._require_handle("sh_world_set_body_contact")
+        a = body_id_in(self, body_a, "body_a")
+        b = body_id_in(self, body_b, "body_b")
+        params = _defs.contact_params(arguments)
+        check(
+            lib.sh_world_set_body_contact(handle, a, b, ctypes.byref(params)),
+            "sh_world_set_body_contact",
+        )
+
+    def clear_body_contact(self, body_a: Body, body_b: Body) -> None:
+        """Disable contact between two bodies (sh_world_set_body_contact with NULL params); a
+        pair without contact is left as it is."""
+        handle = self._require_handle("sh_world_set_body_contact")
+        a = body_id_in(self, body_a, "body_a")
+        b = body_id_in(self, body_b, "body_b")
+        check(lib.sh_world_set_body_contact(handle, a, b, None), "sh_world_set_body_contact")

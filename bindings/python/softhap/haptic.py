@@ -5,14 +5,21 @@ World.add_haptic makes one. Haptic.step is the device-rate call (sh_haptic_step)
 its ctypes buffers, so a Python haptic loop allocates only the small result it returns.
 """
 
+from __future__ import annotations
+
 import ctypes
+from typing import TYPE_CHECKING, Any, Dict, FrozenSet, Iterable, Optional, Sequence, Union
 
 import numpy as np
 
 from ._handle import OwnedHandle
 from ._lib import SH_WARN_COUNT, HapticFault, Status, WarningKind, sh_haptic_def, sh_haptic_output
 from ._loaded import check, lib
-from ._record import Record, record_of
+from ._record import Record, record_of, warning_names
+
+if TYPE_CHECKING:
+    from .contact import Tool
+    from .world import World
 
 
 class HapticResult(Record):
@@ -23,18 +30,18 @@ class HapticResult(Record):
     fault_bits; warnings (set of sh_warning names) and warning_bits."""
 
 
-def _names(bits, kinds):
-    return frozenset(kind.name for kind in kinds if bits & int(kind))
+def _names(bits: int, kinds: Iterable[HapticFault]) -> FrozenSet[str]:
+    return frozenset(str(kind.name) for kind in kinds if bits & int(kind))
 
 
-def _haptic_def(tool, options):
+def _haptic_def(tool: Tool, options: Dict[str, Any]) -> sh_haptic_def:
     definition = sh_haptic_def()
     lib.sh_haptic_def_default(ctypes.byref(definition))
     definition.tool = tool.id
     for name, value in options.items():
         if value is None:
             continue
-        if name not in dict(sh_haptic_def._fields_) or name in ("internal_init", "tool"):
+        if name not in {field[0] for field in sh_haptic_def._fields_} or name in ("internal_init", "tool"):
             raise TypeError("unknown haptic option %r" % name)
         setattr(definition, name, value)
     return definition
@@ -49,7 +56,7 @@ class Haptic(OwnedHandle):
     _kind = "haptic context"
     _destroy = "sh_haptic_destroy"
 
-    def __init__(self, world, tool, **options):
+    def __init__(self, world: World, tool: Tool, **options: Any) -> None:
         """Use World.add_haptic."""
         self._handle = None
         definition = _haptic_def(tool, options)
@@ -69,25 +76,30 @@ class Haptic(OwnedHandle):
         self._orientation = (ctypes.c_double * 4)()
         self._output = sh_haptic_output()
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return "<softhap.Haptic %s>" % ("closed" if self._handle is None else "tool=%#x" % self._tool.id)
 
     @property
-    def tool(self):
+    def tool(self) -> Tool:
         """The Tool the device moves."""
         return self._tool
 
     @property
-    def memory_bytes(self):
+    def memory_bytes(self) -> int:
         """Bytes of memory the context holds, fixed at creation."""
         return self._memory_bytes
 
     @property
-    def dt(self):
+    def dt(self) -> float:
         """The nominal haptic step (s) that step() uses when no dt is given."""
         return self._dt
 
-    def step(self, position, orientation=(1.0, 0.0, 0.0, 0.0), dt=None):
+    def step(
+        self,
+        position: Union[Sequence[float], np.ndarray],
+        orientation: Union[Sequence[float], np.ndarray] = (1.0, 0.0, 0.0, 0.0),
+        dt: Optional[float] = None,
+    ) -> HapticResult:
         """Step the buffer to the device pose (position m, orientation unit quaternion
         (w, x, y, z)) over dt seconds (default: the context's dt) and return the HapticResult.
         A non-finite pose or dt is not raised: the result carries the fault (force held and
@@ -112,12 +124,12 @@ class Haptic(OwnedHandle):
             contact=bool(raw.contact),
             faults=_names(raw.faults, HapticFault),
             fault_bits=int(raw.faults),
-            warnings=frozenset(kind.name for kind in WarningKind if raw.warnings & (1 << int(kind))),
+            warnings=warning_names(raw.warnings),
             warning_bits=int(raw.warnings),
         )
 
     @property
-    def warnings(self):
+    def warnings(self) -> Dict[str, int]:
         """The context's warning counters as a dict {"SH_WARN_FORCE_CLAMPED": count, ...}."""
         handle = self._require_handle("sh_haptic_get_warnings")
         counters = (ctypes.c_uint64 * SH_WARN_COUNT)()

@@ -1,8 +1,13 @@
 """softhap.Mesh: an immutable tetrahedral mesh (sh_mesh)."""
 
+from __future__ import annotations
+
 import ctypes
+import os
+from typing import Optional, Union
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _arrays
 from ._lib import sh_mesh_info
@@ -23,7 +28,7 @@ class Mesh(OwnedHandle):
     _kind = "mesh"
     _destroy = "sh_mesh_destroy"
 
-    def __init__(self, nodes, tets):
+    def __init__(self, nodes: ArrayLike, tets: ArrayLike) -> None:
         """Create a mesh from nodes (n x 3 floats, m) and tets (m x 4 zero-based node indices).
 
         The C library validates the data (finite coordinates, indices in range, no repeated
@@ -48,7 +53,7 @@ class Mesh(OwnedHandle):
         self._handle = handle.value
 
     @classmethod
-    def load(cls, path):
+    def load(cls, path: Union[str, os.PathLike]) -> Mesh:
         """Load a tetrahedral mesh file: Gmsh .msh (1, 2.2, 4.1 ASCII), legacy VTK .vtk, VTK XML
         .vtu (ascii) or TetGen .node/.ele. Non-tet elements are skipped (counted in
         info["skipped_element_count"]).
@@ -62,7 +67,7 @@ class Mesh(OwnedHandle):
         mesh._handle = handle.value
         return mesh
 
-    def transform(self, scale, translation=None):
+    def transform(self, scale: float, translation: Optional[ArrayLike] = None) -> Mesh:
         """Return a new Mesh whose nodes are scale * x + translation (3 floats, m; None for
         none), e.g. scale=0.01 for a file in centimetres. scale must be finite and > 0
         (otherwise softhap.Error SH_ERR_INVALID_ARGUMENT). This mesh is unchanged."""
@@ -83,7 +88,7 @@ class Mesh(OwnedHandle):
         del offset
         return mesh
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         if self._handle is None:
             return "<softhap.Mesh (closed)>"
         info = self.info
@@ -92,7 +97,7 @@ class Mesh(OwnedHandle):
     # -- queries ---------------------------------------------------------------------------
 
     @property
-    def info(self):
+    def info(self) -> MeshInfo:
         """Facts about the mesh as a MeshInfo (a dict with attribute access): node_count,
         tet_count, surface_triangle_count, edge_count, orphan_node_count, reoriented_tet_count,
         skipped_element_count, bounds_min, bounds_max (m) and volume (m^3)."""
@@ -102,17 +107,17 @@ class Mesh(OwnedHandle):
         return record_of(MeshInfo, raw)
 
     @property
-    def node_count(self):
+    def node_count(self) -> int:
         """Number of nodes, including orphans (nodes used by no tet)."""
         return self.info["node_count"]
 
     @property
-    def tet_count(self):
+    def tet_count(self) -> int:
         """Number of tetrahedra."""
         return self.info["tet_count"]
 
     @property
-    def nodes(self):
+    def nodes(self) -> np.ndarray:
         """A copy of the node positions, an (n, 3) float64 array (m)."""
         handle = self._require_handle("sh_mesh_get_nodes")
         out = np.empty((self.node_count, 3), dtype=np.float64)
@@ -121,19 +126,19 @@ class Mesh(OwnedHandle):
         )
         return out
 
-    def _int_table(self, function_name, rows, columns):
+    def _int_table(self, function_name: str, rows: int, columns: int) -> np.ndarray:
         handle = self._require_handle(function_name)
         out = np.empty((rows, columns), dtype=np.int32)
         check(getattr(lib, function_name)(handle, _arrays.int32_ptr(out), out.size), function_name)
         return out
 
     @property
-    def tets(self):
+    def tets(self) -> np.ndarray:
         """A copy of the tets, an (m, 4) int32 array of node indices (positive orientation)."""
         return self._int_table("sh_mesh_get_tets", self.tet_count, 4)
 
     @property
-    def surface_triangles(self):
+    def surface_triangles(self) -> np.ndarray:
         """A copy of the boundary triangles, a (k, 3) int32 array, counter-clockwise seen from
         outside (normals point outward)."""
         return self._int_table(
@@ -141,11 +146,11 @@ class Mesh(OwnedHandle):
         )
 
     @property
-    def edges(self):
+    def edges(self) -> np.ndarray:
         """A copy of the unique tet edges, an (e, 2) int32 array, smaller index first, sorted."""
         return self._int_table("sh_mesh_get_edges", self.info["edge_count"], 2)
 
-    def write_vtu(self, path):
+    def write_vtu(self, path: Union[str, os.PathLike]) -> None:
         """Write the mesh as an ASCII VTK XML unstructured grid (.vtu) file."""
         handle = self._require_handle("sh_mesh_write_vtu")
         check(lib.sh_mesh_write_vtu(handle, _arrays.path_bytes(path)), "sh_mesh_write_vtu")

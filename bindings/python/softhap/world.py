@@ -187,15 +187,17 @@ class World(WorldContacts):
         (SH_ERR_INVALID_ARGUMENT).
         """
         arguments = dict(locals())
-        handle = self._require_handle("sh_world_add_fem_body")
+        self._require_handle("sh_world_add_fem_body")
         if not isinstance(mesh, Mesh):
             raise TypeError("mesh must be a softhap.Mesh, got %s" % type(mesh).__name__)
         definition = _defs.fem_body_def(mesh._require_handle("sh_world_add_fem_body"), arguments)
+        return self._add_body("sh_world_add_fem_body", definition)
+
+    def _add_body(self, function_name: str, definition: ctypes.Structure) -> Body:
+        """Call the C function function_name(world, &definition, &id) and return the new Body."""
         body = sh_body_id()
-        check(
-            lib.sh_world_add_fem_body(handle, ctypes.byref(definition), ctypes.byref(body)),
-            "sh_world_add_fem_body",
-        )
+        function = getattr(lib, function_name)
+        check(function(self._require_handle(function_name), ctypes.byref(definition), ctypes.byref(body)), function_name)
         return Body(self, body.value)
 
     def add_spring_body(
@@ -243,13 +245,11 @@ class World(WorldContacts):
         Unknown names raise ValueError; invalid values raise softhap.Error.
         """
         arguments = dict(locals())
-        handle = self._require_handle("sh_world_add_spring_body")
+        self._require_handle("sh_world_add_spring_body")
         definition, arrays = _defs.spring_body_def(nodes, springs, law, mass, arguments)
-        body = sh_body_id()
-        status = lib.sh_world_add_spring_body(handle, ctypes.byref(definition), ctypes.byref(body))
-        del arrays  # the C library has copied what the def pointed to
-        check(status, "sh_world_add_spring_body")
-        return Body(self, body.value)
+        body = self._add_body("sh_world_add_spring_body", definition)
+        del arrays  # the definition pointed into them until the C library copied what it needs
+        return body
 
     def remove_body(self, body: Body) -> None:
         """Destroy body; its id becomes stale (using the Body afterwards raises softhap.Error with

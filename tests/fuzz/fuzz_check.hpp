@@ -20,7 +20,6 @@
 #include <string_view>
 #include <vector>
 
-#include <sys/stat.h>
 #include <unistd.h>
 
 namespace softhap_fuzz {
@@ -48,17 +47,19 @@ inline std::string_view as_text(const uint8_t* data, size_t size) {
     std::abort();
 }
 
-/// The private folder inputs are written to, made on first use: in /dev/shm when there is one
+/// The private folder inputs are written to, made on first use: in /dev/shm where it can be
 /// (memory, not disk: the fuzzers write thousands of files a second), else in $TMPDIR or /tmp.
 /// Removed with its files at exit (not after a crash: libFuzzer aborts then).
 class TempDir {
 public:
     TempDir() {
-        struct stat info;
         const char* tmp = std::getenv("TMPDIR");
-        const std::string base = stat("/dev/shm", &info) == 0 && S_ISDIR(info.st_mode) ? "/dev/shm" : (tmp ? tmp : "/tmp");
-        path_ = base + "/softhap_fuzz_XXXXXX";
-        if (!mkdtemp(path_.data())) violated("cannot make a temporary folder in", base);
+        for (const char* base : {"/dev/shm", tmp, "/tmp"}) {
+            if (!base) continue;
+            path_ = std::string(base) + "/softhap_fuzz_XXXXXX";
+            if (mkdtemp(path_.data())) return;
+        }
+        violated("cannot make a temporary folder", "in /dev/shm, $TMPDIR or /tmp");
     }
 
     ~TempDir() {

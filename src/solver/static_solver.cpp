@@ -159,9 +159,9 @@ void solve_static_body(SteppedBody& stepped, const double g[3], const sh_static_
             "a body has no fixed or prescribed node: it can float freely, so its stiffness is singular and it has "
             "no static equilibrium (fix or prescribe nodes first)");
     ImplicitState state;
-    ImplicitState* const states[1] = {&state};
+    ImplicitState* states[1] = {&state};
     SteppedBody* const bodies[1] = {&stepped};
-    const LentImplicitStates lent(bodies, states, 1);
+    const SwappedImplicitStates lent(bodies, states, 1);
     prepare_implicit_state(*stepped.body, state, static_solver_settings(def));
     solve_group(NewtonGroup::alone(stepped), g, def, report);
 }
@@ -177,7 +177,7 @@ void solve_static_coupled(CoupledSystem& system, SteppedBody* const* bodies, int
     vec<ImplicitState> fresh(static_cast<size_t>(count));  // as for a body alone
     vec<ImplicitState*> states;
     for (ImplicitState& state : fresh) states.push_back(&state);
-    const LentImplicitStates lent(bodies, states.data(), count);
+    const SwappedImplicitStates lent(bodies, states.data(), count);
     system.prepare(bodies, count, static_solver_settings(def));
     solve_group(NewtonGroup::together(system), g, def, report);
 }

@@ -8,6 +8,8 @@
 
 #include <softhap/softhap.h>
 
+#include <utility>
+
 namespace sh {
 
 struct ImplicitState;
@@ -42,27 +44,27 @@ struct SteppedBody {
     ImplicitState* implicit = nullptr;  ///< built on the first implicit step
 };
 
-/// For a scope, bodies[0..count) use states[0..count) as their implicit states (a static
-/// solve's fresh ones, the error estimate's own); their own come back when it ends, also when
-/// it ends by an exception.
-class LentImplicitStates {
+/// For a scope, bodies[0..count) and states[0..count) trade implicit states (a static solve's
+/// fresh ones, the error estimate's own), and trade back when it ends, also by an exception.
+/// A state a body creates in the scope (step_implicit makes one if it has none) ends up in
+/// states[m].
+class SwappedImplicitStates {
 public:
-    LentImplicitStates(SteppedBody* const* bodies, ImplicitState* const* states, int32_t count)
-        : bodies_(bodies), kept_(static_cast<size_t>(count)) {
-        for (int32_t m = 0; m < count; ++m) {
-            kept_[static_cast<size_t>(m)] = bodies[m]->implicit;
-            bodies[m]->implicit = states[m];
-        }
+    SwappedImplicitStates(SteppedBody* const* bodies, ImplicitState** states, int32_t count)
+        : bodies_(bodies), states_(states), count_(count) {
+        swap();
     }
-    ~LentImplicitStates() {
-        for (size_t m = 0; m < kept_.size(); ++m) bodies_[m]->implicit = kept_[m];
-    }
-    LentImplicitStates(const LentImplicitStates&) = delete;
-    LentImplicitStates& operator=(const LentImplicitStates&) = delete;
+    ~SwappedImplicitStates() { swap(); }
+    SwappedImplicitStates(const SwappedImplicitStates&) = delete;
+    SwappedImplicitStates& operator=(const SwappedImplicitStates&) = delete;
 
 private:
+    void swap() {
+        for (int32_t m = 0; m < count_; ++m) std::swap(bodies_[m]->implicit, states_[m]);
+    }
     SteppedBody* const* bodies_;
-    vec<ImplicitState*> kept_;
+    ImplicitState** states_;
+    int32_t count_;
 };
 
 }  // namespace sh

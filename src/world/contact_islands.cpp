@@ -79,7 +79,6 @@ void World::step_islands(double h, sh_step_report& r, vec<uint8_t>& skip) {
         const uint32_t* members = islands.members(i);
         const int32_t count = islands.member_count(i);
         islands.stepped.clear();
-        islands.bodies.clear();
         islands.doublings.clear();
         islands.ids.clear();
         bool keep_best = false;  // the island's last attempt is that of any member's
@@ -88,7 +87,6 @@ void World::step_islands(double h, sh_step_report& r, vec<uint8_t>& skip) {
             keep_best |= slot.keep_best;
             if (!slot.stepped->implicit) slot.stepped->implicit = sh::create<ImplicitState>();
             islands.stepped.push_back(slot.stepped);
-            islands.bodies.push_back(slot.body());
             islands.doublings.push_back(slot.doubling);
             islands.ids.push_back(id_of(members[m]));
         }
@@ -97,14 +95,14 @@ void World::step_islands(double h, sh_step_report& r, vec<uint8_t>& skip) {
         bool half_steps_stable = false;
         if (error_estimate_) {
             const ScopedTimer timer(r.error_estimate_seconds);
-            half_steps_stable = take_half_steps_together(islands.bodies.data(), islands.doublings.data(), count, h,
+            half_steps_stable = take_half_steps_together(islands.stepped.data(), islands.doublings.data(), count, h,
                                                          [&](double half) { return step_implicit_coupled(system, half, gravity).stable; });
         }
-        for (Body* body : islands.bodies) body->clear_inverted_elements();
+        for (SteppedBody* stepped : islands.stepped) stepped->body->clear_inverted_elements();
         const BodyStepResult result = step_implicit_coupled(system, h, gravity, keep_best);
         for (int32_t m = 0; m < count && error_estimate_; ++m) {
             if (half_steps_stable && result.stable && r.error_estimate >= 0.0)
-                r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*islands.bodies[static_cast<size_t>(m)],
+                r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*islands.stepped[static_cast<size_t>(m)]->body,
                                                                                            *islands.doublings[static_cast<size_t>(m)]));
             else
                 r.error_estimate = -1.0;

@@ -54,7 +54,6 @@ public:
 
     // One island's members as the caller gathers them (scratch).
     vec<SteppedBody*> stepped;
-    vec<Body*> bodies;
     vec<StepDoubling*> doublings;
     vec<sh_body_id> ids;
 

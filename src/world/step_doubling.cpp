@@ -33,16 +33,13 @@ void end_half_steps(Body& body, StepDoubling& scratch, bool keep_positions) {
 }
 
 bool take_half_steps(SteppedBody& stepped, StepDoubling& scratch, double dt, const double gravity[3]) {
-    Body* bodies[1] = {stepped.body};
+    SteppedBody* const bodies[1] = {&stepped};
     StepDoubling* scratches[1] = {&scratch};
-    const auto half_step = [&](double h) { return step_body(stepped, h, gravity, false).stable; };
-    if (stepped.settings.integrator != SH_INTEGRATOR_IMPLICIT_EULER)
-        return take_half_steps_together(bodies, scratches, 1, dt, half_step);
-    // The half steps keep their own factorisation, so that the full step's stays.
-    if (!scratch.implicit) scratch.implicit = sh::create<ImplicitState>();
-    SteppedBody* const lent_to[1] = {&stepped};
-    const LentImplicitStates lent(lent_to, &scratch.implicit, 1);
-    return take_half_steps_together(bodies, scratches, 1, dt, half_step);
+    // An implicit body's half steps keep their own state and factorisation, so that the full
+    // step's stays (the first half step makes it).
+    const SwappedImplicitStates own(bodies, &scratch.implicit, 1);
+    return take_half_steps_together(bodies, scratches, 1, dt,
+                                    [&](double h) { return step_body(stepped, h, gravity, false).stable; });
 }
 
 double largest_half_step_difference(const Body& body, const StepDoubling& scratch) {

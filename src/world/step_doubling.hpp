@@ -39,18 +39,19 @@ void end_half_steps(Body& body, StepDoubling& scratch, bool keep_positions);
 /// and returns whether that was stable; keeps their positions in their scratch.half_x and puts
 /// them back as they were. Returns false if a half step was not stable.
 template <class Step>
-bool take_half_steps_together(Body* const* bodies, StepDoubling* const* scratch, int32_t count, double dt, Step&& step) {
-    for (int32_t m = 0; m < count; ++m) begin_half_steps(*bodies[m], *scratch[m]);
+bool take_half_steps_together(SteppedBody* const* bodies, StepDoubling* const* scratch, int32_t count, double dt,
+                              Step&& step) {
+    for (int32_t m = 0; m < count; ++m) begin_half_steps(*bodies[m]->body, *scratch[m]);
     bool stable;
     try {
         stable = step(0.5 * dt);
-        for (int32_t m = 0; m < count; ++m) restore_targets(*bodies[m], *scratch[m]);
+        for (int32_t m = 0; m < count; ++m) restore_targets(*bodies[m]->body, *scratch[m]);
         if (stable) stable = step(0.5 * dt);
     } catch (...) {  // e.g. out of memory building the half steps' solver: the bodies as they were
-        for (int32_t m = 0; m < count; ++m) end_half_steps(*bodies[m], *scratch[m], false);
+        for (int32_t m = 0; m < count; ++m) end_half_steps(*bodies[m]->body, *scratch[m], false);
         throw;
     }
-    for (int32_t m = 0; m < count; ++m) end_half_steps(*bodies[m], *scratch[m], true);
+    for (int32_t m = 0; m < count; ++m) end_half_steps(*bodies[m]->body, *scratch[m], true);
     return stable;
 }
 

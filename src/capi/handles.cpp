@@ -1,6 +1,7 @@
 #include "capi/handles.hpp"
 
 #include "core/error.hpp"
+#include "core/id_pool.hpp"
 #include "core/memory.hpp"
 
 #include <atomic>
@@ -9,10 +10,9 @@
 namespace sh::capi {
 namespace {
 
-constexpr int kIndexBits = 16;
-static_assert(kMaxLiveHandles == 1u << kIndexBits, "a handle's index bits cover the table");
-constexpr uint64_t kIndexMask = kMaxLiveHandles - 1;
-constexpr uint64_t kGenerationMask = (uint64_t{1} << 48) - 1;  // what a 64-bit handle keeps of it
+// A handle is an Id (id_pool.hpp) cast to a pointer: the same encoding and generations as the
+// world's ids, so a handle is never NULL and a stale one never names a slot's next object.
+static_assert(sizeof(uintptr_t) >= sizeof(Id), "a handle pointer holds a whole id");
 
 // One slot: tag = generation << 8 | kind while live, 0 while free. Published with release
 // after the object, read with acquire before it, so a reader that sees the tag sees the object.
@@ -23,15 +23,16 @@ struct Slot {
 
 // Static storage, never freed: a stale handle's slot stays readable for the process's life.
 Slot g_slots[kMaxLiveHandles];
-uint64_t g_generation[kMaxLiveHandles];  // the slot's latest generation (under g_mutex)
 uint32_t g_next_free[kMaxLiveHandles];   // free list links (under g_mutex)
 uint32_t g_free_head = 0;                // the first free slot, or g_used if none
 uint32_t g_used = 0;                     // slots ever handed out: [0, g_used)
 std::mutex g_mutex;                      // creation and destruction only
 
-uint64_t tag_of(uint64_t generation, HandleKind kind) { return generation << 8 | static_cast<uint64_t>(kind); }
+uint64_t tag_of(uint32_t generation, HandleKind kind) {
+    return static_cast<uint64_t>(generation) << 8 | static_cast<uint64_t>(kind);
+}
 
-uintptr_t value_of(const void* handle) { return reinterpret_cast<uintptr_t>(handle); }
+Id id_of(const void* handle) { return static_cast<Id>(reinterpret_cast<uintptr_t>(handle)); }
 
 }  // namespace
 
@@ -47,19 +48,18 @@ const void* register_handle(HandleKind kind, void* object) {
         index = g_used++;
         g_free_head = g_used;
     }
-    // Generations start at 1, so that no handle is NULL.
-    const uint64_t generation = g_generation[index] = (g_generation[index] % kGenerationMask) + 1;
+    const uint32_t generation = next_generation();
     g_slots[index].object.store(object, std::memory_order_relaxed);
     g_slots[index].tag.store(tag_of(generation, kind), std::memory_order_release);
     object_created();
-    return reinterpret_cast<const void*>(static_cast<uintptr_t>(generation << kIndexBits | index));
+    return reinterpret_cast<const void*>(static_cast<uintptr_t>(pack_id(index, generation)));
 }
 
 void* unregister_handle(HandleKind kind, const void* handle) {
     std::lock_guard<std::mutex> lock(g_mutex);
     void* object = find_handle(kind, handle);
     if (!object) return nullptr;
-    const uint32_t index = static_cast<uint32_t>(value_of(handle) & kIndexMask);
+    const uint32_t index = id_index(id_of(handle));
     g_slots[index].tag.store(0, std::memory_order_release);
     g_slots[index].object.store(nullptr, std::memory_order_relaxed);
     g_next_free[index] = g_free_head;
@@ -69,9 +69,9 @@ void* unregister_handle(HandleKind kind, const void* handle) {
 }
 
 void* find_handle(HandleKind kind, const void* handle) noexcept {
-    const uint64_t value = value_of(handle);
-    const uint64_t index = value & kIndexMask, generation = value >> kIndexBits;
-    if (generation == 0 || generation > kGenerationMask) return nullptr;
+    const Id id = id_of(handle);
+    const uint32_t index = id_index(id), generation = id_generation(id);
+    if (generation == 0 || index >= kMaxLiveHandles) return nullptr;
     const Slot& slot = g_slots[index];
     if (slot.tag.load(std::memory_order_acquire) != tag_of(generation, kind)) return nullptr;
     return slot.object.load(std::memory_order_relaxed);

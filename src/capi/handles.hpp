@@ -1,7 +1,8 @@
 // The handle table: what the opaque sh_mesh*, sh_world* and sh_haptic* the host holds stand
-// for. A handle is not an address but a slot index and that slot's generation, so checking
-// one reads only this table, never the object: a destroyed, foreign or made-up handle is
-// reported as SH_ERR_INVALID_HANDLE, with no read of freed memory, in O(1) and without a lock.
+// for. A handle is not an address but a generation-checked id (core/id_pool.hpp: a slot index
+// and the slot's generation, the encoding of the world's ids), so checking one reads only this
+// table, never the object: a destroyed, foreign or made-up handle is reported as
+// SH_ERR_INVALID_HANDLE, with no read of freed memory, in O(1) and without a lock.
 #pragma once
 
 #include <cstdint>

@@ -13,7 +13,8 @@
 
 namespace sh {
 
-BodyContacts::BodyContacts(const Body& body, bool implicit) : body_(body), implicit_(implicit) {
+BodyContacts::BodyContacts(const Body& body, bool implicit, ContactScratch& scratch)
+    : body_(body), implicit_(implicit), scratch_(scratch) {
     const size_t n = static_cast<size_t>(body.node_count());
     vec<uint8_t> on_surface(n, 0);
     node_area_.assign(n, 0.0);
@@ -47,7 +48,7 @@ BodyContacts::BodyContacts(const Body& body, bool implicit) : body_(body), impli
         edge_length_[i] = norm3(e);
     }
     stamp_.assign(n, 0);
-    node_push_.assign(3 * n, 0.0);
+    if (node_push_.size() < 3 * n) node_push_.resize(3 * n, 0.0);  // the pushes already there are 0
 }
 
 void BodyContacts::clear() {

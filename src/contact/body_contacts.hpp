@@ -46,14 +46,44 @@ struct ContactCandidate {
     double excess_weight = 1.0;
 };
 
+/// The buffers contact evaluation writes and drops again within one call or one explicit
+/// (sub)step. One serves every body of a world, since the world evaluates its bodies' contacts
+/// one after another: the world owns it (in its step scratch) and lends it to each
+/// BodyContacts it builds, so that warmed-up steps allocate nothing here.
+struct ContactScratch {
+    /// Time spent evaluating contact forces and tangents since the last take (s).
+    double evaluation_seconds = 0.0;
+    /// Per node (of the largest body so far): a collider's net push on it (N), zero between
+    /// evaluations (see BodyContacts::add_node_push).
+    vec<double> node_push;
+    /// The nodes with a push in node_push.
+    vec<int32_t> pushed_nodes;
+    /// Explicit bodies: the friction contacts of the (sub)step's first add_forces, applied by
+    /// end_explicit_step of the same body.
+    vec<FrictionRecord> friction_records;
+    /// The next add_forces records its friction contacts (set by begin_explicit_step).
+    bool recording = false;
+    /// keep_deepest's sort keys (a candidate's depth).
+    vec<double> keys;
+
+    /// Returns evaluation_seconds and restarts it from 0.
+    double take_evaluation_seconds() {
+        const double s = evaluation_seconds;
+        evaluation_seconds = 0.0;
+        return s;
+    }
+};
+
 /// The contact state of one body: surface, broad phase and candidates.
 class BodyContacts final : public ExternalField {
 public:
     /// Prepares the body's surface (FEM: its boundary triangles; springs: every node with
     /// mass). implicit: the body's solver minimises an implicit step's potential (contact
     /// takes the step's law over its depth rate and lagged friction), else it steps explicitly
-    /// (the law at rest, friction as impulses per node after each step). Allocates.
-    BodyContacts(const Body& body, bool implicit);
+    /// (the law at rest, friction as impulses per node after each step). scratch: the world's
+    /// evaluation buffers, which must outlive this (grown here for the body's nodes).
+    /// Allocates.
+    BodyContacts(const Body& body, bool implicit, ContactScratch& scratch);
 
     /// Drops the last step's candidates.
     void clear();
@@ -79,13 +109,6 @@ public:
     /// Adds the reactions at the body's current state to each touched collider's state and
     /// returns how many contacts act (a body-pair contact counts on its node's side only).
     int32_t accumulate_reactions();
-
-    /// Time spent evaluating contact forces and tangents since the last call (s).
-    double take_evaluation_seconds() {
-        const double s = evaluation_seconds_;
-        evaluation_seconds_ = 0.0;
-        return s;
-    }
 
     /// Number of candidates.
     int32_t candidate_count() const { return static_cast<int32_t>(candidates_.size()); }
@@ -193,16 +216,19 @@ private:
     uint32_t pass_ = 0;
     vec<ContactCandidate> candidates_;
     vec<Group> groups_;
-    vec<double> keys_;               ///< scratch for keep_deepest
-    mutable double evaluation_seconds_ = 0.0;
-    mutable vec<double> node_push_;       ///< per node: a collider's net push on it (N), see add_node_push
-    mutable vec<int32_t> pushed_nodes_;   ///< the nodes with a push in node_push_
-    /// Explicit bodies: a friction contact as the (sub)step's first add_forces found it, for
-    /// end_explicit_step.
-    mutable vec<FrictionRecord> friction_records_;
-    mutable bool recording_ = false;  ///< the next add_forces records the friction contacts
+    // The world's scratch (see ContactScratch), and its members under the names the
+    // evaluation files use. References: const evaluations write them without `mutable`.
+    ContactScratch& scratch_;
+    vec<double>& keys_ = scratch_.keys;                           ///< see ContactScratch
+    double& evaluation_seconds_ = scratch_.evaluation_seconds;    ///< see ContactScratch
+    vec<double>& node_push_ = scratch_.node_push;                 ///< see ContactScratch
+    vec<int32_t>& pushed_nodes_ = scratch_.pushed_nodes;          ///< see ContactScratch
+    vec<FrictionRecord>& friction_records_ = scratch_.friction_records;  ///< see ContactScratch
+    bool& recording_ = scratch_.recording;                        ///< see ContactScratch
     /// Implicit bodies with friction: per candidate, its geometry at the step's start and its
-    /// friction over the step's Newton iterates (see friction_chord). Residual and response
+    /// friction over the step's Newton iterates (see friction_chord). State of the candidates
+    /// for the whole (sub)step, not scratch: an island's Newton solve interleaves its bodies'
+    /// evaluations, so each body keeps its own; `mutable` since evaluations update it. Residual and response
     /// are per unit step: the row of the Newton residual over h (N) and the rest of the
     /// system's stiffness along the last update over h (N s/m).
     struct FrictionIterate {

@@ -7,6 +7,7 @@
 #include "haptic/haptic_context.hpp"
 #include "material/material_table.hpp"
 #include "model/fem_kernel.hpp"
+#include "solver/substeps.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -14,10 +15,6 @@
 
 namespace sh {
 namespace {
-
-// Most explicit sub-steps in one haptic step; beyond, the step is taken with this many and the
-// runaway check decides.
-constexpr int32_t kMaxSubsteps = 64;
 
 // Fraction of the critical step taken per sub-step.
 constexpr double kSafety = 0.9;
@@ -272,10 +269,11 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
     std::memcpy(saved_v_, v, n3 * sizeof(double));
     tool_.pose = tool_.start;
     const double limit = substep_limit(b, x, v, dt);
-    const double needed = limit > 0.0 ? std::max(1.0, std::ceil(dt / limit)) : INFINITY;  // NaN: the cap
-    substeps = needed <= kMaxSubsteps ? static_cast<int32_t>(needed) : kMaxSubsteps;
+    // A limit that is not positive (NaN too: a runaway state) needs the cap.
+    const SubstepCount count = substep_count(dt, limit > 0.0 ? limit : 0.0, kMaxHapticSubsteps);
+    substeps = count.count;
     // More than the cap: the step goes ahead with it, warned, and the runaway check decides.
-    if (!(needed <= kMaxSubsteps)) step_warnings_ |= 1u << SH_WARN_SUBSTEPPED;
+    if (count.clamped) step_warnings_ |= 1u << SH_WARN_SUBSTEPPED;
     const double h = dt / substeps;
     const double t0 = age_ - dt;  // age_ already counts this step
     const Pose start = tool_.start;

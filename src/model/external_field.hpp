@@ -60,7 +60,7 @@ public:
         (void)h, (void)move_positions, (void)x, (void)v;
     }
 
-    /// For bodies solved together (CoupledSystem): appends to pairs, as (own_index[i],
+    /// For bodies solved together (one Newton problem over several bodies): appends to pairs, as (own_index[i],
     /// other_index[j]), every pair of this body's node i and other's node j that an interaction
     /// this field holds links, both indices >= 0 (each interaction is held by one of the two
     /// bodies' fields). None by default.

@@ -4,6 +4,7 @@
 #include "solver/integrator_table.hpp"
 #include "solver/node_checks.hpp"
 #include "solver/step_support.hpp"
+#include "solver/substeps.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -14,9 +15,6 @@
 
 namespace sh {
 namespace {
-
-// More sub-steps than this means dt_crit is unreasonably small for dt: reject instead.
-constexpr double kMaxSubsteps = 1 << 20;
 
 #if defined(__AVX512F__)
 // Node loops take eight nodes (24 doubles, three registers) at a time. Per-node values are
@@ -237,17 +235,16 @@ BodyStepResult step_explicit(SteppedBody& stepped, double dt, const double g[3])
     Body& body = *stepped.body;
     BodyStepResult result;
     result.dt_critical = critical_step(body, stepped.settings.integrator);
-    double substeps = 1.0;
-    if (dt > result.dt_critical) {
-        substeps = std::ceil(dt / result.dt_critical);
-        if (stepped.settings.on_unstable == SH_UNSTABLE_REJECT || !(substeps <= kMaxSubsteps)) {
-            result.stable = false;
-            result.rejected = true;
-            result.status = SH_ERR_UNSTABLE;
-            return result;
-        }
+    // A step longer than the critical one is sub-stepped, unless the policy rejects it or it
+    // would take more sub-steps than the cap.
+    const SubstepCount substeps = substep_count(dt, result.dt_critical, kMaxExplicitSubsteps);
+    if (substeps.clamped || (dt > result.dt_critical && stepped.settings.on_unstable == SH_UNSTABLE_REJECT)) {
+        result.stable = false;
+        result.rejected = true;
+        result.status = SH_ERR_UNSTABLE;
+        return result;
     }
-    result.substeps = static_cast<int32_t>(substeps);
+    result.substeps = substeps.count;
 
     IntegratorWorkspace& w = stepped.workspace;
     const IntegratorKind& kind = integrator_kind(stepped.settings.integrator);
@@ -289,7 +286,7 @@ BodyStepResult step_explicit(SteppedBody& stepped, double dt, const double g[3])
     save_start_state(stepped);
     begin_kinematic_motion(body, dt);
 
-    const double h = dt / substeps;
+    const double h = dt / substeps.count;
     // Friction's velocity change also moves the nodes by h times it, as if it acted through the
     // sub-step (symplectic Euler's positions take the end velocities; for RK methods it is a
     // first-order splitting); forward Euler's positions take the start velocities.

@@ -2,7 +2,7 @@
 
 #include "core/error.hpp"
 #include "model/external_field.hpp"
-#include "solver/newton_group.hpp"
+#include "solver/newton_problem.hpp"
 #include "solver/step_support.hpp"
 
 #include <algorithm>
@@ -44,83 +44,9 @@ constexpr double kEnergyGrowth = 1.0;
 constexpr double kLinearisedEnergyGain = 1e-6;
 static_assert(kLinearisedEnergyGain <= kEnergyGrowth, "an accepted linearised update must pass the runaway guard");
 
-LinearSolverKind solver_kind(sh_linear_solver kind) {
-    switch (kind) {
-        case SH_LINEAR_SOLVER_CHOLMOD: return LinearSolverKind::Cholmod;
-        case SH_LINEAR_SOLVER_LDLT: return LinearSolverKind::Ldlt;
-        case SH_LINEAR_SOLVER_CG: return LinearSolverKind::ConjugateGradient;
-        default: return (sh_build_features() & SH_FEATURE_CHOLMOD) ? LinearSolverKind::Cholmod : LinearSolverKind::Ldlt;
-    }
-}
-
-}  // namespace
-
-double force_roundoff(const SparseSystem& system, const vec<double>& x, double scale) {
-    double largest = 0.0;
-    for (const double c : x) largest = std::max(largest, std::fabs(c));
-    double sum = 0.0;
-    for (int32_t d = 0; d < system.dof_count(); ++d) {
-        const double k = scale * system.values()[static_cast<size_t>(system.diagonal_slot(d))];
-        sum += k * k;
-    }
-    return 64.0 * std::numeric_limits<double>::epsilon() * largest * std::sqrt(sum);
-}
-
-LinearSolverPtr make_analysed_solver(const SparseSystem& system, const sh_implicit_settings& s) {
-    LinearSolverPtr solver = make_linear_solver(solver_kind(s.linear_solver), s.cg_tolerance, s.cg_max_iterations);
-    solver->analyze(system);
-    return solver;
-}
-
-int32_t prepare_implicit_state(const Body& body, ImplicitState& state, const sh_implicit_settings& s, bool own_solver) {
-    const int32_t n = body.node_count();
-    bool changed = state.free_count < 0;
-    int32_t free_count = 0;
-    if (!changed)
-        for (int32_t i = 0; i < n && !changed; ++i) changed = (state.free_index[static_cast<size_t>(i)] >= 0) != body.is_free(i);
-    if (!changed) {
-        if (own_solver && !state.solver) state.solver = make_analysed_solver(state.system, s);
-        return 3 * state.free_count;
-    }
-
-    vec<int32_t> free_index(static_cast<size_t>(n), -1);
-    for (int32_t i = 0; i < n; ++i)
-        if (body.is_free(i)) free_index[static_cast<size_t>(i)] = free_count++;
-    SparseSystem system;
-    system.build_pattern(body.element_nodes(), static_cast<size_t>(body.element_count()), body.nodes_per_element(),
-                         free_index.data(), n, free_count);
-    LinearSolverPtr solver = own_solver ? make_analysed_solver(system, s) : nullptr;
-    const size_t dofs = 3 * static_cast<size_t>(free_count);
-    vec<double> residual(dofs), delta(dofs, 0.0), diagonal(dofs), previous_v(dofs);
-    // Commit only once everything is built.
-    state.system = std::move(system);
-    state.solver = std::move(solver);
-    state.free_index.swap(free_index);
-    state.residual.swap(residual);
-    state.delta.swap(delta);
-    state.diagonal.swap(diagonal);
-    state.previous_v.swap(previous_v);
-    state.factor_valid = false;
-    state.free_count = free_count;
-    return 3 * free_count;
-}
-
-double assemble_body_tangent(const Body& body, ImplicitState& state, double stiffness_scale, double damping_scale,
-                             const double* v, const double* diagonal, double roundoff_scale) {
-    state.system.clear_values();
-    body.add_tangent(body.x.data(), stiffness_scale, damping_scale, state.system);
-    if (body.field)
-        body.field->add_tangent(body.x.data(), v, stiffness_scale, damping_scale, state.free_index.data(), state.system);
-    const double roundoff = force_roundoff(state.system, body.x, roundoff_scale);
-    if (diagonal) state.system.add_diagonal(diagonal, 1.0);
-    return roundoff;
-}
-
-namespace {
-
 // Per free DOF of body: m (1 + dt (alpha + c_node)), the mass part of the step's matrix.
-void fill_mass_diagonal(const Body& body, ImplicitState& state, double dt) {
-    const vec<int32_t>& global = state.system.dof_to_global();
+void fill_mass_diagonal(const Body& body, NewtonBodyState& state, double dt) {
+    const vec<int32_t>& global = state.matrix.system.dof_to_global();
     for (size_t d = 0; d < global.size(); ++d) {
         const size_t node = static_cast<size_t>(global[d]) / 3;
         state.diagonal[d] = body.mass[node] * (1.0 + dt * body.mass_damping(node));
@@ -131,10 +57,11 @@ void fill_mass_diagonal(const Body& body, ImplicitState& state, double dt) {
 struct Potential {
     double value = 0.0;  ///< J
     double scale = 0.0;  ///< sum of the terms' magnitudes: the round-off of value is eps times it
+    /// Both value and scale are finite.
     bool finite() const { return std::isfinite(value) && std::isfinite(scale); }
 };
 
-// One implicit step of the bodies of a NewtonGroup as the minimisation of its incremental
+// One implicit step of the bodies of a NewtonProblem as the minimisation of its incremental
 // potential over the end-of-step velocities v (x = x0 + h v):
 //   Phi(v) = 1/2 (v - v0)^T M (v - v0) + h/2 v^T C v + h/2 v^T D0 v + E(x) + P(x) + h W(v)
 //            - h v^T (f_ext + m g)
@@ -147,8 +74,10 @@ struct Potential {
 // raises Phi. Its minimum is the backward Euler step.
 class NewtonStep {
 public:
-    NewtonStep(const NewtonGroup& group, const sh_implicit_settings& s, double dt, const double g[3], bool allow_stale)
-        : group_(group), ns_(group.newton), s_(s), dt_(dt), g_(g), allow_stale_(allow_stale) {}
+    /// The step of problem's bodies by dt under gravity g with settings s; allow_stale: it may
+    /// solve with a factorisation kept from earlier iterations or steps.
+    NewtonStep(NewtonProblem& problem, const sh_implicit_settings& s, double dt, const double g[3], bool allow_stale)
+        : problem_(problem), matrix_(problem.matrix()), s_(s), dt_(dt), g_(g), allow_stale_(allow_stale) {}
 
     /// Runs the step. keep_best: a loop that does not converge keeps its last iterate (the
     /// lowest potential found) instead of failing.
@@ -157,34 +86,50 @@ public:
     bool used_stale = false;  ///< an update was solved with a kept factorisation
 
 private:
+    /// Saves the start state, starts kinematic motion, measures the start's energy and decides
+    /// whether the kept factorisation serves this step.
     void begin();
+    /// Diagonal of the bodies' bounding box at the current iterate (m).
     double extent() const;
+    /// Moves the bodies to the current velocities' positions; residual, its norms and Phi there.
     void evaluate();
-    double assemble_member(Body& body, ImplicitState& state);
+    /// One body's m (1 + dt c) + dt D + dt^2 K into its own matrix; its force round-off.
+    double assemble_body(Body& body, NewtonBodyState& state);
+    /// Solves for the Newton update, factorising first unless a kept factorisation serves.
     bool factorize_and_solve(bool& failed);
+    /// Sets v = previous_v + scale delta and evaluates there.
     void take_update(double scale);
+    /// Backtracking line search along delta; false if no step length qualifies.
     bool line_search(double slope, bool fresh);
+    /// Newton iterations the step may take.
     int iteration_cap() const;
+    /// The scale the residual's tolerance is relative to.
     double residual_scale() const;
+    /// Copies the current free velocities into the matrix's previous_v.
     void keep_velocities();
+    /// The Newton loop; true if it converged.
     bool iterate(bool& solver_failed);
+    /// The step's outcome after the loop.
     BodyStepResult finish(bool converged, bool solver_failed, bool keep_best);
+    /// Restores the bodies and reports status and reason.
     BodyStepResult fail(sh_status status, const char* reason);
+    /// Kinetic + potential energy of the bodies (J); scale gets the terms' magnitudes.
     double mechanical_energy(bool at_start, double& scale) const;
+    /// True if the energy rose by more than fraction of its start scale with no outside work.
     bool energy_rose(double fraction) const;
 
-    const NewtonGroup& group_;
-    NewtonSystem& ns_;
-    const sh_implicit_settings& s_;
-    const double dt_;
-    const double* g_;
-    const bool allow_stale_;
-    BodyStepResult result_;
+    NewtonProblem& problem_;        // the bodies stepped
+    NewtonMatrix& matrix_;          // problem_.matrix(): assembled, factorised and solved
+    const sh_implicit_settings& s_; // tolerance, iteration cap, factor_reuse
+    const double dt_;               // step size (s)
+    const double* g_;               // gravity (m/s^2)
+    const bool allow_stale_;        // a kept factorisation may serve
+    BodyStepResult result_;         // what the step did so far
     bool reuse_ = false;           // factorisations are kept
-    bool factor_current_ = false;  // ns_ holds a factorisation usable for this step
+    bool factor_current_ = false;  // matrix_ holds a factorisation usable for this step
     bool fresh_ = false;           // it is of the tangent at the current iterate
-    uint64_t matrix_version_ = 0;
-    int stale_solves_ = 0;
+    uint64_t matrix_version_ = 0;  // the bodies' matrix version at the step's start
+    int stale_solves_ = 0;         // solves with the current factorisation since it was made
     Potential phi_;                // at the current iterate
     double r_ = 0.0, r_max_ = 0.0; // residual norms (2 and max) at the current iterate
     double largest_change_ = 0.0, largest_speed_ = 0.0;  // of the last update taken
@@ -195,20 +140,20 @@ private:
     bool energy_checked_ = false;  // the final iterate passed the linearised energy check
 };
 
-// Kinetic + potential energy (NewtonGroup::potential_energy) of the bodies, at the step's
+// Kinetic + potential energy (NewtonProblem::potential_energy) of the bodies, at the step's
 // start (x0, v0) or now; scale gets the terms' magnitudes.
 double NewtonStep::mechanical_energy(bool at_start, double& scale) const {
     double kinetic = 0.0;
-    group_.each([&](const SteppedBody& stepped, size_t) {
+    problem_.each([&](const SteppedBody& stepped, size_t) {
         const Body& body = *stepped.body;
-        const ImplicitState& state = *stepped.implicit;
+        const NewtonBodyState& state = *stepped.newton;
         const double* v = at_start ? stepped.workspace.v0.data() : body.v.data();
-        for (const int32_t j : state.system.dof_to_global()) {
+        for (const int32_t j : state.matrix.system.dof_to_global()) {
             const size_t k = static_cast<size_t>(j);
             kinetic += 0.5 * body.mass[k / 3] * v[k] * v[k];
         }
     });
-    const double potential = group_.potential_energy(g_, 1.0, at_start, scale);
+    const double potential = problem_.potential_energy(g_, 1.0, at_start, scale);
     scale += kinetic;
     return kinetic + potential;
 }
@@ -226,7 +171,7 @@ bool NewtonStep::energy_rose(double fraction) const {
 // Diagonal of the bodies' bounding box at the current iterate (m).
 double NewtonStep::extent() const {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    group_.each([&](const SteppedBody& stepped, size_t) {
+    problem_.each([&](const SteppedBody& stepped, size_t) {
         const Body& body = *stepped.body;
         for (size_t j = 0; j < body.x.size(); ++j) {
             lo[j % 3] = std::min(lo[j % 3], body.x[j]);
@@ -242,7 +187,7 @@ void NewtonStep::begin() {
     work_done_ = false;
     energy_checked_ = false;
     first_evaluation_ = true;
-    group_.each([&](SteppedBody& stepped, size_t) {
+    problem_.each([&](SteppedBody& stepped, size_t) {
         Body& body = *stepped.body;
         save_start_state(stepped);
         begin_kinematic_motion(body, dt_);
@@ -255,32 +200,32 @@ void NewtonStep::begin() {
         body.add_internal_forces(stepped.workspace.x0.data(), nullptr, base.data());
     });
     if (!work_done_) energy0_ = mechanical_energy(true, energy_scale0_);
-    reuse_ = s_.factor_reuse > 0.0 && ns_.solver->is_direct();
-    matrix_version_ = group_.matrix_version();
-    factor_current_ = reuse_ && allow_stale_ && ns_.factor_valid && ns_.factor_dt == dt_ &&
-                      ns_.factor_matrix_version == matrix_version_;
+    reuse_ = s_.factor_reuse > 0.0 && matrix_.solver->is_direct();
+    matrix_version_ = problem_.matrix_version();
+    factor_current_ = reuse_ && allow_stale_ && matrix_.kept.valid && matrix_.kept.dt == dt_ &&
+                      matrix_.kept.matrix_version == matrix_version_;
 }
 
-// Moves every body to x = x0 + h v, then fills ns_.residual with g(v), r_, r_max_ and phi_.
+// Moves every body to x = x0 + h v, then fills matrix_.residual with g(v), r_, r_max_ and phi_.
 // Every body moves first: the forces between bodies solved together see both ends.
 void NewtonStep::evaluate() {
     const double h = dt_;
-    group_.each([&](SteppedBody& stepped, size_t) {
+    problem_.each([&](SteppedBody& stepped, size_t) {
         Body& body = *stepped.body;
         for (size_t j = 0; j < body.x.size(); ++j) body.x[j] = stepped.workspace.x0[j] + h * body.v[j];
     });
     Potential phi;
     double sum2 = 0.0, push2 = 0.0;
     r_max_ = 0.0;
-    group_.each([&](SteppedBody& stepped, size_t offset) {
+    problem_.each([&](SteppedBody& stepped, size_t offset) {
         Body& body = *stepped.body;
-        ImplicitState& state = *stepped.implicit;
+        const NewtonBodyState& state = *stepped.newton;
         double* f = stepped.workspace.stage_a[0].data();
         std::fill(f, f + body.x.size(), 0.0);
         // The field first: the step's first evaluation measures its push (iterate()).
         if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
         if (first_evaluation_)
-            for (const int32_t j : state.system.dof_to_global()) push2 += f[static_cast<size_t>(j)] * f[static_cast<size_t>(j)];
+            for (const int32_t j : state.matrix.system.dof_to_global()) push2 += f[static_cast<size_t>(j)] * f[static_cast<size_t>(j)];
         body.add_internal_forces(body.x.data(), nullptr, f);
         double* damping = nullptr;  // -D0 v, the lagged internal damping force
         if (body.has_internal_damping()) {
@@ -294,14 +239,14 @@ void NewtonStep::evaluate() {
         const double field = body.field ? body.field->energy(body.x.data()) + h * body.field->dissipation(body.v.data()) : 0.0;
         phi.value += elastic + field;
         phi.scale += std::fabs(elastic) + std::fabs(field);
-        const vec<int32_t>& global = state.system.dof_to_global();
+        const vec<int32_t>& global = state.matrix.system.dof_to_global();
         for (size_t d = 0; d < global.size(); ++d) {
             const size_t j = static_cast<size_t>(global[d]), node = j / 3;
             const double m = body.mass[node], v = body.v[j], dv = v - stepped.workspace.v0[j];
             const double c = body.mass_damping(node);
             const double load = body.applied_load(j, g_), fd = damping ? damping[j] : 0.0;
             const double r_d = m * dv + h * m * c * v - h * (f[j] + fd + load);
-            ns_.residual[offset + d] = r_d;
+            matrix_.residual[offset + d] = r_d;
             sum2 += r_d * r_d;
             r_max_ = std::max(r_max_, std::fabs(r_d));
             const double terms[4] = {0.5 * m * dv * dv, 0.5 * h * m * c * v * v, -0.5 * h * v * fd, -h * v * load};
@@ -317,36 +262,36 @@ void NewtonStep::evaluate() {
     first_evaluation_ = false;
 }
 
-// m (1 + dt c) + dt D + dt^2 K of one body into its own system; its force round-off.
-double NewtonStep::assemble_member(Body& body, ImplicitState& state) {
+// m (1 + dt c) + dt D + dt^2 K of one body into its own matrix; its force round-off.
+double NewtonStep::assemble_body(Body& body, NewtonBodyState& state) {
     fill_mass_diagonal(body, state, dt_);
-    return assemble_body_tangent(body, state, dt_ * dt_, dt_, body.v.data(), state.diagonal.data(), 1.0 / dt_);
+    return state.assemble_tangent(body, dt_ * dt_, dt_, body.v.data(), state.diagonal.data(), 1.0 / dt_);
 }
 
-// Solves the tangent system for the update delta = -H^-1 g into ns_.delta, with a new
+// Solves the tangent system for the update delta = -H^-1 g into matrix_.delta, with a new
 // factorisation at the current iterate unless a kept one may serve. False (failed set) if the
 // factorisation or solve failed; throws what is not a solver failure.
 bool NewtonStep::factorize_and_solve(bool& failed) {
     failed = false;
     try {
         if (!factor_current_ || stale_solves_ == kMaxStaleSolves) {
-            ns_.factor_valid = false;
-            ns_.roundoff_floor = group_.assemble([&](SteppedBody& m) { return assemble_member(*m.body, *m.implicit); },
-                                                 dt_ * dt_, dt_, false);
-            ns_.solver->factorize(ns_.system);
-            result_.factorize_seconds += ns_.solver->factorize_seconds;
+            matrix_.kept.valid = false;
+            matrix_.kept.roundoff_floor = problem_.assemble(
+                [&](SteppedBody& m) { return assemble_body(*m.body, *m.newton); }, dt_ * dt_, dt_, false);
+            matrix_.solver->factorize(matrix_.system);
+            result_.factorize_seconds += matrix_.solver->factorize_seconds;
             ++result_.factorizations;
-            ns_.factor_valid = reuse_;
-            ns_.factor_dt = dt_;
-            ns_.factor_matrix_version = matrix_version_;
+            matrix_.kept.valid = reuse_;
+            matrix_.kept.dt = dt_;
+            matrix_.kept.matrix_version = matrix_version_;
             factor_current_ = true;
             fresh_ = true;
             stale_solves_ = 0;
         }
-        for (double& r_d : ns_.residual) r_d = -r_d;
-        result_.linear_iterations += ns_.solver->solve(ns_.system, ns_.residual.data(), ns_.delta.data());
-        for (double& r_d : ns_.residual) r_d = -r_d;
-        result_.solve_seconds += ns_.solver->solve_seconds;
+        for (double& r_d : matrix_.residual) r_d = -r_d;
+        result_.linear_iterations += matrix_.solver->solve(matrix_.system, matrix_.residual.data(), matrix_.delta.data());
+        for (double& r_d : matrix_.residual) r_d = -r_d;
+        result_.solve_seconds += matrix_.solver->solve_seconds;
     } catch (const Error& e) {
         if (e.status() != SH_ERR_NOT_CONVERGED && e.status() != SH_ERR_SOLVER) throw;
         result_.status = e.status();
@@ -358,14 +303,13 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
 // v = previous_v + scale delta, then evaluate().
 void NewtonStep::take_update(double scale) {
     largest_change_ = largest_speed_ = 0.0;
-    group_.each([&](SteppedBody& stepped, size_t offset) {
+    problem_.each([&](SteppedBody& stepped, size_t offset) {
         Body& body = *stepped.body;
-        ImplicitState& state = *stepped.implicit;
-        const vec<int32_t>& global = state.system.dof_to_global();
+        const vec<int32_t>& global = stepped.newton->matrix.system.dof_to_global();
         for (size_t d = 0; d < global.size(); ++d) {
             double& v = body.v[static_cast<size_t>(global[d])];
-            v = ns_.previous_v[offset + d] + scale * ns_.delta[offset + d];
-            largest_change_ = std::max(largest_change_, std::fabs(scale * ns_.delta[offset + d]));
+            v = matrix_.previous_v[offset + d] + scale * matrix_.delta[offset + d];
+            largest_change_ = std::max(largest_change_, std::fabs(scale * matrix_.delta[offset + d]));
             largest_speed_ = std::max(largest_speed_, std::fabs(v));
         }
     });
@@ -379,18 +323,18 @@ void NewtonStep::take_update(double scale) {
 bool NewtonStep::line_search(double slope, bool fresh) {
     const Potential phi0 = phi_;
     const double r0 = r_, r0_max = r_max_;
-    // Phi's round-off: of its sum, and of the forces (ns_.roundoff_floor, in residual units)
+    // Phi's round-off: of its sum, and of the forces (kept.roundoff_floor, in residual units)
     // along the update, which element energies computed from position differences carry.
     double length = 0.0;
-    for (const double d : ns_.delta) length += d * d;
+    for (const double d : matrix_.delta) length += d * d;
     length = std::sqrt(length);
     double scale = 1.0;
     for (int halving = 0; halving <= (fresh ? kMaxHalvings : 0); ++halving, scale *= 0.5) {
         take_update(scale);
-        const double roundoff = sum_roundoff(phi0.scale) + 4.0 * ns_.roundoff_floor * scale * length;
+        const double roundoff = sum_roundoff(phi0.scale) + 4.0 * matrix_.kept.roundoff_floor * scale * length;
         if (!phi_.finite() || phi_.value > phi0.value + kArmijo * scale * slope + roundoff) continue;
         if (fresh) return true;
-        const double floor = ns_.roundoff_floor;
+        const double floor = matrix_.kept.roundoff_floor;
         if (r_ <= std::max(kStaleContraction * r0, floor) && r_max_ <= std::max(kStaleContraction * r0_max, floor)) return true;
     }
     take_update(0.0);
@@ -401,8 +345,8 @@ bool NewtonStep::line_search(double slope, bool fresh) {
 }
 
 BodyStepResult NewtonStep::fail(sh_status status, const char* reason) {
-    group_.each([](SteppedBody& stepped, size_t) { restore_start_state(stepped); });
-    ns_.factor_valid = false;  // built at an iterate that went wrong
+    problem_.each([](SteppedBody& stepped, size_t) { restore_start_state(stepped); });
+    matrix_.kept.valid = false;  // built at an iterate that went wrong
     result_.stable = false;
     result_.status = status;
     result_.reason = reason;
@@ -427,7 +371,7 @@ BodyStepResult NewtonStep::run(bool keep_best) {
 // single update cannot follow: a body in contact iterates.
 int NewtonStep::iteration_cap() const {
     bool in_contact = false;
-    group_.each([&](const SteppedBody& stepped, size_t) { in_contact |= stepped.body->field != nullptr; });
+    problem_.each([&](const SteppedBody& stepped, size_t) { in_contact |= stepped.body->field != nullptr; });
     return std::max(in_contact ? kContactNewtonIterations : 1, s_.newton_max_iterations);
 }
 
@@ -436,16 +380,16 @@ int NewtonStep::iteration_cap() const {
 // push: relative to the tiny residual of a step that starts at rest, the tolerance would sit
 // below what the contact's and friction's kinks let Newton reach.
 double NewtonStep::residual_scale() const {
-    const double loads = std::hypot(group_.applied_load_norm(g_), field_push_);
+    const double loads = std::hypot(problem_.applied_load_norm(g_), field_push_);
     return std::max(r_, dt_ * loads);
 }
 
-// ns_.previous_v := the free velocities of the current iterate (the line search's start).
+// matrix_.previous_v := the free velocities of the current iterate (the line search's start).
 void NewtonStep::keep_velocities() {
-    group_.each([&](SteppedBody& stepped, size_t offset) {
-        const vec<int32_t>& global = stepped.implicit->system.dof_to_global();
+    problem_.each([&](SteppedBody& stepped, size_t offset) {
+        const vec<int32_t>& global = stepped.newton->matrix.system.dof_to_global();
         for (size_t d = 0; d < global.size(); ++d)
-            ns_.previous_v[offset + d] = stepped.body->v[static_cast<size_t>(global[d])];
+            matrix_.previous_v[offset + d] = stepped.body->v[static_cast<size_t>(global[d])];
     });
 }
 
@@ -459,7 +403,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
     // A linearised step's updates with a kept factorisation go on until both norms are down
     // by factor_reuse (the max norm keeps a small badly-solved region from hiding in the sum).
     const double target = s_.factor_reuse * r_, target_max = s_.factor_reuse * r_max_;
-    const auto small = [&] { return r_ <= std::max(s_.newton_tolerance * residual0, ns_.roundoff_floor); };
+    const auto small = [&] { return r_ <= std::max(s_.newton_tolerance * residual0, matrix_.kept.roundoff_floor); };
     result_.newton_residual = -1.0;
     if (residual0 == 0.0) return true;
     bool towards_minimiser = false;  // a linearised step that went on iterating (see below)
@@ -480,7 +424,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
         }
         keep_velocities();
         double slope = 0.0;  // d Phi / d scale along delta, at scale 0
-        for (size_t d = 0; d < ns_.delta.size(); ++d) slope += ns_.residual[d] * ns_.delta[d];
+        for (size_t d = 0; d < matrix_.delta.size(); ++d) slope += matrix_.residual[d] * matrix_.delta[d];
         const bool fresh = fresh_;
         if (!(slope < 0.0) || !line_search(slope, fresh)) {
             if (!fresh) {  // the kept factorisation is too far from the current tangent
@@ -491,7 +435,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
             // as asked or within a few times the forces' round-off estimate (a fresh Newton
             // direction that cannot lower Phi there shows the residual is that round-off),
             // else stalled.
-            return r_ <= std::max(s_.newton_tolerance * residual0, kStalledRoundoffFactor * ns_.roundoff_floor);
+            return r_ <= std::max(s_.newton_tolerance * residual0, kStalledRoundoffFactor * matrix_.kept.roundoff_floor);
         }
         if (!fresh) {
             ++stale_solves_;
@@ -504,7 +448,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
         if (linearised) {
             // One update with the tangent at its iterate is the linearised step; updates with
             // a kept factorisation go on until they are as good as factor_reuse asks.
-            const double floor = ns_.roundoff_floor;
+            const double floor = matrix_.kept.roundoff_floor;
             if (!fresh && !(r_ <= std::max(target, floor) && r_max_ <= std::max(target_max, floor))) continue;
             if (!energy_rose(kLinearisedEnergyGain)) return energy_checked_ = true;
             // One update gained energy from nothing (large rotations, elements near inversion):
@@ -536,7 +480,7 @@ BodyStepResult NewtonStep::finish(bool converged, bool solver_failed, bool keep_
     result_.not_converged = !converged;
     result_.status = SH_OK;
     bool sane = true;
-    group_.each([&](SteppedBody& stepped, size_t) {
+    problem_.each([&](SteppedBody& stepped, size_t) {
         Body& body = *stepped.body;
         end_kinematic_motion(body);
         sane = sane && body_state_is_sane(stepped);
@@ -552,13 +496,13 @@ BodyStepResult NewtonStep::finish(bool converged, bool solver_failed, bool keep_
 }
 
 // The step, retried with a factorisation at every iterate if a kept one took it somewhere bad.
-BodyStepResult run_step(const NewtonGroup& group, const sh_implicit_settings& s, double dt, const double g[3],
+BodyStepResult run_step(NewtonProblem& problem, const sh_implicit_settings& s, double dt, const double g[3],
                         bool keep_best) {
-    NewtonStep first(group, s, dt, g, true);
+    NewtonStep first(problem, s, dt, g, true);
     const BodyStepResult result = first.run(keep_best);
     if (result.stable || !first.used_stale) return result;
     // The bodies are back at their start state.
-    NewtonStep again(group, s, dt, g, false);
+    NewtonStep again(problem, s, dt, g, false);
     BodyStepResult sum = again.run(keep_best);
     sum.newton_iterations += result.newton_iterations;
     sum.linear_iterations += result.linear_iterations;
@@ -571,19 +515,20 @@ BodyStepResult run_step(const NewtonGroup& group, const sh_implicit_settings& s,
 }  // namespace
 
 BodyStepResult step_implicit(SteppedBody& stepped, double dt, const double g[3], bool keep_best) {
-    if (!stepped.implicit) stepped.implicit = sh::create<ImplicitState>();
-    prepare_implicit_state(*stepped.body, *stepped.implicit, stepped.settings.implicit);
-    return run_step(NewtonGroup::alone(stepped), stepped.settings.implicit, dt, g, keep_best);
+    if (!stepped.newton) stepped.newton = sh::create<NewtonBodyState>();
+    stepped.newton->prepare(*stepped.body, stepped.settings.implicit);
+    NewtonProblem alone(stepped);
+    return run_step(alone, stepped.settings.implicit, dt, g, keep_best);
 }
 
-BodyStepResult step_implicit_coupled(CoupledSystem& system, double dt, const double g[3], bool keep_best) {
-    sh_implicit_settings s = system.member(0).stepped->settings.implicit;
-    for (int32_t m = 1; m < system.member_count(); ++m) {
-        const sh_implicit_settings& other = system.member(m).stepped->settings.implicit;
+BodyStepResult step_implicit_coupled(NewtonProblem& problem, double dt, const double g[3], bool keep_best) {
+    sh_implicit_settings s = problem.body(0).settings.implicit;
+    for (int32_t m = 1; m < problem.body_count(); ++m) {
+        const sh_implicit_settings& other = problem.body(m).settings.implicit;
         s.newton_tolerance = std::min(s.newton_tolerance, other.newton_tolerance);
         s.newton_max_iterations = std::max(s.newton_max_iterations, other.newton_max_iterations);
     }
-    return run_step(NewtonGroup::together(system), s, dt, g, keep_best);
+    return run_step(problem, s, dt, g, keep_best);
 }
 
 }  // namespace sh

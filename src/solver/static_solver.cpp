@@ -2,7 +2,7 @@
 
 #include "core/error.hpp"
 #include "model/external_field.hpp"
-#include "solver/newton_group.hpp"
+#include "solver/newton_problem.hpp"
 #include "solver/step_support.hpp"
 
 #include <algorithm>
@@ -11,6 +11,7 @@
 namespace sh {
 namespace {
 
+// True if body has a fixed or prescribed node.
 bool is_anchored(const Body& body) {
     for (const uint8_t k : body.kinematic)
         if (k) return true;
@@ -29,31 +30,30 @@ bool is_anchored(const Body& body) {
 // 24 to 29.
 constexpr double kFloatingShift = 1e-3;
 
-// K of a body at rest into its own system, with the shift above if the body has no fixed node;
+// K of a body at rest into its own matrix, with the shift above if the body has no fixed node;
 // its force round-off.
-double assemble_static_tangent(Body& body, ImplicitState& state, double shift) {
+double assemble_static_tangent(Body& body, NewtonBodyState& state, double shift) {
     const bool floating = !is_anchored(body);
     if (floating) {  // the shift scales with the body's own stiffness, not its contacts'
-        const SparseSystem& k = state.system;
-        state.system.clear_values();
-        body.add_tangent(body.x.data(), 1.0, 0.0, state.system);
+        SparseSystem& k = state.matrix.system;
+        k.clear_values();
+        body.add_tangent(body.x.data(), 1.0, 0.0, k);
         for (int32_t d = 0; d < k.dof_count(); ++d)
             state.diagonal[static_cast<size_t>(d)] = shift * k.values()[static_cast<size_t>(k.diagonal_slot(d))];
     }
-    return assemble_body_tangent(body, state, 1.0, 0.0, nullptr, floating ? state.diagonal.data() : nullptr, 1.0);
+    return state.assemble_tangent(body, 1.0, 0.0, nullptr, floating ? state.diagonal.data() : nullptr, 1.0);
 }
 
 // Out-of-balance force f(x) + load_factor * (f_ext + m g) on the free DOFs into out, and its
 // norm. Each body's workspace.stage_a[0] is scratch.
-double out_of_balance(const NewtonGroup& group, const double g[3], double load_factor, vec<double>& out) {
-    group.each([&](SteppedBody& stepped, size_t offset) {
+double out_of_balance(const NewtonProblem& problem, const double g[3], double load_factor, vec<double>& out) {
+    problem.each([&](SteppedBody& stepped, size_t offset) {
         Body& body = *stepped.body;
-        ImplicitState& state = *stepped.implicit;
         vec<double>& force = stepped.workspace.stage_a[0];
         std::fill(force.begin(), force.end(), 0.0);
         body.add_internal_forces(body.x.data(), nullptr, force.data());
         if (body.field) body.field->add_forces(body.x.data(), nullptr, force.data());
-        const vec<int32_t>& global = state.system.dof_to_global();
+        const vec<int32_t>& global = stepped.newton->matrix.system.dof_to_global();
         for (size_t d = 0; d < global.size(); ++d) {
             const size_t j = static_cast<size_t>(global[d]);
             out[offset + d] = force[j] + load_factor * body.applied_load(j, g);
@@ -64,57 +64,56 @@ double out_of_balance(const NewtonGroup& group, const double g[3], double load_f
     return std::sqrt(s);
 }
 
-// Newton-Raphson with line search for the group's bodies, their states prepared.
-void solve_group(const NewtonGroup& group, const double g[3], const sh_static_def& def, sh_static_report& report) {
-    NewtonSystem& ns = group.newton;
-    group.each([](SteppedBody& stepped, size_t) {
+// Newton-Raphson with line search for the problem's bodies, their states prepared.
+void solve_problem(NewtonProblem& problem, const double g[3], const sh_static_def& def, sh_static_report& report) {
+    NewtonMatrix& matrix = problem.matrix();
+    problem.each([](SteppedBody& stepped, size_t) {
         Body& body = *stepped.body;
         end_kinematic_motion(body);  // fixed and prescribed nodes on their targets
         std::fill(body.v.begin(), body.v.end(), 0.0);
     });
-    if (ns.system.dof_count() == 0) return;
+    if (matrix.system.dof_count() == 0) return;
 
-    vec<double>& residual = ns.residual;
-    vec<double>& step = ns.delta;
+    vec<double>& residual = matrix.residual;
+    vec<double>& step = matrix.delta;
     // Scale of the residual: the full applied load, or 1 N if nothing is applied.
-    double load_norm = group.applied_load_norm(g);
+    double load_norm = problem.applied_load_norm(g);
     if (!(load_norm > 0.0)) load_norm = 1.0;
 
     for (int32_t load_step = 1; load_step <= def.load_steps; ++load_step) {
         const double factor = static_cast<double>(load_step) / def.load_steps;
-        double r = out_of_balance(group, g, factor, residual) / load_norm;
+        double r = out_of_balance(problem, g, factor, residual) / load_norm;
         bool converged = r <= def.tolerance;
         double floor = 0.0;
         for (int32_t iteration = 0; iteration < def.max_iterations && !converged; ++iteration) {
-            const auto assemble_member = [&](SteppedBody& stepped) {
-                return assemble_static_tangent(*stepped.body, *stepped.implicit, kFloatingShift * std::min(r, 1.0));
+            const auto assemble_body = [&](SteppedBody& stepped) {
+                return assemble_static_tangent(*stepped.body, *stepped.newton, kFloatingShift * std::min(r, 1.0));
             };
             // Below the round-off of the internal forces the residual cannot fall further.
-            floor = std::max(floor, group.assemble(assemble_member, 1.0, 0.0, true) / load_norm);
-            ns.solver->factorize(ns.system);
-            ns.solver->solve(ns.system, residual.data(), step.data());
+            floor = std::max(floor, problem.assemble(assemble_body, 1.0, 0.0, true) / load_norm);
+            matrix.solver->factorize(matrix.system);
+            matrix.solver->solve(matrix.system, residual.data(), step.data());
             double slope = 0.0;  // d potential / d alpha at alpha = 0
             for (size_t d = 0; d < residual.size(); ++d) slope -= residual[d] * step[d];
             double scale = 0.0;
-            const double energy0 = group.potential_energy(g, factor, false, scale), r0 = r;
-            group.each([](SteppedBody& stepped, size_t) {
+            const double energy0 = problem.potential_energy(g, factor, false, scale), r0 = r;
+            problem.each([](SteppedBody& stepped, size_t) {
                 Body& body = *stepped.body;
                 std::copy(body.x.begin(), body.x.end(), stepped.workspace.xs.begin());
             });
             double alpha = 1.0;
             bool accepted = false;
             for (int trial = 0; trial < 30 && !accepted; ++trial, alpha *= 0.5) {
-                group.each([&](SteppedBody& stepped, size_t offset) {
+                problem.each([&](SteppedBody& stepped, size_t offset) {
                     Body& body = *stepped.body;
-                    ImplicitState& state = *stepped.implicit;
-                    const vec<int32_t>& global = state.system.dof_to_global();
+                    const vec<int32_t>& global = stepped.newton->matrix.system.dof_to_global();
                     for (size_t d = 0; d < global.size(); ++d) {
                         const size_t j = static_cast<size_t>(global[d]);
                         body.x[j] = stepped.workspace.xs[j] + alpha * step[offset + d];
                     }
                 });
-                r = out_of_balance(group, g, factor, residual) / load_norm;
-                const double energy = group.potential_energy(g, factor, false, scale);
+                r = out_of_balance(problem, g, factor, residual) / load_norm;
+                const double energy = problem.potential_energy(g, factor, false, scale);
                 // Armijo's decrease, or a smaller residual where the potential is flat to its
                 // round-off; never an iterate that raises the potential (a smaller residual
                 // there can lead the iteration round in a cycle over a kink of the contact
@@ -123,11 +122,11 @@ void solve_group(const NewtonGroup& group, const double g[3], const sh_static_de
                                                      (r < r0 && energy <= energy0 + sum_roundoff(scale)));
             }
             if (!accepted) {  // no step helped: stay where the iteration was
-                group.each([](SteppedBody& stepped, size_t) {
+                problem.each([](SteppedBody& stepped, size_t) {
                     Body& body = *stepped.body;
                     std::copy(stepped.workspace.xs.begin(), stepped.workspace.xs.end(), body.x.begin());
                 });
-                r = out_of_balance(group, g, factor, residual) / load_norm;
+                r = out_of_balance(problem, g, factor, residual) / load_norm;
             }
             ++report.iterations;
             if (report.history_count < SH_STATIC_HISTORY) report.residual_history[report.history_count++] = r;
@@ -158,15 +157,16 @@ void solve_static_body(SteppedBody& stepped, const double g[3], const sh_static_
     require(is_anchored(*stepped.body), SH_ERR_SOLVER,
             "a body has no fixed or prescribed node: it can float freely, so its stiffness is singular and it has "
             "no static equilibrium (fix or prescribe nodes first)");
-    ImplicitState state;
-    ImplicitState* states[1] = {&state};
+    NewtonBodyState state;
+    NewtonBodyState* states[1] = {&state};
     SteppedBody* const bodies[1] = {&stepped};
-    const SwappedImplicitStates lent(bodies, states, 1);
-    prepare_implicit_state(*stepped.body, state, static_solver_settings(def));
-    solve_group(NewtonGroup::alone(stepped), g, def, report);
+    const SwappedNewtonStates lent(bodies, states, 1);
+    state.prepare(*stepped.body, static_solver_settings(def));
+    NewtonProblem alone(stepped);
+    solve_problem(alone, g, def, report);
 }
 
-void solve_static_coupled(CoupledSystem& system, SteppedBody* const* bodies, int32_t count, const double g[3],
+void solve_static_coupled(NewtonProblem& problem, SteppedBody* const* bodies, int32_t count, const double g[3],
                           const sh_static_def& def, sh_static_report& report) {
     bool anchored = false;
     for (int32_t m = 0; m < count; ++m) anchored |= is_anchored(*bodies[m]->body);
@@ -174,12 +174,12 @@ void solve_static_coupled(CoupledSystem& system, SteppedBody* const* bodies, int
             "bodies in contact with each other have no fixed or prescribed node among them: they can float "
             "freely, so their stiffness is singular and they have no static equilibrium (fix or prescribe nodes "
             "of one of them first)");
-    vec<ImplicitState> fresh(static_cast<size_t>(count));  // as for a body alone
-    vec<ImplicitState*> states;
-    for (ImplicitState& state : fresh) states.push_back(&state);
-    const SwappedImplicitStates lent(bodies, states.data(), count);
-    system.prepare(bodies, count, static_solver_settings(def));
-    solve_group(NewtonGroup::together(system), g, def, report);
+    vec<NewtonBodyState> fresh(static_cast<size_t>(count));  // as for a body alone
+    vec<NewtonBodyState*> states;
+    for (NewtonBodyState& state : fresh) states.push_back(&state);
+    const SwappedNewtonStates lent(bodies, states.data(), count);
+    problem.prepare(bodies, count, static_solver_settings(def));
+    solve_problem(problem, g, def, report);
 }
 
 }  // namespace sh

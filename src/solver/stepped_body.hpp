@@ -1,6 +1,6 @@
 // SteppedBody: a body as the solvers step it. The body owns its state and physics; how it is
-// stepped (integrator, guards, implicit settings) and the solvers' scratch for it live here,
-// one per body, owned by the world.
+// stepped (integrator, guards, implicit settings), the solvers' scratch for it and the Newton
+// solves' per-body data (NewtonBodyState) live here, one per body, owned by the world.
 #pragma once
 
 #include "core/memory.hpp"
@@ -12,12 +12,12 @@
 
 namespace sh {
 
-struct ImplicitState;
+struct NewtonBodyState;
 
 /// How a body is stepped, chosen when it is created.
 struct StepSettings {
-    sh_integrator integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
-    sh_unstable_policy on_unstable = SH_UNSTABLE_SUBSTEP;
+    sh_integrator integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;  ///< the time-stepping scheme
+    sh_unstable_policy on_unstable = SH_UNSTABLE_SUBSTEP;      ///< what a failed step does
     sh_implicit_settings implicit{};  ///< read for SH_INTEGRATOR_IMPLICIT_EULER
     double runaway_speed = 1e4;       ///< m/s: a faster node rolls the step back
 };
@@ -36,35 +36,38 @@ struct IntegratorWorkspace {
     void resize(int32_t node_count);
 };
 
-/// A body with its step settings, scratch and implicit solver state.
+/// A body with its step settings, scratch and the Newton solves' data for it.
 struct SteppedBody {
-    Body* body = nullptr;
-    StepSettings settings;
-    IntegratorWorkspace workspace;
-    ImplicitState* implicit = nullptr;  ///< built on the first implicit step
+    Body* body = nullptr;            ///< the body stepped (owned by the world)
+    StepSettings settings;           ///< how it is stepped
+    IntegratorWorkspace workspace;   ///< the integrators' scratch
+    NewtonBodyState* newton = nullptr;  ///< its Newton solves' data, built on the first implicit step
 };
 
-/// For a scope, bodies[0..count) and states[0..count) trade implicit states (a static solve's
+/// For a scope, bodies[0..count) and states[0..count) trade Newton states (a static solve's
 /// fresh ones, the error estimate's own), and trade back when it ends, also by an exception.
 /// A state a body creates in the scope (step_implicit makes one if it has none) ends up in
 /// states[m].
-class SwappedImplicitStates {
+class SwappedNewtonStates {
 public:
-    SwappedImplicitStates(SteppedBody* const* bodies, ImplicitState** states, int32_t count)
+    /// Swaps bodies[m]->newton with states[m] for every m < count.
+    SwappedNewtonStates(SteppedBody* const* bodies, NewtonBodyState** states, int32_t count)
         : bodies_(bodies), states_(states), count_(count) {
         swap();
     }
-    ~SwappedImplicitStates() { swap(); }
-    SwappedImplicitStates(const SwappedImplicitStates&) = delete;
-    SwappedImplicitStates& operator=(const SwappedImplicitStates&) = delete;
+    /// Swaps them back.
+    ~SwappedNewtonStates() { swap(); }
+    SwappedNewtonStates(const SwappedNewtonStates&) = delete;             ///< a scope guard
+    SwappedNewtonStates& operator=(const SwappedNewtonStates&) = delete;  ///< a scope guard
 
 private:
+    /// Trades every body's state with its entry of states_.
     void swap() {
-        for (int32_t m = 0; m < count_; ++m) std::swap(bodies_[m]->implicit, states_[m]);
+        for (int32_t m = 0; m < count_; ++m) std::swap(bodies_[m]->newton, states_[m]);
     }
-    SteppedBody* const* bodies_;
-    ImplicitState** states_;
-    int32_t count_;
+    SteppedBody* const* bodies_;  ///< the bodies
+    NewtonBodyState** states_;    ///< their states for the scope, theirs outside it
+    int32_t count_;               ///< how many
 };
 
 }  // namespace sh

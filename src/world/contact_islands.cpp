@@ -1,7 +1,8 @@
 #include "world/contact_islands.hpp"
 
 #include "core/clock.hpp"
-#include "solver/coupled_system.hpp"
+#include "solver/implicit_integrator.hpp"
+#include "solver/newton_problem.hpp"
 #include "solver/static_solver.hpp"
 #include "world/body_step.hpp"
 #include "world/step_doubling.hpp"
@@ -12,7 +13,7 @@
 namespace sh {
 
 ContactIslands::~ContactIslands() {
-    for (Kept& k : kept_) sh::destroy(k.system);
+    for (Kept& k : kept_) sh::destroy(k.problem);
 }
 
 uint32_t ContactIslands::root(uint32_t slot) {
@@ -52,23 +53,23 @@ int32_t ContactIslands::group(size_t slot_count) {
     return island_count();
 }
 
-CoupledSystem& ContactIslands::system(const sh_body_id* ids_, int32_t count) {
+NewtonProblem& ContactIslands::problem(const sh_body_id* ids_, int32_t count) {
     for (Kept& k : kept_)
         if (k.ids.size() == static_cast<size_t>(count) && std::equal(k.ids.begin(), k.ids.end(), ids_)) {
             k.used = true;
-            return *k.system;
+            return *k.problem;
         }
     Kept k;
     k.ids.assign(ids_, ids_ + count);
     kept_.push_back(std::move(k));
-    kept_.back().system = sh::create<CoupledSystem>();
+    kept_.back().problem = sh::create<NewtonProblem>();
     kept_.back().used = true;
-    return *kept_.back().system;
+    return *kept_.back().problem;
 }
 
 void ContactIslands::drop_unused() {
     for (Kept& k : kept_)
-        if (!k.used) sh::destroy(k.system);
+        if (!k.used) sh::destroy(k.problem);
     kept_.erase(std::remove_if(kept_.begin(), kept_.end(), [](const Kept& k) { return !k.used; }), kept_.end());
     for (Kept& k : kept_) k.used = false;
 }
@@ -85,21 +86,21 @@ void World::step_islands(double h, sh_step_report& r, vec<uint8_t>& skip) {
         for (int32_t m = 0; m < count; ++m) {
             Slot& slot = slots_[members[m]];
             keep_best |= slot.keep_best;
-            if (!slot.stepped->implicit) slot.stepped->implicit = sh::create<ImplicitState>();
+            if (!slot.stepped->newton) slot.stepped->newton = sh::create<NewtonBodyState>();
             islands.stepped.push_back(slot.stepped);
             islands.doublings.push_back(slot.doubling);
             islands.ids.push_back(id_of(members[m]));
         }
-        CoupledSystem& system = islands.system(islands.ids.data(), count);
-        system.prepare(islands.stepped.data(), count, islands.stepped[0]->settings.implicit);
+        NewtonProblem& problem = islands.problem(islands.ids.data(), count);
+        problem.prepare(islands.stepped.data(), count, islands.stepped[0]->settings.implicit);
         bool half_steps_stable = false;
         if (error_estimate_) {
             const ScopedTimer timer(r.error_estimate_seconds);
             half_steps_stable = take_half_steps_together(islands.stepped.data(), islands.doublings.data(), count, h,
-                                                         [&](double half) { return step_implicit_coupled(system, half, gravity).stable; });
+                                                         [&](double half) { return step_implicit_coupled(problem, half, gravity).stable; });
         }
         for (SteppedBody* stepped : islands.stepped) stepped->body->clear_inverted_elements();
-        const BodyStepResult result = step_implicit_coupled(system, h, gravity, keep_best);
+        const BodyStepResult result = step_implicit_coupled(problem, h, gravity, keep_best);
         for (int32_t m = 0; m < count && error_estimate_; ++m) {
             if (half_steps_stable && result.stable && r.error_estimate >= 0.0)
                 r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*islands.stepped[static_cast<size_t>(m)]->body,
@@ -120,8 +121,8 @@ void World::solve_static_islands(const sh_static_def& def, sh_static_report& r) 
         const int32_t count = islands.member_count(i);
         islands.stepped.clear();
         for (int32_t m = 0; m < count; ++m) islands.stepped.push_back(slots_[members[m]].stepped);
-        CoupledSystem system;
-        solve_static_coupled(system, islands.stepped.data(), count, gravity, def, r);
+        NewtonProblem problem;
+        solve_static_coupled(problem, islands.stepped.data(), count, gravity, def, r);
     }
 }
 

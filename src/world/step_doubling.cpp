@@ -1,6 +1,6 @@
 #include "world/step_doubling.hpp"
 
-#include "solver/implicit_integrator.hpp"
+#include "solver/newton_body_state.hpp"
 #include "world/body_step.hpp"
 
 #include <algorithm>
@@ -10,7 +10,7 @@ namespace sh {
 
 StepDoubling::StepDoubling(size_t values) : start_x(values), start_v(values), start_target(values), half_x(values) {}
 
-StepDoubling::~StepDoubling() { sh::destroy(implicit); }
+StepDoubling::~StepDoubling() { sh::destroy(newton); }
 
 void begin_half_steps(Body& body, StepDoubling& scratch) {
     std::copy(body.x.begin(), body.x.end(), scratch.start_x.begin());
@@ -37,7 +37,7 @@ bool take_half_steps(SteppedBody& stepped, StepDoubling& scratch, double dt, con
     StepDoubling* scratches[1] = {&scratch};
     // An implicit body's half steps keep their own state and factorisation, so that the full
     // step's stays (the first half step makes it).
-    const SwappedImplicitStates own(bodies, &scratch.implicit, 1);
+    const SwappedNewtonStates own(bodies, &scratch.newton, 1);
     return take_half_steps_together(bodies, scratches, 1, dt,
                                     [&](double h) { return step_body(stepped, h, gravity, false).stable; });
 }

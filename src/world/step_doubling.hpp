@@ -10,18 +10,20 @@
 
 namespace sh {
 
-struct ImplicitState;
+struct NewtonBodyState;
 
 /// Scratch of one body's step-doubling estimate, sized when the body joins the world.
 struct StepDoubling {
     vec<double> start_x, start_v, start_target;  ///< 3 per node: the state to go back to
     vec<double> half_x;                          ///< 3 per node: positions after two half steps
-    ImplicitState* implicit = nullptr;           ///< the half steps' own implicit solver state,
-                                                 ///< so the full step's kept factorisation stays
+    NewtonBodyState* newton = nullptr;           ///< the half steps' own Newton state, so the
+                                                 ///< full step's kept factorisation stays
+    /// Scratch for a body of values / 3 nodes.
     explicit StepDoubling(size_t values);
+    /// Frees newton.
     ~StepDoubling();
-    StepDoubling(const StepDoubling&) = delete;
-    StepDoubling& operator=(const StepDoubling&) = delete;
+    StepDoubling(const StepDoubling&) = delete;             ///< owns newton
+    StepDoubling& operator=(const StepDoubling&) = delete;  ///< owns newton
 };
 
 /// Saves body's start state in scratch and moves its kinematic nodes' targets to the midpoint
@@ -56,7 +58,7 @@ bool take_half_steps_together(SteppedBody* const* bodies, StepDoubling* const* s
 }
 
 /// take_half_steps_together for one body with its own integrator (an implicit one with
-/// scratch.implicit as its state).
+/// scratch.newton as its Newton state).
 bool take_half_steps(SteppedBody& stepped, StepDoubling& scratch, double dt, const double gravity[3]);
 
 /// Largest distance between a node of body and its position in scratch.half_x (m).

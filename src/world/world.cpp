@@ -11,35 +11,15 @@
 #include "solver/implicit_integrator.hpp"
 #include "solver/static_solver.hpp"
 #include "solver/step_support.hpp"
+#include "solver/substeps.hpp"
 #include "world/body_step.hpp"
 #include "world/contact_islands.hpp"
 #include "world/step_doubling.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 namespace sh {
-namespace {
-
-uint32_t slot_of(sh_body_id id) { return static_cast<uint32_t>(id & 0xffffffffu) - 1u; }
-uint32_t generation_of(sh_body_id id) { return static_cast<uint32_t>(id >> 32); }
-
-// Generations come from one counter shared by all worlds, so an id is never valid in a world
-// other than the one that issued it.
-std::atomic<uint32_t> g_next_generation{1};
-
-// More contact sub-steps than this in one step are not taken (the tool then moves farther
-// per sub-step).
-constexpr double kMaxContactSubsteps = 1024.0;
-
-uint32_t next_generation() {
-    uint32_t g = g_next_generation.fetch_add(1);
-    while (g == 0) g = g_next_generation.fetch_add(1);
-    return g;
-}
-
-}  // namespace
 
 World::World(const sh_world_def& def) : error_estimate_(def.error_estimate != 0) {
     for (int k = 0; k < 3; ++k) gravity[k] = def.gravity[k];
@@ -47,158 +27,116 @@ World::World(const sh_world_def& def) : error_estimate_(def.error_estimate != 0)
 
 World::~World() {
     for (StepHook* hook : hooks_) hook->detach();
-    for (Slot& slot : slots_) destroy_slot(slot);
-    for (ColliderSlot& c : colliders_) sh::destroy(c.collider);
+    slots_.for_each([&](Slot& slot) { destroy_slot(slot); });
+    colliders_.for_each([](Collider* c) { sh::destroy(c); });
     sh::destroy(islands_);
 }
 
 void World::destroy_slot(Slot& slot) {
     if (slot.stepped) {
         sh::destroy(slot.body());
-        sh::destroy(slot.stepped->implicit);
+        sh::destroy(slot.stepped->newton);
     }
     sh::destroy(slot.stepped);
     sh::destroy(slot.doubling);
     sh::destroy(slot.contacts);
-    slot.stepped = nullptr;
-    slot.doubling = nullptr;
-    slot.contacts = nullptr;
-    slot.saved = vec<double>();
+    slot = Slot{};
 }
 
-sh_body_id World::add_body(Body* body, const StepSettings& settings) {
-    uint32_t index;
-    if (!free_slots_.empty()) {
-        index = free_slots_.back();
-        free_slots_.pop_back();
-    } else {
-        try {
-            // Room for every slot in the free list, so that remove_body never allocates.
-            if (free_slots_.capacity() < slots_.size() + 1) free_slots_.reserve(2 * slots_.size() + 1);
-            slots_.push_back(Slot{});
-        } catch (...) {
-            sh::destroy(body);
-            throw;
-        }
-        index = static_cast<uint32_t>(slots_.size() - 1);
-    }
+Id World::add_body(Body* body, const StepSettings& settings) {
     StepDoubling* doubling = nullptr;
     SteppedBody* stepped = nullptr;
-    Slot& slot = slots_[index];
+    Id id = kNullId;
     try {
         if (error_estimate_) doubling = sh::create<StepDoubling>(body->x.size());
-        // Room for the step's start state, scratch and attempt flags, so that a step allocates
-        // nothing.
         stepped = sh::create<SteppedBody>();
         stepped->workspace.resize(body->node_count());
-        slot.saved.reserve(body->x.size() + body->v.size());
-        skip_.reserve(slots_.size());
+        stepped->body = body;
+        stepped->settings = settings;
+        id = slots_.allocate(Slot{stepped, doubling, nullptr});
+        // Room for the step's start state, scratch and attempt flags, so that a step allocates
+        // nothing.
+        scratch_.reserve_body(slots_.size(), id_index(id), body->x.size() + body->v.size());
     } catch (...) {
-        free_slots_.push_back(index);
+        if (id != kNullId) slots_.release(id);
         sh::destroy(stepped);
         sh::destroy(doubling);
         sh::destroy(body);
         throw;
     }
-    stepped->body = body;
-    stepped->settings = settings;
-    slot.stepped = stepped;
-    slot.doubling = doubling;
-    slot.generation = next_generation();
-    return id_of(index);
+    return id;
 }
 
-bool World::is_valid(sh_body_id id) const {
-    if (id == SH_NULL_BODY) return false;
-    const uint32_t index = slot_of(id);
-    return index < slots_.size() && slots_[index].body() && slots_[index].generation == generation_of(id);
-}
+bool World::is_valid(Id id) const { return slots_.contains(id); }
 
-Body& World::body(sh_body_id id) const {
-    if (!is_valid(id))
+Body& World::body(Id id) const {
+    const Slot* slot = slots_.find(id);
+    if (!slot)
         throw Error(SH_ERR_INVALID_HANDLE,
-                    id == SH_NULL_BODY ? std::string("body id is null (0)")
-                                       : format("body id 0x%llx is not a live body of this world (removed or never created)",
-                                                static_cast<unsigned long long>(id)));
-    return *slots_[slot_of(id)].body();
+                    id == kNullId ? std::string("body id is null (0)")
+                                  : format("body id 0x%llx is not a live body of this world (removed or never created)",
+                                           static_cast<unsigned long long>(id)));
+    return *slot->body();
 }
 
-sh_body_id World::add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
-                               double damping_stiffness, const StepSettings& settings) {
-    const sh_body_id id = add_body(sh::create<FemBody>(mesh, material, damping_mass, damping_stiffness), settings);
+Id World::add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
+                       double damping_stiffness, const StepSettings& settings) {
+    const Id id = add_body(sh::create<FemBody>(mesh, material, damping_mass, damping_stiffness), settings);
     if (locks_linear_tets(material)) ++warnings[SH_WARN_LOCKING];
     return id;
 }
 
-void World::set_material(sh_body_id id, const int32_t* elements, int32_t count, const sh_material& material) {
+void World::set_material(Id id, const int32_t* elements, int32_t count, const sh_material& material) {
     Body& b = body(id);
     require(b.is_fem(), SH_ERR_UNSUPPORTED, "sh_body_set_material needs an FEM body; this is a mass-spring body");
     static_cast<FemBody&>(b).set_material(elements, count, material);
     if (locks_linear_tets(material) && count > 0) ++warnings[SH_WARN_LOCKING];
 }
 
-const StepSettings& World::step_settings(sh_body_id id) const {
+const StepSettings& World::step_settings(Id id) const {
     body(id);  // validates
-    return slots_[slot_of(id)].stepped->settings;
+    return slots_[id_index(id)].stepped->settings;
 }
 
-void World::remove_body(sh_body_id id) {
+void World::remove_body(Id id) {
     body(id);  // validates
-    const uint32_t index = slot_of(id);
-    free_slots_.push_back(index);  // within the capacity reserved in add_body
-    destroy_slot(slots_[index]);
+    destroy_slot(slots_[id_index(id)]);
+    scratch_.release_body(id_index(id));
+    slots_.release(id);  // never allocates
     pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(), [&](const BodyPair& p) { return p.a == id || p.b == id; }),
                  pairs_.end());
 }
 
-uint64_t World::add_collider(const sh_collider_def& def, bool is_tool) {
+Id World::add_collider(const sh_collider_def& def, bool is_tool) {
     Collider* collider = sh::create<Collider>(def, is_tool);
-    uint32_t index;
-    if (!free_colliders_.empty()) {
-        index = free_colliders_.back();
-        free_colliders_.pop_back();
-    } else {
-        try {
-            if (free_colliders_.capacity() < colliders_.size() + 1) free_colliders_.reserve(2 * colliders_.size() + 1);
-            colliders_.push_back(ColliderSlot{});
-        } catch (...) {
-            sh::destroy(collider);
-            throw;
-        }
-        index = static_cast<uint32_t>(colliders_.size() - 1);
+    try {
+        return colliders_.allocate(collider);
+    } catch (...) {
+        sh::destroy(collider);
+        throw;
     }
-    colliders_[index].collider = collider;
-    colliders_[index].generation = next_generation();
-    ++collider_count_;
-    return (static_cast<uint64_t>(colliders_[index].generation) << 32) | (static_cast<uint64_t>(index) + 1);
 }
 
-bool World::is_valid_collider(uint64_t id, bool is_tool) const {
-    if (id == 0) return false;
-    const uint32_t index = slot_of(id);
-    return index < colliders_.size() && colliders_[index].collider && colliders_[index].generation == generation_of(id) &&
-           colliders_[index].collider->is_tool == is_tool;
+bool World::is_valid_collider(Id id, bool is_tool) const {
+    Collider* const* collider = colliders_.find(id);
+    return collider && (*collider)->is_tool == is_tool;
 }
 
-Collider& World::collider(uint64_t id, bool is_tool) const {
+Collider& World::collider(Id id, bool is_tool) const {
     const char* kind = is_tool ? "tool" : "obstacle";
     if (!is_valid_collider(id, is_tool))
-        throw Error(SH_ERR_INVALID_HANDLE, id == 0 ? format("%s id is null (0)", kind)
-                                                   : format("%s id 0x%llx is not a live %s of this world (removed or never created)",
-                                                            kind, static_cast<unsigned long long>(id), kind));
-    return *colliders_[slot_of(id)].collider;
+        throw Error(SH_ERR_INVALID_HANDLE, id == kNullId ? format("%s id is null (0)", kind)
+                                                         : format("%s id 0x%llx is not a live %s of this world (removed or never created)",
+                                                                  kind, static_cast<unsigned long long>(id), kind));
+    return **colliders_.find(id);
 }
 
-void World::remove_collider(uint64_t id, bool is_tool) {
+void World::remove_collider(Id id, bool is_tool) {
     collider(id, is_tool);  // validates
-    const uint32_t index = slot_of(id);
-    free_colliders_.push_back(index);  // within the capacity reserved in add_collider
-    sh::destroy(colliders_[index].collider);
-    colliders_[index].collider = nullptr;
-    --collider_count_;
+    sh::destroy(colliders_.release(id));  // release never allocates
 }
 
-void World::set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params* params) {
+void World::set_body_contact(Id a, Id b, const sh_contact_params* params) {
     require(body(a).is_fem() && body(b).is_fem(), SH_ERR_UNSUPPORTED,
             "body contact needs two FEM bodies (a mass-spring body has no tets to be inside of)");
     require(a != b, SH_ERR_INVALID_ARGUMENT, "a and b are the same body: self-contact is not supported");
@@ -214,7 +152,10 @@ void World::set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params
     }
 }
 
-const BodyContacts* World::contacts_of(sh_body_id id) const { return is_valid(id) ? slots_[slot_of(id)].contacts : nullptr; }
+const BodyContacts* World::contacts_of(Id id) const {
+    const Slot* slot = slots_.find(id);
+    return slot ? slot->contacts : nullptr;
+}
 
 void World::add_hook(StepHook* hook) { hooks_.push_back(hook); }
 
@@ -253,8 +194,8 @@ void World::note_result(size_t index, const BodyStepResult& result, sh_step_repo
     if (result.not_converged) r.warnings |= 1u << SH_WARN_NOT_CONVERGED;
     if (result.stable) return;
     skip[index] = 1;  // the body sits out the rest of this attempt
-    slot.failure = result;
-    slot.failed = true;
+    scratch_.bodies[index].failure = result;
+    scratch_.bodies[index].failed = true;
 }
 
 bool World::group_islands(bool implicit_only, const vec<uint8_t>* failed) {
@@ -262,7 +203,7 @@ bool World::group_islands(bool implicit_only, const vec<uint8_t>* failed) {
     if (!islands_) islands_ = sh::create<ContactIslands>();
     islands_->links.clear();
     for (const BodyPair& pair : pairs_) {
-        const uint32_t a = slot_of(pair.a), b = slot_of(pair.b);
+        const uint32_t a = id_index(pair.a), b = id_index(pair.b);
         const auto eligible = [&](uint32_t index) {
             return !(failed && (*failed)[index]) &&
                    (!implicit_only || slots_[index].stepped->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER);
@@ -274,12 +215,11 @@ bool World::group_islands(bool implicit_only, const vec<uint8_t>* failed) {
 
 uint32_t World::detect_contacts(double h, double travel_fraction, double extra_reach) {
     uint32_t warning_bits = 0;
-    for (Slot& slot : slots_) {
-        if (!slot.body()) continue;
+    slots_.for_each([&](Slot& slot) {
         Body& body = *slot.body();
         if (!slot.contacts)
-            slot.contacts =
-                sh::create<BodyContacts>(body, slot.stepped->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER);
+            slot.contacts = sh::create<BodyContacts>(body, slot.stepped->settings.integrator == SH_INTEGRATOR_IMPLICIT_EULER,
+                                                     scratch_.contact);
         BodyContacts& contacts = *slot.contacts;
         contacts.clear();
         // How far a node may go in the (sub)step: twice its speed's reach, plus a little.
@@ -289,17 +229,16 @@ uint32_t World::detect_contacts(double h, double travel_fraction, double extra_r
         const double margin = 2.0 * h * std::sqrt(speed2) + extra_reach;
         contacts.refit(margin);
         double anticipated = margin;
-        for (const ColliderSlot& c : colliders_) {
-            if (!c.collider) continue;
-            const double reach = margin + travel_fraction * c.collider->travel();
+        colliders_.for_each([&](Collider* c) {
+            const double reach = margin + travel_fraction * c->travel();
             anticipated = std::max(anticipated, reach);
-            if (contacts.detect(*c.collider, reach)) warning_bits |= 1u << SH_WARN_CAPACITY;
-        }
+            if (contacts.detect(*c, reach)) warning_bits |= 1u << SH_WARN_CAPACITY;
+        });
         contacts.anticipated_depth = anticipated;
-    }
+    });
     for (BodyPair& pair : pairs_) {
-        Slot& a = slots_[slot_of(pair.a)];
-        Slot& b = slots_[slot_of(pair.b)];
+        Slot& a = slots_[id_index(pair.a)];
+        Slot& b = slots_[id_index(pair.b)];
         const int32_t before = a.contacts->candidate_count() + b.contacts->candidate_count();
         if (BodyContacts::detect_pair(*a.contacts, *b.contacts, pair.params)) warning_bits |= 1u << SH_WARN_CAPACITY;
         if (BodyContacts::detect_pair(*b.contacts, *a.contacts, pair.params)) warning_bits |= 1u << SH_WARN_CAPACITY;
@@ -307,30 +246,26 @@ uint32_t World::detect_contacts(double h, double travel_fraction, double extra_r
     }
     // Implicit bodies take each candidate's depth at the step's start for the depth rate of
     // the step's contact law: with the colliders where the (sub)step starts.
-    for (ColliderSlot& c : colliders_)
-        if (c.collider) std::swap(c.collider->pose, c.collider->previous);
-    for (Slot& slot : slots_)
-        if (slot.body()) slot.body()->field = slot.contacts->finish_detection(h);
-    for (ColliderSlot& c : colliders_)
-        if (c.collider) std::swap(c.collider->pose, c.collider->previous);
+    const auto swap_poses = [](Collider* c) { std::swap(c->pose, c->previous); };
+    colliders_.for_each(swap_poses);
+    slots_.for_each([&](Slot& slot) { slot.body()->field = slot.contacts->finish_detection(h); });
+    colliders_.for_each(swap_poses);
     return warning_bits;
 }
 
 int32_t World::finish_contacts() {
-    for (ColliderSlot& c : colliders_)
-        if (c.collider) c.collider->state = sh_contact_state{};
+    colliders_.for_each([](Collider* c) { c->state = sh_contact_state{}; });
     int32_t count = 0;
-    for (Slot& slot : slots_) {
-        if (!slot.body() || !slot.contacts) continue;
+    slots_.for_each([&](Slot& slot) {
+        if (!slot.contacts) return;
         if (slot.body()->field) count += slot.contacts->accumulate_reactions();
         slot.body()->field = nullptr;
-    }
-    for (ColliderSlot& c : colliders_) {
-        if (!c.collider) continue;
-        c.collider->start = c.collider->target;
-        c.collider->pose = c.collider->target;
-        c.collider->velocity_given = false;
-    }
+    });
+    colliders_.for_each([](Collider* c) {
+        c->start = c->target;
+        c->pose = c->target;
+        c->velocity_given = false;
+    });
     return count;
 }
 
@@ -346,8 +281,7 @@ void World::step(double dt, sh_step_report* report) {
     try {
         run_attempts(dt, r);
     } catch (...) {
-        for (Slot& slot : slots_)
-            if (slot.body()) slot.body()->field = nullptr;
+        slots_.for_each([](Slot& slot) { slot.body()->field = nullptr; });
         throw;
     }
     if (has_contact()) {
@@ -355,16 +289,15 @@ void World::step(double dt, sh_step_report* report) {
             const ScopedTimer timer(r.collision_seconds);
             r.contact_count = finish_contacts();
         }
-        for (const Slot& slot : slots_)
-            if (slot.contacts) r.collision_seconds += slot.contacts->take_evaluation_seconds();
+        r.collision_seconds += scratch_.contact.take_evaluation_seconds();
         if (r.warnings & (1u << SH_WARN_CAPACITY)) ++warnings[SH_WARN_CAPACITY];
     }
     for (StepHook* hook : hooks_) hook->after_step(*this, dt);
-    const Slot* failed = nullptr;
-    for (const Slot& slot : slots_)
-        if (slot.body() && slot.failed) {
+    size_t failed = slots_.size();  // the first failed body's slot, if any
+    for (size_t index = 0; index < slots_.size(); ++index)
+        if (slots_.is_live(index) && scratch_.bodies[index].failed) {
             ++r.unstable_body_count;
-            if (!failed) failed = &slot;
+            if (failed == slots_.size()) failed = index;
         }
     if (r.unstable_body_count > 0) r.warnings |= 1u << SH_WARN_UNSTABLE;
     for (const sh_warning kind : {SH_WARN_SUBSTEPPED, SH_WARN_INVERTED, SH_WARN_NOT_CONVERGED})
@@ -375,38 +308,42 @@ void World::step(double dt, sh_step_report* report) {
         r.wall_seconds = now_seconds() - start;
         *report = r;
     }
-    if (!failed) return;
-    const unsigned long long id = static_cast<unsigned long long>(id_of(static_cast<size_t>(failed - slots_.data())));
-    if (failed->failure.rejected)
+    if (failed == slots_.size()) return;
+    const unsigned long long id = static_cast<unsigned long long>(id_of(failed));
+    const BodyStepResult& failure = scratch_.bodies[failed].failure;
+    if (failure.rejected)
         throw Error(SH_ERR_UNSTABLE, format("body 0x%llx: dt = %g s exceeds its critical step %g s (policy: reject); "
                                             "%d body(ies) left unchanged",
-                                            id, dt, failed->failure.dt_critical, r.unstable_body_count));
-    throw Error(failed->failure.status, format("body 0x%llx: %s (%d body(ies) left as before the step)", id,
-                                               failed->failure.reason, r.unstable_body_count));
+                                            id, dt, failure.dt_critical, r.unstable_body_count));
+    throw Error(failure.status, format("body 0x%llx: %s (%d body(ies) left as before the step)", id, failure.reason,
+                                       r.unstable_body_count));
 }
 
 int32_t World::begin_colliders(double dt) {
     // Tools move from their last pose to the host's in sub-steps short enough that none
     // crosses more than half its inner radius at once.
-    double substeps = 1.0;
-    for (ColliderSlot& c : colliders_) {
-        if (!c.collider) continue;
-        c.collider->begin_step(dt);
-        const double travel = c.collider->travel(), limit = 0.5 * c.collider->shape.inner_radius();
-        if (travel > limit) substeps = std::max(substeps, std::ceil(travel / limit));
-    }
-    return static_cast<int32_t>(std::min(substeps, kMaxContactSubsteps));
+    int32_t substeps = 1;
+    colliders_.for_each([&](Collider* c) {
+        c->begin_step(dt);
+        const double travel = c->travel(), limit = 0.5 * c->shape.inner_radius();
+        substeps = std::max(substeps, substep_count(travel, limit, kMaxContactSubsteps).count);
+    });
+    return substeps;
 }
 
-void World::save_step_start(Slot& slot) {
-    slot.saved.assign(slot.body()->x.begin(), slot.body()->x.end());
-    slot.saved.insert(slot.saved.end(), slot.body()->v.begin(), slot.body()->v.end());
+void World::save_step_start(size_t index) {
+    const Body& body = *slots_[index].body();
+    vec<double>& saved = scratch_.bodies[index].saved;
+    saved.assign(body.x.begin(), body.x.end());
+    saved.insert(saved.end(), body.v.begin(), body.v.end());
 }
 
-void World::restore_step_start(Slot& slot) {
-    const size_t n = slot.body()->x.size();
-    std::copy(slot.saved.begin(), slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.body()->x.begin());
-    std::copy(slot.saved.begin() + static_cast<std::ptrdiff_t>(n), slot.saved.end(), slot.body()->v.begin());
+void World::restore_step_start(size_t index) {
+    Body& body = *slots_[index].body();
+    const vec<double>& saved = scratch_.bodies[index].saved;
+    const size_t n = body.x.size();
+    std::copy(saved.begin(), saved.begin() + static_cast<std::ptrdiff_t>(n), body.x.begin());
+    std::copy(saved.begin() + static_cast<std::ptrdiff_t>(n), saved.end(), body.v.begin());
 }
 
 // The step as attempts of 1, 2, 4, ... times the contact sub-steps: a body whose attempt
@@ -417,27 +354,29 @@ void World::restore_step_start(Slot& slot) {
 // the start is copied only for attempts of more sub-steps.
 void World::run_attempts(double dt, sh_step_report& r) {
     const int32_t base = r.contact_substeps;
-    skip_.assign(slots_.size(), 0);
-    for (Slot& slot : slots_) {
-        slot.failed = false;
-        if (slot.body() && base > 1) save_step_start(slot);
+    vec<uint8_t>& skip = scratch_.skip;
+    skip.assign(slots_.size(), 0);  // within the capacity reserved in add_body
+    for (size_t index = 0; index < slots_.size(); ++index) {
+        scratch_.bodies[index].failed = false;
+        if (slots_.is_live(index) && base > 1) save_step_start(index);
     }
     for (int32_t factor = 1;; factor *= 2) {
-        for (Slot& slot : slots_)
-            if (slot.body())
-                slot.keep_best = sub_steps_on_failure(slot.stepped->settings) && 2 * factor > retry_limit(slot.stepped->settings);
+        slots_.for_each([&](Slot& slot) {
+            const StepSettings& s = slot.stepped->settings;
+            slot.keep_best = sub_steps_on_failure(s) && !may_retry_in(s, 2 * factor);
+        });
         run_substeps(dt, base * factor, r);
         bool retry = false;
         for (size_t index = 0; index < slots_.size(); ++index) {
-            Slot& slot = slots_[index];
-            if (!slot.body()) continue;
-            skip_[index] = 1;  // done, unless it retries
-            if (!slot.failed) continue;
-            if (base * factor > 1) restore_step_start(slot);
-            if (2 * factor > retry_limit(slot.stepped->settings)) continue;  // final: reported by step()
-            if (base * factor == 1) save_step_start(slot);
-            slot.failed = false;
-            skip_[index] = 0;
+            if (!slots_.is_live(index)) continue;
+            BodyAttempt& attempt = scratch_.bodies[index];
+            skip[index] = 1;  // done, unless it retries
+            if (!attempt.failed) continue;
+            if (base * factor > 1) restore_step_start(index);
+            if (!may_retry_in(slots_[index].stepped->settings, 2 * factor)) continue;  // final: reported by step()
+            if (base * factor == 1) save_step_start(index);
+            attempt.failed = false;
+            skip[index] = 0;
             retry = true;
         }
         if (!retry) return;
@@ -452,24 +391,30 @@ bool World::sub_steps_on_failure(const StepSettings& s) {
 
 int32_t World::retry_limit(const StepSettings& s) { return sub_steps_on_failure(s) ? s.implicit.max_substeps : 1; }
 
-// substeps equal sub-steps of the bodies not in skip_, each tool moving its share of the step
-// from its start pose, with contact detection before each.
+bool World::may_retry_in(const StepSettings& s, int32_t substeps) {
+    // Counted in sub-steps: a step of `substeps` units, none longer than one unit, needs
+    // exactly that many, which the body's cap may clamp.
+    return !substep_count(substeps, 1.0, retry_limit(s)).clamped;
+}
+
+// substeps equal sub-steps of the bodies not in scratch_.skip, each tool moving its share of
+// the step from its start pose, with contact detection before each.
 void World::run_substeps(double dt, int32_t substeps, sh_step_report& r) {
     const double h = dt / substeps;
-    vec<uint8_t>& skip = skip_;
+    vec<uint8_t>& skip = scratch_.skip;
     if (!has_contact()) {
         step_bodies(h, r, skip);
         return;
     }
-    for (ColliderSlot& c : colliders_)
-        if (c.collider && c.collider->is_tool) c.collider->pose = c.collider->start;
+    colliders_.for_each([](Collider* c) {
+        if (c->is_tool) c->pose = c->start;
+    });
     for (int32_t s = 0; s < substeps; ++s) {
         const double fraction = static_cast<double>(s + 1) / substeps;
-        for (ColliderSlot& c : colliders_) {
-            if (!c.collider) continue;
-            c.collider->previous = c.collider->pose;
-            if (c.collider->is_tool) c.collider->pose = interpolate(c.collider->start, c.collider->target, fraction);
-        }
+        colliders_.for_each([&](Collider* c) {
+            c->previous = c->pose;
+            if (c->is_tool) c->pose = interpolate(c->start, c->target, fraction);
+        });
         {
             const ScopedTimer timer(r.collision_seconds);
             r.warnings |= detect_contacts(h, 1.0 / substeps, 0.0);
@@ -479,9 +424,8 @@ void World::run_substeps(double dt, int32_t substeps, sh_step_report& r) {
 }
 
 void World::add_energies(sh_step_report& r) const {
-    for (const Slot& slot : slots_) {
+    slots_.for_each([&](const Slot& slot) {
         const Body* body = slot.body();
-        if (!body) continue;
         for (int32_t i = 0; i < body->node_count(); ++i) {
             const double m = body->mass[static_cast<size_t>(i)];
             const double* v = &body->v[3 * static_cast<size_t>(i)];
@@ -490,37 +434,34 @@ void World::add_energies(sh_step_report& r) const {
             r.potential_energy -= m * (gravity[0] * x[0] + gravity[1] * x[1] + gravity[2] * x[2]);
         }
         r.elastic_energy += body->elastic_energy(body->x.data());
-    }
+    });
 }
 
 void World::solve_static(const sh_static_def& def, sh_static_report* report) {
     const double start = now_seconds();
     sh_static_report r{};
-    for (Slot& slot : slots_)
-        if (slot.body()) save_start_state(*slot.stepped);
+    slots_.for_each([](Slot& slot) { save_start_state(*slot.stepped); });
     for (StepHook* hook : hooks_) hook->before_step(*this);
     try {
         if (has_contact()) {
             // Tools rest at their host-set poses; candidates reach as far as the tool's size,
             // since the solve may move the surface that far.
-            for (ColliderSlot& c : colliders_) {
-                if (!c.collider) continue;
-                c.collider->start = c.collider->pose = c.collider->previous = c.collider->target;
-                c.collider->velocity_given = false;
-                for (int k = 0; k < 3; ++k) c.collider->velocity[k] = c.collider->angular[k] = 0.0;
-            }
-            for (Slot& slot : slots_)
-                if (slot.body()) std::fill(slot.body()->v.begin(), slot.body()->v.end(), 0.0);
+            colliders_.for_each([](Collider* c) {
+                c->start = c->pose = c->previous = c->target;
+                c->velocity_given = false;
+                for (int k = 0; k < 3; ++k) c->velocity[k] = c->angular[k] = 0.0;
+            });
+            slots_.for_each([](Slot& slot) { std::fill(slot.body()->v.begin(), slot.body()->v.end(), 0.0); });
         }
         double reach = 0.0, extent = 0.0;
-        for (const ColliderSlot& c : colliders_)
-            if (c.collider && !c.collider->shape.is_half_space()) reach = std::max(reach, c.collider->shape.inner_radius());
-        for (const Slot& slot : slots_) {
-            if (!slot.body()) continue;
+        colliders_.for_each([&](const Collider* c) {
+            if (!c->shape.is_half_space()) reach = std::max(reach, c->shape.inner_radius());
+        });
+        slots_.for_each([&](const Slot& slot) {
             Aabb box;
             for (size_t j = 0; j < slot.body()->x.size(); j += 3) box.add(&slot.body()->x[j]);
             for (int k = 0; k < 3; ++k) extent = std::max(extent, box.hi[k] - box.lo[k]);
-        }
+        });
         reach = std::max(reach, 0.05 * extent);
         // Bodies pressing on each other are solved together, for their joint equilibrium.
         if (has_contact()) detect_contacts(0.0, 0.0, reach);  // h = 0: the contact law at rest
@@ -531,11 +472,10 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
         if (coupled) solve_static_islands(def, r);
         if (has_contact()) finish_contacts();
     } catch (...) {
-        for (Slot& slot : slots_)
-            if (slot.body()) {
-                slot.body()->field = nullptr;
-                restore_start_state(*slot.stepped);
-            }
+        slots_.for_each([](Slot& slot) {
+            slot.body()->field = nullptr;
+            restore_start_state(*slot.stepped);
+        });
         r.wall_seconds = now_seconds() - start;
         if (report) *report = r;  // what was tried, for the host's diagnosis
         throw;
@@ -545,10 +485,6 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
     for (StepHook* hook : hooks_) hook->after_step(*this, 0.0);
     r.wall_seconds = now_seconds() - start;
     if (report) *report = r;
-}
-
-sh_body_id World::id_of(size_t index) const {
-    return (static_cast<uint64_t>(slots_[index].generation) << 32) | (static_cast<uint64_t>(index) + 1);
 }
 
 }  // namespace sh

@@ -1,11 +1,13 @@
 // World: owns bodies behind generation-checked ids and steps them.
 #pragma once
 
+#include "core/id_pool.hpp"
 #include "core/memory.hpp"
 #include "model/body.hpp"
 #include "solver/explicit_integrator.hpp"
 #include "solver/stepped_body.hpp"
 #include "world/step_hook.hpp"
+#include "world/step_scratch.hpp"
 
 #include <softhap/softhap.h>
 
@@ -17,10 +19,11 @@ class BodyContacts;
 struct TetMesh;
 class ContactIslands;
 struct Collider;
-struct ImplicitState;
+struct NewtonBodyState;
 struct StepDoubling;
 
-/// The simulation world of the C API's sh_world.
+/// The simulation world of the C API's sh_world. Bodies, tools and obstacles are named by
+/// generation-checked Ids (core/id_pool.hpp), the values the C API's id types carry.
 class World {
 public:
     explicit World(const sh_world_def& def);
@@ -30,44 +33,44 @@ public:
 
     /// Takes ownership of body (made with sh::create), to be stepped with settings; returns
     /// its new id.
-    sh_body_id add_body(Body* body, const StepSettings& settings);
+    Id add_body(Body* body, const StepSettings& settings);
 
     /// Adds an FEM body made from mesh with one material (see FemBody), stepped with settings;
     /// counts SH_WARN_LOCKING if the material locks linear tets. Returns its id.
-    sh_body_id add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
-                            double damping_stiffness, const StepSettings& settings);
+    Id add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
+                    double damping_stiffness, const StepSettings& settings);
 
     /// Gives elements[0..count) of FEM body id material (SH_ERR_UNSUPPORTED for a spring body);
     /// counts SH_WARN_LOCKING if it locks linear tets.
-    void set_material(sh_body_id id, const int32_t* elements, int32_t count, const sh_material& material);
+    void set_material(Id id, const int32_t* elements, int32_t count, const sh_material& material);
 
     /// How body id is stepped; throws SH_ERR_INVALID_HANDLE like body().
-    const StepSettings& step_settings(sh_body_id id) const;
+    const StepSettings& step_settings(Id id) const;
 
     /// Destroys the body; its id becomes stale. Throws SH_ERR_INVALID_HANDLE if not live.
-    void remove_body(sh_body_id id);
+    void remove_body(Id id);
 
     /// True if id names a live body of this world.
-    bool is_valid(sh_body_id id) const;
+    bool is_valid(Id id) const;
 
     /// The body named by id; throws SH_ERR_INVALID_HANDLE if the id is null, stale or foreign.
-    Body& body(sh_body_id id) const;
+    Body& body(Id id) const;
 
     /// Adds a tool (is_tool) or an obstacle made from def; returns its id.
-    uint64_t add_collider(const sh_collider_def& def, bool is_tool);
+    Id add_collider(const sh_collider_def& def, bool is_tool);
 
     /// Destroys a tool or obstacle; throws SH_ERR_INVALID_HANDLE if id is not a live one of
     /// that kind.
-    void remove_collider(uint64_t id, bool is_tool);
+    void remove_collider(Id id, bool is_tool);
 
     /// True if id names a live tool (is_tool) or obstacle of this world.
-    bool is_valid_collider(uint64_t id, bool is_tool) const;
+    bool is_valid_collider(Id id, bool is_tool) const;
 
     /// The tool or obstacle named by id; throws SH_ERR_INVALID_HANDLE otherwise.
-    Collider& collider(uint64_t id, bool is_tool) const;
+    Collider& collider(Id id, bool is_tool) const;
 
     /// Enables contact between bodies a and b with params, or disables it for null.
-    void set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params* params);
+    void set_body_contact(Id a, Id b, const sh_contact_params* params);
 
     /// Steps every body by dt; fills report if not null. Throws SH_ERR_UNSTABLE (after
     /// filling report and advancing the stable bodies) if any body was rejected or rolled back.
@@ -85,58 +88,59 @@ public:
     void remove_hook(StepHook* hook);
 
     /// The contact state of body id after the last step, or null if it has none yet.
-    const BodyContacts* contacts_of(sh_body_id id) const;
+    const BodyContacts* contacts_of(Id id) const;
 
     /// Calls visit(id, body) for every live body.
     template <class Visit>
     void for_each_body(Visit&& visit) const {
         for (size_t index = 0; index < slots_.size(); ++index)
-            if (slots_[index].body()) visit(id_of(index), *slots_[index].body());
+            if (slots_[index].body()) visit(slots_.id_at(index), *slots_[index].body());
     }
 
-    double gravity[3];
-    uint64_t warnings[SH_WARN_COUNT] = {};
+    double gravity[3];                       ///< m/s^2, on every body
+    uint64_t warnings[SH_WARN_COUNT] = {};   ///< per kind: how often it was raised (sh_world_get_warnings)
 
 private:
+    /// What a body slot owns (all null while free). Its step scratch is in scratch_.
     struct Slot {
         SteppedBody* stepped = nullptr;     ///< the body with its step settings and scratch;
                                             ///< null for a free slot
+        /// The body, or null for a free slot.
         Body* body() const { return stepped ? stepped->body : nullptr; }
         StepDoubling* doubling = nullptr;   ///< with error_estimate_ only
         BodyContacts* contacts = nullptr;   ///< built on the first step with contact
-        vec<double> saved;                  ///< x then v at the step's start, for attempts
-                                            ///< of more than one sub-step
-        BodyStepResult failure;             ///< why the body's last attempt failed
-        bool failed = false;                ///< its last attempt in this step failed
-        bool keep_best = false;             ///< this attempt is its last: keep the best iterate
-        uint32_t generation = 0;
+        /// This attempt is its last: keep the best iterate. Attempt scratch, kept here because
+        /// step_islands (contact_islands.cpp) reads it from the slot.
+        bool keep_best = false;
     };
-    struct ColliderSlot {
-        Collider* collider = nullptr;
-        uint32_t generation = 0;
-    };
+    /// Two bodies in contact with each other, with their contact law.
     struct BodyPair {
-        sh_body_id a, b;
+        Id a, b;
         sh_contact_params params;
         bool has_candidates = false;  ///< the last detection found candidates between them
     };
+    /// Destroys what slot owns and leaves it empty.
     void destroy_slot(Slot& slot);
-    bool has_contact() const { return collider_count_ > 0 || !pairs_.empty(); }
+    /// True if any tool, obstacle or body pair may touch: the step then detects contact.
+    bool has_contact() const { return colliders_.live_count() > 0 || !pairs_.empty(); }
     /// Starts every collider's step of dt; returns the contact sub-steps it needs.
     int32_t begin_colliders(double dt);
-    /// Saves slot's body's x and v (the step's start) in slot.saved.
-    void save_step_start(Slot& slot);
-    /// Puts slot's body back to the step's start.
-    void restore_step_start(Slot& slot);
+    /// Saves body slot index's x and v (the step's start) in its attempt scratch.
+    void save_step_start(size_t index);
+    /// Puts body slot index back to the step's start.
+    void restore_step_start(size_t index);
     /// Runs the step's attempts (see world.cpp).
     void run_attempts(double dt, sh_step_report& r);
     /// True if a failed step of a body stepped with s is retried in sub-steps and its last
     /// attempt keeps its best iterate (an implicit body with policy SH_UNSTABLE_SUBSTEP).
     static bool sub_steps_on_failure(const StepSettings& s);
     /// How many sub-steps (times the contact sub-steps) a step of a body stepped with s may be
-    /// retried in.
+    /// retried in: the cap of its substep_count.
     static int32_t retry_limit(const StepSettings& s);
-    /// Steps the bodies not in skip_ through substeps equal sub-steps of dt.
+    /// True if a body stepped with s may retry its step in substeps sub-steps (times the
+    /// contact sub-steps): that many are within its retry_limit.
+    static bool may_retry_in(const StepSettings& s, int32_t substeps);
+    /// Steps the bodies not in scratch_.skip through substeps equal sub-steps of dt.
     void run_substeps(double dt, int32_t substeps, sh_step_report& r);
     /// Steps every body not in skip by h, adding to r; a body that fails joins skip.
     void step_bodies(double h, sh_step_report& r, vec<uint8_t>& skip);
@@ -157,17 +161,17 @@ private:
     uint32_t detect_contacts(double h, double travel_fraction, double extra_reach);
     /// Contact forces at the end state into every collider's state; detaches the fields.
     int32_t finish_contacts();
-    int32_t collider_count_ = 0;
-    vec<ColliderSlot> colliders_;
-    vec<uint32_t> free_colliders_;
-    vec<BodyPair> pairs_;
-    vec<uint8_t> skip_;  ///< per slot: sits out the current attempt
+    /// Tools and obstacles in one pool (Collider::is_tool tells them apart, so a tool's id
+    /// never names an obstacle): detection visits them in slot order, as they were added.
+    IdPool<Collider*> colliders_;
+    vec<BodyPair> pairs_;                ///< body pairs with contact enabled
     ContactIslands* islands_ = nullptr;  ///< built on the first step with body pairs
-    vec<StepHook*> hooks_;
-    bool error_estimate_ = false;
-    sh_body_id id_of(size_t index) const;
-    vec<Slot> slots_;
-    vec<uint32_t> free_slots_;
+    vec<StepHook*> hooks_;               ///< told before and after each step
+    bool error_estimate_ = false;        ///< bodies take half steps for sh_step_report's estimate
+    /// The id of live body slot index.
+    Id id_of(size_t index) const { return slots_.id_at(index); }
+    IdPool<Slot> slots_;                 ///< the bodies
+    StepScratch scratch_;                ///< the step's scratch, indexed like slots_
 };
 
 }  // namespace sh

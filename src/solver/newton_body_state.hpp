@@ -1,0 +1,39 @@
+// NewtonBodyState: what one body keeps from one Newton solve to the next (implicit steps, static
+// solves): which of its nodes are free and in what order (its free-node index map), and its own
+// matrix over their DOFs, assembled from its elements, its field and its mass. A body solved
+// alone factorises that matrix; a body solved together with others (NewtonProblem::prepare) has
+// it assembled and then added into their joint matrix.
+#pragma once
+
+#include "core/memory.hpp"
+#include "model/body.hpp"
+#include "solver/newton_matrix.hpp"
+
+#include <softhap/softhap.h>
+
+#include <cstdint>
+
+namespace sh {
+
+/// Per-body data of the Newton solves, built on first use and kept across steps while the
+/// body's free nodes stay the same.
+struct NewtonBodyState {
+    vec<int32_t> free_index;  ///< per node: its index among the body's free nodes, or -1
+    int32_t free_count = -1;  ///< free nodes of the body; -1: not prepared yet
+    NewtonMatrix matrix;      ///< the body's own matrix over its free DOFs (3 per free node)
+    vec<double> diagonal;     ///< per free DOF: the diagonal added to the tangent (scratch)
+
+    /// Rebuilds free_index and the matrix's pattern (and, with own_solver, its solver and
+    /// symbolic analysis) if body's free nodes changed since the last call; makes the solver if
+    /// own_solver and there is none yet. Returns the number of free DOFs.
+    int32_t prepare(const Body& body, const sh_implicit_settings& settings, bool own_solver = true);
+
+    /// Clears the matrix and adds stiffness_scale K + damping_scale D of body at (body.x, v)
+    /// (v null: at rest) from its elements and its field, then add_diagonal (per free DOF) if
+    /// not null. Returns the round-off of the body's forces: force_roundoff of the matrix
+    /// before the diagonal, with roundoff_scale.
+    double assemble_tangent(const Body& body, double stiffness_scale, double damping_scale, const double* v,
+                            const double* add_diagonal, double roundoff_scale);
+};
+
+}  // namespace sh

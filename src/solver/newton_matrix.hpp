@@ -1,0 +1,51 @@
+// NewtonMatrix: the linear system a Newton solve assembles and factorises — the sparse matrix
+// over the solve's free DOFs, the linear solver analysed for its pattern, the factorisation a
+// direct solver may keep across iterations and steps, and the scratch vectors of the solve (one
+// value per DOF of the matrix).
+#pragma once
+
+#include "core/memory.hpp"
+#include "linalg/linear_solver.hpp"
+#include "linalg/sparse_system.hpp"
+
+#include <softhap/softhap.h>
+
+#include <cstdint>
+
+namespace sh {
+
+/// What is known of the factorisation a direct solver holds, kept across Newton iterations and
+/// steps while it may serve (a chord/lagged Newton method): it is of M + h D + h^2 K(x_f) for
+/// one step size and one matrix version of the bodies, at some earlier iterate x_f.
+struct KeptFactorisation {
+    bool valid = false;           ///< the solver holds a factorisation that may be reused
+    double dt = 0.0;              ///< the step size it was made for (s)
+    uint64_t matrix_version = 0;  ///< the bodies' matrix version it was made for
+    double roundoff_floor = 0.0;  ///< the residual's round-off level at the factorised iterate
+};
+
+/// The sparse linear system of a Newton solve and what solving it needs.
+struct NewtonMatrix {
+    SparseSystem system;     ///< the matrix: pattern and values over the solve's free DOFs
+    LinearSolverPtr solver;  ///< analysed for system's pattern (null: not made yet, or not needed)
+    vec<double> residual;    ///< per DOF: the residual (gradient) at the current iterate
+    vec<double> delta;       ///< per DOF: the Newton update (CG's warm start)
+    vec<double> previous_v;  ///< per DOF: velocities before a trial update (the line search's start)
+    KeptFactorisation kept;  ///< the factorisation the solver may be holding
+
+    /// Takes pattern as the matrix and solver (analysed for it, or null) as its solver, sizes
+    /// the scratch vectors for its DOFs (delta zeroed) and forgets any kept factorisation.
+    /// Allocates before it changes anything: if that throws, the matrix is as it was.
+    void reset(SparseSystem&& pattern, LinearSolverPtr solver);
+};
+
+/// The linear solver settings name (DEFAULT: CHOLMOD when built in, else LDL^T), made and
+/// analysed for system.
+LinearSolverPtr make_analysed_solver(const SparseSystem& system, const sh_implicit_settings& settings);
+
+/// Round-off level of internal forces computed at positions x: they come from position
+/// differences that carry about eps |x|, which a stiffness turns into eps |x| K_dd per DOF.
+/// system holds K / scale (its diagonal times scale is K_dd); the result is in force units.
+double force_roundoff(const SparseSystem& system, const vec<double>& x, double scale);
+
+}  // namespace sh

@@ -215,7 +215,7 @@ static void bar_build(bar_t* b, int ny) {
     sh_mesh_info info;
     CHECK(sh_mesh_get_info(b->mesh, &info));
     int32_t* tris = (int32_t*)xcalloc(3 * (size_t)info.surface_triangle_count, sizeof(int32_t));
-    CHECK(sh_mesh_get_surface_triangles(b->mesh, tris, 3 * (int64_t)info.surface_triangle_count));
+    CHECK(sh_mesh_get_surface_triangles(b->mesh, tris, info.surface_triangle_count));
     b->tip_weight = (double*)xcalloc((size_t)b->node_count, sizeof(double));
     const double tip = kLength - 1e-12;
     double area_sum = 0.0;
@@ -279,8 +279,8 @@ static sh_body_id add_bar(sh_world* world, const bar_t* b, sh_material_model mod
         def.implicit.newton_max_iterations = method->newton > 0 ? method->newton : 1;
         def.implicit.newton_tolerance = kNewtonTolerance;
     }
-    sh_body_id body = SH_NULL_BODY;
-    CHECK(sh_world_add_fem_body(world, &def, &body));
+    sh_body_id body = SH_NULL_ID;
+    CHECK(sh_fem_body_create(world, &def, &body));
     CHECK(sh_body_fix_nodes(world, body, b->fixed, b->fixed_count));
     return body;
 }
@@ -347,7 +347,7 @@ static void run_dynamic(const bar_t* b, sh_material_model model, const method_t*
     r->substep_warnings = warnings[SH_WARN_SUBSTEPPED];
     r->inverted_warnings = warnings[SH_WARN_INVERTED];
     r->x = (double*)xcalloc(3 * (size_t)b->node_count, sizeof(double));
-    CHECK(sh_body_get_positions(world, body, r->x, 3 * (int64_t)b->node_count));
+    CHECK(sh_body_get_positions(world, body, r->x, b->node_count));
     CHECK(sh_world_destroy(world));
 }
 
@@ -492,7 +492,7 @@ static void job_static_eb(FILE* out, int ny) {
         const sh_status st = sh_world_solve_static(world, &sd, &rep);
         const double wall = now_s() - t0;
         const double cpu = cpu_s() - c0;
-        CHECK(sh_body_get_positions(world, body, x, 3 * (int64_t)b.node_count));
+        CHECK(sh_body_get_positions(world, body, x, b.node_count));
         const double w = -tip_displacement(&b, x, 2);
         /* Timoshenko: add the shear deflection F L / (kappa G A), Cowper's kappa for a square. */
         const double shear = 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu);
@@ -534,7 +534,7 @@ static void job_static_nonlinear(FILE* out, int ny) {
         sh_static_def_default(&sd);
         sd.tolerance = kStaticTolerance;
         CHECK(sh_world_solve_static(world, &sd, NULL));
-        CHECK(sh_body_get_positions(world, body, x, 3 * (int64_t)b.node_count));
+        CHECK(sh_body_get_positions(world, body, x, b.node_count));
         compliance = -tip_displacement(&b, x, 2);
         CHECK(sh_world_destroy(world));
     }
@@ -565,7 +565,7 @@ static void job_static_nonlinear(FILE* out, int ny) {
             }
             const double wall = now_s() - t0;
             const double cpu = cpu_s() - c0;
-            CHECK(sh_body_get_positions(world, body, x, 3 * (int64_t)b.node_count));
+            CHECK(sh_body_get_positions(world, body, x, b.node_count));
             const double w = -tip_displacement(&b, x, 2);
             fprintf(out, "{\"study\":\"static_nonlinear\"");
             mesh_fields(out, &b);
@@ -621,8 +621,8 @@ static void job_oscillator(FILE* out) {
             def.damping_mass = 0.0;
             def.implicit.newton_max_iterations = method->newton > 0 ? method->newton : 1;
             def.implicit.newton_tolerance = kNewtonTolerance;
-            sh_body_id body = SH_NULL_BODY;
-            CHECK(sh_world_add_spring_body(world, &def, &body));
+            sh_body_id body = SH_NULL_ID;
+            CHECK(sh_spring_body_create(world, &def, &body));
             const int32_t fixed = 0;
             CHECK(sh_body_fix_nodes(world, body, &fixed, 1));
             const double start[6] = {0.0, 0.0, 0.0, kOscRest + kOscAmplitude, 0.0, 0.0};
@@ -640,8 +640,8 @@ static void job_oscillator(FILE* out) {
             const double wall = now_s() - t0;
             const double cpu = cpu_s() - c0;
             double x[6], v[6];
-            CHECK(sh_body_get_positions(world, body, x, 6));
-            CHECK(sh_body_get_velocities(world, body, v, 6));
+            CHECK(sh_body_get_positions(world, body, x, 2));
+            CHECK(sh_body_get_velocities(world, body, v, 2));
             const double dx = x[3] - kOscRest - exact_x, dv = (v[3] - exact_v) / omega;
             fprintf(out, "{\"study\":\"oscillator\",\"method\":\"%s\",\"steps\":%d", method->name, steps);
             jnum(out, "dt", dt);

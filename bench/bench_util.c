@@ -117,8 +117,8 @@ int bench_load_scaled_mesh(const char* dir, const char* file, const double* turn
     const int32_t n = info.node_count, t = info.tet_count;
     double* nodes = (double*)xmalloc(sizeof(double) * 3 * (size_t)n);
     int32_t* tets = (int32_t*)xmalloc(sizeof(int32_t) * 4 * (size_t)t);
-    CHECK(sh_mesh_get_nodes(raw, nodes, 3 * (int64_t)n));
-    CHECK(sh_mesh_get_tets(raw, tets, 4 * (int64_t)t));
+    CHECK(sh_mesh_get_nodes(raw, nodes, n));
+    CHECK(sh_mesh_get_tets(raw, tets, t));
     CHECK(sh_mesh_destroy(raw));
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {

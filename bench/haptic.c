@@ -247,7 +247,7 @@ static void tissue_finish(tissue* t, double base_height) {
     t->tet_count = info.tet_count;
     t->tri_count = info.surface_triangle_count;
     t->tris = (int32_t*)xmalloc(sizeof(int32_t) * 3 * (size_t)t->tri_count);
-    CHECK(sh_mesh_get_surface_triangles(t->mesh, t->tris, 3 * (int64_t)t->tri_count));
+    CHECK(sh_mesh_get_surface_triangles(t->mesh, t->tris, t->tri_count));
     t->fixed = (int32_t*)xmalloc(sizeof(int32_t) * (size_t)t->node_count);
     t->fixed_count = 0;
     for (int32_t i = 0; i < t->node_count; ++i)
@@ -414,7 +414,7 @@ static scene scene_create(const tissue* t, sh_material_model model, sh_integrato
     def.material.density = kDensity;
     def.integrator = integrator;
     def.damping_mass = damping;
-    CHECK(sh_world_add_fem_body(s.world, &def, &s.body));
+    CHECK(sh_fem_body_create(s.world, &def, &s.body));
     CHECK(sh_body_fix_nodes(s.world, s.body, t->fixed, t->fixed_count));
     sh_collider_def tool;
     sh_collider_def_default(&tool);

@@ -137,8 +137,8 @@ static int load_liver(const char* dir, liver* l) {
     l->tet_count = info.tet_count;
     double* x = (double*)xmalloc(sizeof(double) * 3 * (size_t)info.node_count);
     int32_t* tris = (int32_t*)xmalloc(sizeof(int32_t) * 3 * (size_t)info.surface_triangle_count);
-    CHECK(sh_mesh_get_nodes(l->mesh, x, 3 * (int64_t)info.node_count));
-    CHECK(sh_mesh_get_surface_triangles(l->mesh, tris, 3 * (int64_t)info.surface_triangle_count));
+    CHECK(sh_mesh_get_nodes(l->mesh, x, info.node_count));
+    CHECK(sh_mesh_get_surface_triangles(l->mesh, tris, info.surface_triangle_count));
     double base[3], centroid[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 1.0};
     fix_base(x, info.node_count, l, base);
     const int found = press_triangle(x, tris, info.surface_triangle_count, base, centroid, normal);
@@ -170,10 +170,13 @@ static sh_world* make_world(const liver* l, sh_material_model model, sh_tool_id*
     sh_fem_body_def def;
     sh_fem_body_def_default(&def);
     def.mesh = l->mesh;
-    def.material = (sh_material){.model = model, .young = kYoung, .poisson = kPoisson, .density = kDensity};
+    def.material.model = model;
+    def.material.young = kYoung;
+    def.material.poisson = kPoisson;
+    def.material.density = kDensity;
     def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
     sh_body_id body;
-    CHECK(sh_world_add_fem_body(world, &def, &body));
+    CHECK(sh_fem_body_create(world, &def, &body));
     CHECK(sh_body_fix_nodes(world, body, l->fixed, l->fixed_count));
     sh_collider_def td;
     sh_collider_def_default(&td);

@@ -101,7 +101,7 @@ static int load_mesh_file(const char* file, const char* name, bench_mesh* m) {
 
     m->edge_count = m->info.edge_count;
     int32_t* edges = (int32_t*)xmalloc(sizeof(int32_t) * 2 * (size_t)m->edge_count);
-    CHECK(sh_mesh_get_edges(m->mesh, edges, 2 * (int64_t)m->edge_count));
+    CHECK(sh_mesh_get_edges(m->mesh, edges, m->edge_count));
     double sum = 0.0;
     for (int32_t e = 0; e < m->edge_count; ++e) {
         const double* a = &nodes[3 * edges[2 * e]];
@@ -140,7 +140,7 @@ static const body_kind kKinds[] = {{"linear", SH_MATERIAL_LINEAR},
 
 static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_integrator integrator,
                            const sh_implicit_settings* implicit) {
-    sh_body_id body = SH_NULL_BODY;
+    sh_body_id body = SH_NULL_ID;
     if (model >= 0) {
         sh_fem_body_def def;
         sh_fem_body_def_default(&def);
@@ -151,7 +151,7 @@ static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_i
         def.material.density = kDensity;
         def.integrator = integrator;
         if (implicit) def.implicit = *implicit;
-        CHECK(sh_world_add_fem_body(world, &def, &body));
+        CHECK(sh_fem_body_create(world, &def, &body));
     } else {
         /* A rod of section l^2 and length l has axial stiffness E l; nodes share the mass. */
         sh_spring_body_def def;
@@ -162,7 +162,7 @@ static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_i
         def.node_mass = kDensity * m->info.volume / (m->info.node_count - m->info.orphan_node_count);
         def.integrator = integrator;
         if (implicit) def.implicit = *implicit;
-        CHECK(sh_world_add_spring_body(world, &def, &body));
+        CHECK(sh_spring_body_create(world, &def, &body));
     }
     CHECK(sh_body_fix_nodes(world, body, m->fixed, m->fixed_count));
     return body;
@@ -454,10 +454,10 @@ static void run_contact_world(const bench_mesh* m, int colliders, int steps, con
     def.integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
     def.on_unstable = SH_UNSTABLE_SUBSTEP;
     sh_body_id body;
-    CHECK(sh_world_add_fem_body(world, &def, &body));
+    CHECK(sh_fem_body_create(world, &def, &body));
     r->dt = kDtFraction * body_dt_crit(world, body);
 
-    sh_tool_id tool = 0;
+    sh_tool_id tool = SH_NULL_ID;
     sh_collider_def tool_def;
     sh_collider_def_default(&tool_def);
     if (colliders) {
@@ -475,7 +475,7 @@ static void run_contact_world(const bench_mesh* m, int colliders, int steps, con
         /* The highest surface node. */
         const int32_t tri_count = m->info.surface_triangle_count;
         int32_t* tris = (int32_t*)xmalloc(sizeof(int32_t) * 3 * (size_t)tri_count);
-        CHECK(sh_mesh_get_surface_triangles(m->mesh, tris, 3 * (int64_t)tri_count));
+        CHECK(sh_mesh_get_surface_triangles(m->mesh, tris, tri_count));
         int32_t top = tris[0];
         for (int32_t i = 1; i < 3 * tri_count; ++i)
             if (m->rest[3 * tris[i] + 2] > m->rest[3 * top + 2]) top = tris[i];

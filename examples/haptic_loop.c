@@ -417,7 +417,7 @@ static int run_at(liver_scene* scene, const liver_path* path, double rate, int d
     run* r = calloc(1, sizeof *r);
     sh_collider_def tool_def;
     sh_haptic_def haptic_def;
-    sh_tool_id tool = 0;
+    sh_tool_id tool = SH_NULL_ID;
     pthread_t device, sim;
     double along, below;
     int ok = 0;
@@ -497,7 +497,7 @@ static int run_at(liver_scene* scene, const liver_path* path, double rate, int d
 
 done:
     sh_haptic_destroy(r->haptic); /* NULL is fine */
-    if (tool) sh_tool_destroy(scene->world, tool);
+    if (!SH_ID_IS_NULL(tool)) sh_tool_destroy(scene->world, tool);
     free(r->lateness);
     free(r->step_time);
     free(r->rows);

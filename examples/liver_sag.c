@@ -111,8 +111,8 @@ int main(int argc, char** argv) {
         fprintf(stderr, "liver_sag: out of memory\n");
         goto done;
     }
-    CHECK(sh_mesh_get_nodes(file_mesh, nodes, 3 * (int64_t)node_count));
-    CHECK(sh_mesh_get_tets(file_mesh, tets, 4 * (int64_t)info.tet_count));
+    CHECK(sh_mesh_get_nodes(file_mesh, nodes, node_count));
+    CHECK(sh_mesh_get_tets(file_mesh, tets, info.tet_count));
     for (i = 0; i < 3 * node_count; ++i) nodes[i] *= kCentimetre;
     CHECK(sh_mesh_create(nodes, node_count, tets, info.tet_count, &mesh));
     CHECK(sh_mesh_get_info(mesh, &info));
@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
     def.damping_mass = 6.0;       /* 1/s: the first mode rings for a few cycles, then settles */
     def.integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
     def.on_unstable = SH_UNSTABLE_SUBSTEP;
-    CHECK(sh_world_add_fem_body(world, &def, &body));
+    CHECK(sh_fem_body_create(world, &def, &body));
 
     /* 3. Clamp the side with the smallest x. */
     for (i = 0; i < node_count; ++i) {
@@ -145,7 +145,7 @@ int main(int argc, char** argv) {
     for (i = 0; i < fixed_count; ++i) fixed[i] = keys[i].index;
     CHECK(sh_body_fix_nodes(world, body, fixed, fixed_count));
     CHECK(sh_body_get_info(world, body, &body_info));
-    CHECK(sh_body_get_positions(world, body, rest, 3 * (int64_t)node_count));
+    CHECK(sh_body_get_positions(world, body, rest, node_count));
     printf("liver_sag: mass %.1f g, %d nodes fixed (x <= %.2f cm), dt %.1f ms, dt_crit %.3f ms "
            "(about %d sub-steps per step)\n",
            body_info.total_mass * 1e3, body_info.fixed_node_count, keys[fixed_count - 1].x / kCentimetre,
@@ -184,7 +184,7 @@ int main(int argc, char** argv) {
         {
             double sag = 0.0;
             char name[64];
-            CHECK(sh_body_get_positions(world, body, x, 3 * (int64_t)node_count));
+            CHECK(sh_body_get_positions(world, body, x, node_count));
             for (i = 0; i < node_count; ++i)
                 if (rest[3 * i + 2] - x[3 * i + 2] > sag) sag = rest[3 * i + 2] - x[3 * i + 2];
             if (step == 0) {

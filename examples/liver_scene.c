@@ -154,8 +154,8 @@ int liver_scene_create(const liver_scene_def* def, liver_scene* out) {
         fprintf(stderr, "%s: out of memory\n", def->program);
         goto done;
     }
-    CHECK(sh_mesh_get_nodes(file_mesh, out->x, 3 * (int64_t)info.node_count));
-    CHECK(sh_mesh_get_tets(file_mesh, tets, 4 * (int64_t)info.tet_count));
+    CHECK(sh_mesh_get_nodes(file_mesh, out->x, info.node_count));
+    CHECK(sh_mesh_get_tets(file_mesh, tets, info.tet_count));
     for (i = 0; i < info.node_count; ++i) {
         const double y = out->x[3 * i + 1], z = out->x[3 * i + 2];
         out->x[3 * i + 1] = z;
@@ -172,7 +172,7 @@ int liver_scene_create(const liver_scene_def* def, liver_scene* out) {
     CHECK(sh_mesh_transform(turned, scale, translation, &out->mesh));
     CHECK(sh_mesh_get_info(out->mesh, &info));
     out->triangle_count = info.surface_triangle_count;
-    CHECK(sh_mesh_get_surface_triangles(out->mesh, out->triangles, 3 * (int64_t)out->triangle_count));
+    CHECK(sh_mesh_get_surface_triangles(out->mesh, out->triangles, out->triangle_count));
     fprintf(stderr, "%s: %s: %d nodes, %d tets, %d surface triangles, scaled by %.4g to "
             "%.1f x %.1f x %.1f cm\n", def->program, def->mesh_path, out->node_count, info.tet_count,
             out->triangle_count, scale, (info.bounds_max[0] - info.bounds_min[0]) * 100,
@@ -190,7 +190,7 @@ int liver_scene_create(const liver_scene_def* def, liver_scene* out) {
     body_def.integrator = def->integrator;
     body_def.on_unstable = SH_UNSTABLE_SUBSTEP;
     body_def.damping_mass = 2.0;        /* 1/s */
-    CHECK(sh_world_add_fem_body(out->world, &body_def, &out->body));
+    CHECK(sh_fem_body_create(out->world, &body_def, &out->body));
     CHECK(sh_body_get_info(out->world, out->body, &body_info));
     out->total_mass = body_info.total_mass;
     out->dt_critical = body_info.dt_critical;
@@ -215,7 +215,7 @@ int liver_scene_create(const liver_scene_def* def, liver_scene* out) {
             table_state.max_depth * 1e3);
     CHECK(sh_obstacle_destroy(out->world, table));
     CHECK(add_table(out->world, def->table_friction, &out->table));
-    CHECK(sh_body_get_positions(out->world, out->body, out->x, 3 * (int64_t)out->node_count));
+    CHECK(sh_body_get_positions(out->world, out->body, out->x, out->node_count));
     if (def->base_height > 0.0) {
         int32_t count = 0;
         base = malloc(sizeof(int32_t) * (size_t)out->node_count);

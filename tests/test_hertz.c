@@ -139,7 +139,7 @@ static sh_body_id add_block_body(sh_world* world, const block_mesh* b) {
     def.material.young = YOUNG;
     def.material.poisson = POISSON;
     sh_body_id body;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_fem_body_create(world, &def, &body));
     return body;
 }
 
@@ -235,7 +235,7 @@ static void apply_k(exact_solver* s, const double* v, double* out) {
     const double scale = 1e-3 / vmax;
     for (int i = 0; i < n3; ++i) s->x[i] = s->mesh->nodes[i] + scale * v[i];
     assert_ok(sh_body_set_positions(s->world, s->body, s->x, s->n));
-    assert_ok(sh_body_get_elastic_forces(s->world, s->body, s->force, n3));
+    assert_ok(sh_body_get_elastic_forces(s->world, s->body, s->force, n3 / 3));
     for (int i = 0; i < n3; ++i) out[i] = -(s->force[i] - s->f0[i]) / scale;
     ++s->matvecs;
 }
@@ -286,7 +286,7 @@ static exact_solver make_exact_solver(const block_mesh* mesh) {
     s.normal = malloc(sizeof(double) * 3 * s.candidate_count);
     s.gap = malloc(sizeof(double) * s.candidate_count);
     assert_ok(sh_body_set_positions(s.world, s.body, mesh->nodes, s.n));
-    assert_ok(sh_body_get_elastic_forces(s.world, s.body, s.f0, n3));
+    assert_ok(sh_body_get_elastic_forces(s.world, s.body, s.f0, n3 / 3));
     assemble_block_inverse(&s);
     return s;
 }
@@ -495,7 +495,7 @@ static void test_sphere_indentation(void** state) {
         assert_true(fabs(cs.force[0]) < 1e-3 * cs.force[2] && fabs(cs.force[1]) < 1e-3 * cs.force[2]);
         /* In equilibrium the fixed bottom carries what the sphere pushes: the elastic forces on
          * the free nodes balance the contact forces, and they sum to zero over all nodes. */
-        assert_ok(sh_body_get_elastic_forces(world, body, elastic, 3 * (int64_t)mesh.node_count));
+        assert_ok(sh_body_get_elastic_forces(world, body, elastic, mesh.node_count));
         double bottom_z = 0.0;
         for (int i = 0; i < bottom_count; ++i) bottom_z += elastic[3 * bottom[i] + 2];
         assert_close(-bottom_z / cs.force[2], 1.0, 1e-2);

@@ -52,7 +52,7 @@ int32_t ContactIslands::group(size_t slot_count) {
     return island_count();
 }
 
-CoupledSystem& ContactIslands::system(const sh_body_id* ids_, int32_t count) {
+CoupledSystem& ContactIslands::system(const uint64_t* ids_, int32_t count) {
     for (Kept& k : kept_)
         if (k.ids.size() == static_cast<size_t>(count) && std::equal(k.ids.begin(), k.ids.end(), ids_)) {
             k.used = true;

@@ -45,7 +45,7 @@ public:
 
     /// The coupled system kept for the bodies ids[0..count), made on first use. Those not
     /// asked for since the last drop_unused are destroyed by it.
-    CoupledSystem& system(const sh_body_id* ids, int32_t count);
+    CoupledSystem& system(const uint64_t* ids, int32_t count);
 
     /// Destroys the kept systems not asked for since the last call.
     void drop_unused();
@@ -55,11 +55,11 @@ public:
     // One island's members as the caller gathers them (scratch).
     vec<SteppedBody*> stepped;
     vec<StepDoubling*> doublings;
-    vec<sh_body_id> ids;
+    vec<uint64_t> ids;
 
 private:
     struct Kept {
-        vec<sh_body_id> ids;
+        vec<uint64_t> ids;
         CoupledSystem* system = nullptr;
         bool used = false;
     };

@@ -22,8 +22,8 @@
 namespace sh {
 namespace {
 
-uint32_t slot_of(sh_body_id id) { return static_cast<uint32_t>(id & 0xffffffffu) - 1u; }
-uint32_t generation_of(sh_body_id id) { return static_cast<uint32_t>(id >> 32); }
+uint32_t slot_of(uint64_t id) { return static_cast<uint32_t>(id & 0xffffffffu) - 1u; }
+uint32_t generation_of(uint64_t id) { return static_cast<uint32_t>(id >> 32); }
 
 // Generations come from one counter shared by all worlds, so an id is never valid in a world
 // other than the one that issued it.
@@ -66,7 +66,7 @@ void World::destroy_slot(Slot& slot) {
     slot.saved = vec<double>();
 }
 
-sh_body_id World::add_body(Body* body, const StepSettings& settings) {
+uint64_t World::add_body(Body* body, const StepSettings& settings) {
     uint32_t index;
     if (!free_slots_.empty()) {
         index = free_slots_.back();
@@ -108,41 +108,41 @@ sh_body_id World::add_body(Body* body, const StepSettings& settings) {
     return id_of(index);
 }
 
-bool World::is_valid(sh_body_id id) const {
-    if (id == SH_NULL_BODY) return false;
+bool World::is_valid(uint64_t id) const {
+    if (id == uint64_t{0}) return false;
     const uint32_t index = slot_of(id);
     return index < slots_.size() && slots_[index].body() && slots_[index].generation == generation_of(id);
 }
 
-Body& World::body(sh_body_id id) const {
+Body& World::body(uint64_t id) const {
     if (!is_valid(id))
         throw Error(SH_ERR_INVALID_HANDLE,
-                    id == SH_NULL_BODY ? std::string("body id is null (0)")
+                    id == uint64_t{0} ? std::string("body id is null (0)")
                                        : format("body id 0x%llx is not a live body of this world (removed or never created)",
                                                 static_cast<unsigned long long>(id)));
     return *slots_[slot_of(id)].body();
 }
 
-sh_body_id World::add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
+uint64_t World::add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
                                double damping_stiffness, const StepSettings& settings) {
-    const sh_body_id id = add_body(sh::create<FemBody>(mesh, material, damping_mass, damping_stiffness), settings);
+    const uint64_t id = add_body(sh::create<FemBody>(mesh, material, damping_mass, damping_stiffness), settings);
     if (locks_linear_tets(material)) ++warnings[SH_WARN_LOCKING];
     return id;
 }
 
-void World::set_material(sh_body_id id, const int32_t* elements, int32_t count, const sh_material& material) {
+void World::set_material(uint64_t id, const int32_t* elements, int32_t count, const sh_material& material) {
     Body& b = body(id);
     require(b.is_fem(), SH_ERR_UNSUPPORTED, "sh_body_set_material needs an FEM body; this is a mass-spring body");
     static_cast<FemBody&>(b).set_material(elements, count, material);
     if (locks_linear_tets(material) && count > 0) ++warnings[SH_WARN_LOCKING];
 }
 
-const StepSettings& World::step_settings(sh_body_id id) const {
+const StepSettings& World::step_settings(uint64_t id) const {
     body(id);  // validates
     return slots_[slot_of(id)].stepped->settings;
 }
 
-void World::remove_body(sh_body_id id) {
+void World::remove_body(uint64_t id) {
     body(id);  // validates
     const uint32_t index = slot_of(id);
     free_slots_.push_back(index);  // within the capacity reserved in add_body
@@ -198,7 +198,7 @@ void World::remove_collider(uint64_t id, bool is_tool) {
     --collider_count_;
 }
 
-void World::set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params* params) {
+void World::set_body_contact(uint64_t a, uint64_t b, const sh_contact_params* params) {
     require(body(a).is_fem() && body(b).is_fem(), SH_ERR_UNSUPPORTED,
             "body contact needs two FEM bodies (a mass-spring body has no tets to be inside of)");
     require(a != b, SH_ERR_INVALID_ARGUMENT, "a and b are the same body: self-contact is not supported");
@@ -214,7 +214,7 @@ void World::set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params
     }
 }
 
-const BodyContacts* World::contacts_of(sh_body_id id) const { return is_valid(id) ? slots_[slot_of(id)].contacts : nullptr; }
+const BodyContacts* World::contacts_of(uint64_t id) const { return is_valid(id) ? slots_[slot_of(id)].contacts : nullptr; }
 
 void World::add_hook(StepHook* hook) { hooks_.push_back(hook); }
 
@@ -547,7 +547,7 @@ void World::solve_static(const sh_static_def& def, sh_static_report* report) {
     if (report) *report = r;
 }
 
-sh_body_id World::id_of(size_t index) const {
+uint64_t World::id_of(size_t index) const {
     return (static_cast<uint64_t>(slots_[index].generation) << 32) | (static_cast<uint64_t>(index) + 1);
 }
 

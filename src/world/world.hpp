@@ -30,28 +30,28 @@ public:
 
     /// Takes ownership of body (made with sh::create), to be stepped with settings; returns
     /// its new id.
-    sh_body_id add_body(Body* body, const StepSettings& settings);
+    uint64_t add_body(Body* body, const StepSettings& settings);
 
     /// Adds an FEM body made from mesh with one material (see FemBody), stepped with settings;
     /// counts SH_WARN_LOCKING if the material locks linear tets. Returns its id.
-    sh_body_id add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
+    uint64_t add_fem_body(const TetMesh& mesh, const sh_material& material, double damping_mass,
                             double damping_stiffness, const StepSettings& settings);
 
     /// Gives elements[0..count) of FEM body id material (SH_ERR_UNSUPPORTED for a spring body);
     /// counts SH_WARN_LOCKING if it locks linear tets.
-    void set_material(sh_body_id id, const int32_t* elements, int32_t count, const sh_material& material);
+    void set_material(uint64_t id, const int32_t* elements, int32_t count, const sh_material& material);
 
     /// How body id is stepped; throws SH_ERR_INVALID_HANDLE like body().
-    const StepSettings& step_settings(sh_body_id id) const;
+    const StepSettings& step_settings(uint64_t id) const;
 
     /// Destroys the body; its id becomes stale. Throws SH_ERR_INVALID_HANDLE if not live.
-    void remove_body(sh_body_id id);
+    void remove_body(uint64_t id);
 
     /// True if id names a live body of this world.
-    bool is_valid(sh_body_id id) const;
+    bool is_valid(uint64_t id) const;
 
     /// The body named by id; throws SH_ERR_INVALID_HANDLE if the id is null, stale or foreign.
-    Body& body(sh_body_id id) const;
+    Body& body(uint64_t id) const;
 
     /// Adds a tool (is_tool) or an obstacle made from def; returns its id.
     uint64_t add_collider(const sh_collider_def& def, bool is_tool);
@@ -67,7 +67,7 @@ public:
     Collider& collider(uint64_t id, bool is_tool) const;
 
     /// Enables contact between bodies a and b with params, or disables it for null.
-    void set_body_contact(sh_body_id a, sh_body_id b, const sh_contact_params* params);
+    void set_body_contact(uint64_t a, uint64_t b, const sh_contact_params* params);
 
     /// Steps every body by dt; fills report if not null. Throws SH_ERR_UNSTABLE (after
     /// filling report and advancing the stable bodies) if any body was rejected or rolled back.
@@ -85,7 +85,7 @@ public:
     void remove_hook(StepHook* hook);
 
     /// The contact state of body id after the last step, or null if it has none yet.
-    const BodyContacts* contacts_of(sh_body_id id) const;
+    const BodyContacts* contacts_of(uint64_t id) const;
 
     /// Calls visit(id, body) for every live body.
     template <class Visit>
@@ -116,7 +116,7 @@ private:
         uint32_t generation = 0;
     };
     struct BodyPair {
-        sh_body_id a, b;
+        uint64_t a, b;
         sh_contact_params params;
         bool has_candidates = false;  ///< the last detection found candidates between them
     };
@@ -165,7 +165,7 @@ private:
     ContactIslands* islands_ = nullptr;  ///< built on the first step with body pairs
     vec<StepHook*> hooks_;
     bool error_estimate_ = false;
-    sh_body_id id_of(size_t index) const;
+    uint64_t id_of(size_t index) const;
     vec<Slot> slots_;
     vec<uint32_t> free_slots_;
 };

@@ -369,7 +369,7 @@ def collider_def(
     lib.sh_collider_def_default(ctypes.byref(definition))
     arrays: List[Any] = []
     _set_shape(definition.shape, kind, arguments, arrays)
-    if position is not None:  # None, passed explicitly, keeps the C default as it used to
+    if position is not None:  # None keeps the C default (the origin)
         _set_vector(definition.position, position, "position")
     if orientation is not None:
         _set_vector(definition.orientation, orientation, "orientation")

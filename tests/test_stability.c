@@ -953,7 +953,7 @@ static sh_body_id add_bar_body(sh_world* world, const sh_mesh* bar, sh_integrato
  *    matrix 2 - z^2 reaches 2) and 2 sqrt(2) / w_max for RK4 (|R(i z)| = 1 at z^2 = 8);
  *  - w_max is also measured from the library's own forward Euler step alone, w = sqrt(factor -
  *    1) / dt, and must agree with the eigensolver's;
- *  - the issue's criterion: 0.5 <= dt_crit / blow-up step <= 1 for symplectic Euler and RK4;
+ *  - the criterion: 0.5 <= dt_crit / blow-up step <= 1 for symplectic Euler and RK4;
  *  - forward Euler and RK2 have no undamped stable step (their factor exceeds 1 at every dt):
  *    asserted instead that they get the symplectic Euler guard (the leapfrog limit the header
  *    documents) and that their measured growth per step at dt_crit is exactly 1 + z^2 and
@@ -962,6 +962,189 @@ static sh_body_id add_bar_body(sh_world* world, const sh_mesh* bar, sh_integrato
  *    velocity perturbation stay bounded (symplectic Euler within H_0 (1 + z/2) / (1 - z/2), RK4
  *    never growing), and a step 1 % above dt_crit is rejected with the state unchanged.
  * dt_crit is also the same for every material model (it is a small-strain property). */
+/* The stiffness of body (a linear material, forces exactly linear) at the mesh's rest positions,
+ * dofs x dofs row-major, by central differences of its elastic forces; checked symmetric. */
+static double* stiffness_by_differences(sh_world* world, sh_body_id body, const mesh_data* m) {
+    const int n = m->node_count, dofs = 3 * n;
+    double* k = malloc(sizeof(double) * (size_t)dofs * dofs);
+    double* x = malloc(sizeof(double) * (size_t)dofs);
+    double* fp = malloc(sizeof(double) * (size_t)dofs);
+    double* fm = malloc(sizeof(double) * (size_t)dofs);
+    const double eps = 1e-6;
+    for (int j = 0; j < dofs; ++j) {
+        memcpy(x, m->nodes, sizeof(double) * (size_t)dofs);
+        x[j] += eps;
+        assert_ok(sh_body_set_positions(world, body, x, n));
+        assert_ok(sh_body_get_elastic_forces(world, body, fp, n));
+        x[j] -= 2 * eps;
+        assert_ok(sh_body_set_positions(world, body, x, n));
+        assert_ok(sh_body_get_elastic_forces(world, body, fm, n));
+        for (int i = 0; i < dofs; ++i) k[i * dofs + j] = -(fp[i] - fm[i]) / (2 * eps);
+    }
+    double kmax = 0.0, asym = 0.0;
+    for (int i = 0; i < dofs * dofs; ++i) kmax = fmax(kmax, fabs(k[i]));
+    for (int i = 0; i < dofs; ++i)
+        for (int j = 0; j < i; ++j) asym = fmax(asym, fabs(k[i * dofs + j] - k[j * dofs + i]));
+    assert_true(asym <= 1e-8 * kmax);
+    free(x);
+    free(fp);
+    free(fm);
+    return k;
+}
+
+/* The highest mode of K with lumped masses mass (per node): the largest eigenvalue of
+ * M^-1/2 K M^-1/2 by the Jacobi solver, checked by its residual. Fills u (dofs values) with
+ * its mode shape in displacements, scaled to 10 um at the largest; returns w_max (rad/s). */
+static double highest_mode(const double* k, const double* mass, int dofs, double* u) {
+    double* a = malloc(sizeof(double) * (size_t)dofs * dofs);
+    double* a_copy = malloc(sizeof(double) * (size_t)dofs * dofs);
+    double* values = malloc(sizeof(double) * (size_t)dofs);
+    double* vectors = malloc(sizeof(double) * (size_t)dofs * dofs);
+    for (int i = 0; i < dofs; ++i)
+        for (int j = 0; j < dofs; ++j)
+            a[i * dofs + j] = 0.5 * (k[i * dofs + j] + k[j * dofs + i]) / sqrt(mass[i / 3] * mass[j / 3]);
+    memcpy(a_copy, a, sizeof(double) * (size_t)dofs * dofs);
+    jacobi_eigen(a, dofs, values, vectors);
+    int top = 0;
+    for (int i = 1; i < dofs; ++i)
+        if (values[i] > values[top]) top = i;
+    const double lambda = values[top];
+    double residual = 0.0;
+    for (int i = 0; i < dofs; ++i) {
+        double r = -lambda * vectors[i * dofs + top];
+        for (int j = 0; j < dofs; ++j) r += a_copy[i * dofs + j] * vectors[j * dofs + top];
+        residual += r * r;
+    }
+    assert_true(sqrt(residual) <= 1e-9 * lambda);
+    double umax = 0.0;
+    for (int i = 0; i < dofs; ++i) {
+        u[i] = vectors[i * dofs + top] / sqrt(mass[i / 3]);
+        umax = fmax(umax, fabs(u[i]));
+    }
+    for (int i = 0; i < dofs; ++i) u[i] *= 1e-5 / umax;
+    free(a);
+    free(a_copy);
+    free(values);
+    free(vectors);
+    return sqrt(lambda);
+}
+
+/* For each of the four explicit integrators, on bar: dt_crit (into dt_crit[integrator]), the
+ * same for every material model, and one step at dt_crit from rest + u whose energy factor is
+ * the scheme's analytic one at z = w_max dt_crit. Returns w_max as forward Euler's step measures
+ * it, sqrt(factor - 1) / dt. */
+static double check_one_step_on_the_mode(sh_mesh* bar, const mesh_data* m, const double* u, double w_max,
+                                         double dt_crit[4]) {
+    const int n = m->node_count, dofs = 3 * n;
+    double* x = malloc(sizeof(double) * (size_t)dofs);
+    double w_measured = 0.0;
+    for (int integrator = 0; integrator < 4; ++integrator) {
+        sh_world* one = sh_test_world(0.0);
+        const sh_body_id body = add_bar_body(one, bar, (sh_integrator)integrator, SH_MATERIAL_LINEAR);
+        sh_body_info info;
+        assert_ok(sh_body_get_info(one, body, &info));
+        dt_crit[integrator] = info.dt_critical;
+        assert_true(isfinite(info.dt_critical) && info.dt_critical > 0.0);
+        for (int model = 1; model < 4; ++model) {
+            const sh_body_id other = add_bar_body(one, bar, (sh_integrator)integrator, (sh_material_model)model);
+            sh_body_info other_info;
+            assert_ok(sh_body_get_info(one, other, &other_info));
+            assert_close(other_info.dt_critical, info.dt_critical, 1e-12);
+            assert_ok(sh_body_destroy(one, other));
+        }
+        for (int i = 0; i < dofs; ++i) x[i] = m->nodes[i] + u[i];
+        assert_ok(sh_body_set_positions(one, body, x, n));
+        double e0;
+        assert_ok(sh_body_get_elastic_energy(one, body, &e0));
+        sh_step_report report;
+        assert_ok(sh_world_step(one, info.dt_critical, &report));
+        assert_int_equal(report.substeps, 1);
+        const double factor = (report.kinetic_energy + report.elastic_energy) / e0;
+        const double expected = mode_energy_factor((sh_integrator)integrator, w_max * info.dt_critical);
+        if (!(fabs(factor - expected) <= 1e-6 * expected))
+            print_message("integrator %d: energy factor %.12f, analytic %.12f at z = %.6f\n", integrator, factor,
+                          expected, w_max * info.dt_critical);
+        assert_true(fabs(factor - expected) <= 1e-6 * expected);
+        if (integrator == SH_INTEGRATOR_FORWARD_EULER) w_measured = sqrt(factor - 1.0) / info.dt_critical;
+        assert_ok(sh_world_destroy(one));
+    }
+    free(x);
+    return w_measured;
+}
+
+/* Symplectic Euler and RK4 at dt_crit for 2000 steps from rest + u with a small random velocity
+ * stay bounded (symplectic Euler within H_0 (1 + z/2) / (1 - z/2), RK4 never growing); a step 1 %
+ * above dt_crit is then rejected with the state unchanged. */
+static void check_long_runs_at_critical_step(sh_mesh* bar, const mesh_data* m, const double* u, const double* mass,
+                                             double w_max) {
+    const int n = m->node_count, dofs = 3 * n;
+    const sh_integrator stable[2] = {SH_INTEGRATOR_SYMPLECTIC_EULER, SH_INTEGRATOR_RK4};
+    double* x = malloc(sizeof(double) * (size_t)dofs);
+    double* v = malloc(sizeof(double) * (size_t)dofs);
+    for (int si = 0; si < 2; ++si) {
+        sh_world* run = sh_test_world(0.0);
+        const sh_body_id body = add_bar_body(run, bar, stable[si], SH_MATERIAL_LINEAR);
+        sh_body_info info;
+        assert_ok(sh_body_get_info(run, body, &info));
+        unsigned seed = 12345u;
+        for (int i = 0; i < dofs; ++i) {
+            x[i] = m->nodes[i] + u[i];
+            seed = seed * 1103515245u + 12345u;
+            v[i] = 0.1 * 1e-5 * w_max * (((seed >> 8) & 0xffff) / 32768.0 - 1.0);
+        }
+        assert_ok(sh_body_set_positions(run, body, x, n));
+        assert_ok(sh_body_set_velocities(run, body, v, n));
+        double e0;
+        assert_ok(sh_body_get_elastic_energy(run, body, &e0));
+        for (int i = 0; i < dofs; ++i) e0 += 0.5 * mass[i / 3] * v[i] * v[i];
+        const double z = w_max * info.dt_critical, band = (1.0 + 0.5 * z) / (1.0 - 0.5 * z);
+        double previous = e0, highest = 0.0;
+        for (int s = 0; s < 2000; ++s) {
+            sh_step_report report;
+            assert_ok(sh_world_step(run, info.dt_critical, &report));
+            const double e = report.kinetic_energy + report.elastic_energy;
+            highest = fmax(highest, e / e0);
+            if (stable[si] == SH_INTEGRATOR_SYMPLECTIC_EULER) assert_true(e <= band * e0);
+            else assert_true(e <= previous * (1.0 + 1e-10));
+            previous = e;
+        }
+        print_message("  %s at dt_crit for 2000 steps: max H / H0 %.4f%s\n",
+                      stable[si] == SH_INTEGRATOR_RK4 ? "RK4" : "symplectic Euler", highest,
+                      stable[si] == SH_INTEGRATOR_RK4 ? " (never growing)" : "");
+        double before[2][3 * 200], after[2][3 * 200];
+        assert_true(dofs <= 3 * 200);
+        assert_ok(sh_body_get_positions(run, body, before[0], n));
+        assert_ok(sh_body_get_velocities(run, body, before[1], n));
+        assert_status(sh_world_step(run, 1.01 * info.dt_critical, NULL), SH_ERR_UNSTABLE);
+        assert_ok(sh_body_get_positions(run, body, after[0], n));
+        assert_ok(sh_body_get_velocities(run, body, after[1], n));
+        assert_memory_equal(before[0], after[0], sizeof(double) * (size_t)dofs);
+        assert_memory_equal(before[1], after[1], sizeof(double) * (size_t)dofs);
+        assert_ok(sh_world_destroy(run));
+    }
+    free(x);
+    free(v);
+}
+
+/* The guards against the measured blow-up steps: 0.5 <= dt_crit / blow-up <= 1 for symplectic
+ * Euler (2 / w) and RK4 (2 sqrt(2) / w); forward Euler and RK2 get symplectic Euler's guard. */
+static void check_critical_ratios(const int cells[3], int dofs, double w_max, double w_measured,
+                                  const double dt_crit[4]) {
+    const double blowup_se = 2.0 / w_measured, blowup_rk4 = 2.0 * sqrt(2.0) / w_measured;
+    const double ratio_se = dt_crit[SH_INTEGRATOR_SYMPLECTIC_EULER] / blowup_se;
+    const double ratio_rk4 = dt_crit[SH_INTEGRATOR_RK4] / blowup_rk4;
+    const double z_fe = w_max * dt_crit[SH_INTEGRATOR_FORWARD_EULER], z_rk2 = w_max * dt_crit[SH_INTEGRATOR_RK2];
+    print_message("bar %dx%dx%d (%d DOF): w_max %.6g rad/s (forward Euler measures %.6g); symplectic Euler dt_crit "
+                  "%.4e s vs blow-up 2/w %.4e s: ratio %.4f; RK4 %.4e vs 2 sqrt(2)/w %.4e: ratio %.4f; forward Euler "
+                  "growth %.4f and RK2 growth %.4f per step at their dt_crit\n",
+                  cells[0], cells[1], cells[2], dofs, w_max, w_measured, dt_crit[1], blowup_se, ratio_se, dt_crit[3],
+                  blowup_rk4, ratio_rk4, 1.0 + z_fe * z_fe, 1.0 + pow(z_rk2, 4) / 4.0);
+    assert_true(ratio_se >= 0.5 && ratio_se <= 1.0);
+    assert_true(ratio_rk4 >= 0.5 && ratio_rk4 <= 1.0);
+    assert_close(dt_crit[SH_INTEGRATOR_FORWARD_EULER], dt_crit[SH_INTEGRATOR_SYMPLECTIC_EULER], 1e-12);
+    assert_close(dt_crit[SH_INTEGRATOR_RK2], dt_crit[SH_INTEGRATOR_SYMPLECTIC_EULER], 1e-12);
+}
+
 static void test_critical_step(void** state) {
     (void)state;
     const clock_t start = clock();
@@ -974,161 +1157,18 @@ static void test_critical_step(void** state) {
         const sh_body_id probe = add_bar_body(world, bar, SH_INTEGRATOR_SYMPLECTIC_EULER, SH_MATERIAL_LINEAR);
         double* mass = malloc(sizeof(double) * (size_t)n);
         assert_ok(sh_body_get_masses(world, probe, mass, n));
-
-        /* Stiffness by central differences of the elastic forces. */
-        double* k = malloc(sizeof(double) * (size_t)dofs * dofs);
-        double* x = malloc(sizeof(double) * (size_t)dofs);
-        double* fp = malloc(sizeof(double) * (size_t)dofs);
-        double* fm = malloc(sizeof(double) * (size_t)dofs);
-        const double eps = 1e-6;
-        for (int j = 0; j < dofs; ++j) {
-            memcpy(x, m.nodes, sizeof(double) * (size_t)dofs);
-            x[j] += eps;
-            assert_ok(sh_body_set_positions(world, probe, x, n));
-            assert_ok(sh_body_get_elastic_forces(world, probe, fp, dofs / 3));
-            x[j] -= 2 * eps;
-            assert_ok(sh_body_set_positions(world, probe, x, n));
-            assert_ok(sh_body_get_elastic_forces(world, probe, fm, dofs / 3));
-            for (int i = 0; i < dofs; ++i) k[i * dofs + j] = -(fp[i] - fm[i]) / (2 * eps);
-        }
-        double kmax = 0.0, asym = 0.0;
-        for (int i = 0; i < dofs * dofs; ++i) kmax = fmax(kmax, fabs(k[i]));
-        for (int i = 0; i < dofs; ++i)
-            for (int j = 0; j < i; ++j) asym = fmax(asym, fabs(k[i * dofs + j] - k[j * dofs + i]));
-        assert_true(asym <= 1e-8 * kmax);
-
-        /* A = M^-1/2 K M^-1/2 and its spectrum. */
-        double* a = malloc(sizeof(double) * (size_t)dofs * dofs);
-        double* a_copy = malloc(sizeof(double) * (size_t)dofs * dofs);
-        double* values = malloc(sizeof(double) * (size_t)dofs);
-        double* vectors = malloc(sizeof(double) * (size_t)dofs * dofs);
-        for (int i = 0; i < dofs; ++i)
-            for (int j = 0; j < dofs; ++j)
-                a[i * dofs + j] = 0.5 * (k[i * dofs + j] + k[j * dofs + i]) / sqrt(mass[i / 3] * mass[j / 3]);
-        memcpy(a_copy, a, sizeof(double) * (size_t)dofs * dofs);
-        jacobi_eigen(a, dofs, values, vectors);
-        int top = 0;
-        for (int i = 1; i < dofs; ++i)
-            if (values[i] > values[top]) top = i;
-        const double lambda = values[top], w_max = sqrt(lambda);
-        double residual = 0.0;
-        for (int i = 0; i < dofs; ++i) {
-            double r = -lambda * vectors[i * dofs + top];
-            for (int j = 0; j < dofs; ++j) r += a_copy[i * dofs + j] * vectors[j * dofs + top];
-            residual += r * r;
-        }
-        assert_true(sqrt(residual) <= 1e-9 * lambda);
+        double* k = stiffness_by_differences(world, probe, &m);
         double* u = malloc(sizeof(double) * (size_t)dofs);
-        double umax = 0.0;
-        for (int i = 0; i < dofs; ++i) {
-            u[i] = vectors[i * dofs + top] / sqrt(mass[i / 3]);
-            umax = fmax(umax, fabs(u[i]));
-        }
-        for (int i = 0; i < dofs; ++i) u[i] *= 1e-5 / umax; /* 10 um at the largest */
+        const double w_max = highest_mode(k, mass, dofs, u);
 
-        double dt_crit[4], w_measured = 0.0;
-        for (int integrator = 0; integrator < 4; ++integrator) {
-            sh_world* one = sh_test_world(0.0);
-            const sh_body_id body = add_bar_body(one, bar, (sh_integrator)integrator, SH_MATERIAL_LINEAR);
-            sh_body_info info;
-            assert_ok(sh_body_get_info(one, body, &info));
-            dt_crit[integrator] = info.dt_critical;
-            assert_true(isfinite(info.dt_critical) && info.dt_critical > 0.0);
-            for (int model = 1; model < 4; ++model) {
-                const sh_body_id other = add_bar_body(one, bar, (sh_integrator)integrator, (sh_material_model)model);
-                sh_body_info other_info;
-                assert_ok(sh_body_get_info(one, other, &other_info));
-                assert_close(other_info.dt_critical, info.dt_critical, 1e-12);
-                assert_ok(sh_body_destroy(one, other));
-            }
-            /* One step on the highest mode. */
-            for (int i = 0; i < dofs; ++i) x[i] = m.nodes[i] + u[i];
-            assert_ok(sh_body_set_positions(one, body, x, n));
-            double e0;
-            assert_ok(sh_body_get_elastic_energy(one, body, &e0));
-            sh_step_report report;
-            assert_ok(sh_world_step(one, info.dt_critical, &report));
-            assert_int_equal(report.substeps, 1);
-            const double factor = (report.kinetic_energy + report.elastic_energy) / e0;
-            const double z = w_max * info.dt_critical;
-            const double expected = mode_energy_factor((sh_integrator)integrator, z);
-            if (!(fabs(factor - expected) <= 1e-6 * expected))
-                print_message("integrator %d: energy factor %.12f, analytic %.12f at z = %.6f\n", integrator, factor, expected, z);
-            assert_true(fabs(factor - expected) <= 1e-6 * expected);
-            if (integrator == SH_INTEGRATOR_FORWARD_EULER) w_measured = sqrt(factor - 1.0) / info.dt_critical;
-            assert_ok(sh_world_destroy(one));
-        }
+        double dt_crit[4];
+        const double w_measured = check_one_step_on_the_mode(bar, &m, u, w_max, dt_crit);
         assert_close(w_measured / w_max, 1.0, 1e-6);
-
-        const double blowup_se = 2.0 / w_measured, blowup_rk4 = 2.0 * sqrt(2.0) / w_measured;
-        const double ratio_se = dt_crit[SH_INTEGRATOR_SYMPLECTIC_EULER] / blowup_se;
-        const double ratio_rk4 = dt_crit[SH_INTEGRATOR_RK4] / blowup_rk4;
-        const double z_fe = w_max * dt_crit[SH_INTEGRATOR_FORWARD_EULER], z_rk2 = w_max * dt_crit[SH_INTEGRATOR_RK2];
-        print_message("bar %dx%dx%d (%d DOF): w_max %.6g rad/s (forward Euler measures %.6g); symplectic Euler dt_crit "
-                      "%.4e s vs blow-up 2/w %.4e s: ratio %.4f; RK4 %.4e vs 2 sqrt(2)/w %.4e: ratio %.4f; forward Euler "
-                      "growth %.4f and RK2 growth %.4f per step at their dt_crit\n",
-                      cells[b][0], cells[b][1], cells[b][2], dofs, w_max, w_measured, dt_crit[1], blowup_se, ratio_se,
-                      dt_crit[3], blowup_rk4, ratio_rk4, 1.0 + z_fe * z_fe, 1.0 + pow(z_rk2, 4) / 4.0);
-        assert_true(ratio_se >= 0.5 && ratio_se <= 1.0);
-        assert_true(ratio_rk4 >= 0.5 && ratio_rk4 <= 1.0);
-        assert_close(dt_crit[SH_INTEGRATOR_FORWARD_EULER], dt_crit[SH_INTEGRATOR_SYMPLECTIC_EULER], 1e-12);
-        assert_close(dt_crit[SH_INTEGRATOR_RK2], dt_crit[SH_INTEGRATOR_SYMPLECTIC_EULER], 1e-12);
-
-        /* Long runs at dt_crit from the mode plus a velocity perturbation; the guard rejects more. */
-        const sh_integrator stable[2] = {SH_INTEGRATOR_SYMPLECTIC_EULER, SH_INTEGRATOR_RK4};
-        for (int si = 0; si < 2; ++si) {
-            sh_world* run = sh_test_world(0.0);
-            const sh_body_id body = add_bar_body(run, bar, stable[si], SH_MATERIAL_LINEAR);
-            sh_body_info info;
-            assert_ok(sh_body_get_info(run, body, &info));
-            double* v = malloc(sizeof(double) * (size_t)dofs);
-            unsigned seed = 12345u;
-            for (int i = 0; i < dofs; ++i) {
-                x[i] = m.nodes[i] + u[i];
-                seed = seed * 1103515245u + 12345u;
-                v[i] = 0.1 * 1e-5 * w_max * (((seed >> 8) & 0xffff) / 32768.0 - 1.0);
-            }
-            assert_ok(sh_body_set_positions(run, body, x, n));
-            assert_ok(sh_body_set_velocities(run, body, v, n));
-            double e0;
-            assert_ok(sh_body_get_elastic_energy(run, body, &e0));
-            for (int i = 0; i < dofs; ++i) e0 += 0.5 * mass[i / 3] * v[i] * v[i];
-            const double z = w_max * info.dt_critical, band = (1.0 + 0.5 * z) / (1.0 - 0.5 * z);
-            double previous = e0, highest = 0.0;
-            for (int s = 0; s < 2000; ++s) {
-                sh_step_report report;
-                assert_ok(sh_world_step(run, info.dt_critical, &report));
-                const double e = report.kinetic_energy + report.elastic_energy;
-                highest = fmax(highest, e / e0);
-                if (stable[si] == SH_INTEGRATOR_SYMPLECTIC_EULER) assert_true(e <= band * e0);
-                else assert_true(e <= previous * (1.0 + 1e-10));
-                previous = e;
-            }
-            print_message("  %s at dt_crit for 2000 steps: max H / H0 %.4f%s\n",
-                          stable[si] == SH_INTEGRATOR_RK4 ? "RK4" : "symplectic Euler", highest,
-                          stable[si] == SH_INTEGRATOR_RK4 ? " (never growing)" : "");
-            double before[2][3 * 200], after[2][3 * 200];
-            assert_true(dofs <= 3 * 200);
-            assert_ok(sh_body_get_positions(run, body, before[0], dofs / 3));
-            assert_ok(sh_body_get_velocities(run, body, before[1], dofs / 3));
-            assert_status(sh_world_step(run, 1.01 * info.dt_critical, NULL), SH_ERR_UNSTABLE);
-            assert_ok(sh_body_get_positions(run, body, after[0], dofs / 3));
-            assert_ok(sh_body_get_velocities(run, body, after[1], dofs / 3));
-            assert_memory_equal(before[0], after[0], sizeof(double) * (size_t)dofs);
-            assert_memory_equal(before[1], after[1], sizeof(double) * (size_t)dofs);
-            free(v);
-            assert_ok(sh_world_destroy(run));
-        }
+        check_critical_ratios(cells[b], dofs, w_max, w_measured, dt_crit);
+        check_long_runs_at_critical_step(bar, &m, u, mass, w_max);
 
         free(u);
-        free(a);
-        free(a_copy);
-        free(values);
-        free(vectors);
         free(k);
-        free(x);
-        free(fp);
-        free(fm);
         free(mass);
         assert_ok(sh_world_destroy(world));
         sh_test_mesh_arrays_free(&m);

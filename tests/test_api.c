@@ -840,7 +840,8 @@ static void two_node_def(sh_spring_body_def* def, const double* nodes, const int
     def->spring_count = 1;
 }
 
-static void test_spring_def_errors(void** state) {
+/* Spring bodies whose nodes, springs, masses or counts are wrong: each is the error naming it. */
+static void test_spring_def_topology_errors(void** state) {
     (void)state;
     sh_world* world = make_world();
     const double nodes[9] = {0, 0, 0, 0.01, 0, 0, 0, 0.01, 0};
@@ -852,10 +853,6 @@ static void test_spring_def_errors(void** state) {
     const int32_t negative_index[2] = {-1, 1};
     const double negative_masses[2] = {1e-3, -1e-3};
     const double nan_masses[2] = {1e-3, NAN};
-    const double decreasing[6] = {0.0, 0.0, 0.2, 1.0, 0.1, 2.0};
-    const double repeated[6] = {0.0, 0.0, 0.1, 1.0, 0.1, 2.0};
-    const double good_table[6] = {-0.1, -1.0, 0.0, 0.0, 0.1, 1.0};
-    const double nan_table[4] = {0.0, 0.0, NAN, 1.0};
     sh_spring_body_def def;
 
     two_node_def(&def, same_place, one_spring);
@@ -881,6 +878,38 @@ static void test_spring_def_errors(void** state) {
     EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node 1");
     def.node_masses = nan_masses;
     EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node 1");
+
+    two_node_def(&def, nodes, one_spring);
+    def.node_count = 0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node_count");
+    def.node_count = -2;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node_count");
+    two_node_def(&def, nodes, one_spring);
+    def.spring_count = -1;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "spring_count");
+    two_node_def(&def, nodes, one_spring);
+    def.integrator = (sh_integrator)5;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "integrator");
+    two_node_def(&def, nodes, one_spring);
+    def.runaway_speed = -1.0;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "runaway_speed");
+
+    /* And a single particle with no spring is a valid body. */
+    sh_spring_body_def_default(&def);
+    def.nodes = nodes;
+    def.node_count = 1;
+    sh_body_id id;
+    assert_ok(sh_spring_body_create(world, &def, &id));
+    assert_ok(sh_world_destroy(world));
+}
+
+/* Spring laws with a parameter out of range, or no law at all: each is the error naming it. */
+static void test_spring_law_errors(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    const double nodes[6] = {0, 0, 0, 0.01, 0, 0};
+    const int32_t one_spring[2] = {0, 1};
+    sh_spring_body_def def;
 
     two_node_def(&def, nodes, one_spring);
     def.params.stiffness = 0.0;
@@ -914,6 +943,28 @@ static void test_spring_def_errors(void** state) {
     EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "params.a");
 
     two_node_def(&def, nodes, one_spring);
+    def.params.law = (sh_spring_law)42;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "law");
+    def.params.law = (sh_spring_law)-1;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "law");
+
+    assert_ok(sh_world_destroy(world));
+}
+
+/* Measured-curve springs: tables that are not strictly increasing in strain, not finite, too
+ * short or missing are errors naming the table; a valid one makes a body. */
+static void test_spring_table_errors(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    const double nodes[6] = {0, 0, 0, 0.01, 0, 0};
+    const int32_t one_spring[2] = {0, 1};
+    const double decreasing[6] = {0.0, 0.0, 0.2, 1.0, 0.1, 2.0};
+    const double repeated[6] = {0.0, 0.0, 0.1, 1.0, 0.1, 2.0};
+    const double good_table[6] = {-0.1, -1.0, 0.0, 0.0, 0.1, 1.0};
+    const double nan_table[4] = {0.0, 0.0, NAN, 1.0};
+    sh_spring_body_def def;
+
+    two_node_def(&def, nodes, one_spring);
     def.params.law = SH_SPRING_TABLE;
     def.params.table = decreasing;
     def.params.table_rows = 3;
@@ -935,36 +986,10 @@ static void test_spring_def_errors(void** state) {
     EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "table");
 
     two_node_def(&def, nodes, one_spring);
-    def.params.law = (sh_spring_law)42;
-    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "law");
-    def.params.law = (sh_spring_law)-1;
-    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "law");
-
-    two_node_def(&def, nodes, one_spring);
-    def.node_count = 0;
-    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node_count");
-    def.node_count = -2;
-    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "node_count");
-    two_node_def(&def, nodes, one_spring);
-    def.spring_count = -1;
-    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "spring_count");
-    two_node_def(&def, nodes, one_spring);
-    def.integrator = (sh_integrator)5;
-    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "integrator");
-    two_node_def(&def, nodes, one_spring);
-    def.runaway_speed = -1.0;
-    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "runaway_speed");
-
-    /* And the good ones: the valid table, and a single particle with no spring. */
-    two_node_def(&def, nodes, one_spring);
     def.params.law = SH_SPRING_TABLE;
     def.params.table = good_table;
     def.params.table_rows = 3;
     sh_body_id id;
-    assert_ok(sh_spring_body_create(world, &def, &id));
-    sh_spring_body_def_default(&def);
-    def.nodes = nodes;
-    def.node_count = 1;
     assert_ok(sh_spring_body_create(world, &def, &id));
     assert_ok(sh_world_destroy(world));
 }
@@ -1275,7 +1300,9 @@ int main(void) {
         cmocka_unit_test(test_uninitialized_materials_and_contact_params),
         cmocka_unit_test(test_material_validation_in_def),
         cmocka_unit_test_setup_teardown(test_material_validation_in_set_material, setup_moved_box, teardown_moved_box),
-        cmocka_unit_test(test_spring_def_errors),
+        cmocka_unit_test(test_spring_def_topology_errors),
+        cmocka_unit_test(test_spring_law_errors),
+        cmocka_unit_test(test_spring_table_errors),
         cmocka_unit_test_setup_teardown(test_step_rejects_bad_dt, setup_moved_box_and_spring, teardown_moved_box),
         cmocka_unit_test_setup_teardown(test_set_state_rejects_non_finite_and_wrong_counts, setup_moved_box, teardown_moved_box),
         cmocka_unit_test_setup_teardown(test_get_capacity_too_small, setup_moved_box, teardown_moved_box),

@@ -1,5 +1,5 @@
 /*
- * softhap_bench accuracy: error against run time (issue 3, item 4). One JSON line per run on
+ * softhap_bench accuracy: error against run time. One JSON line per run on
  * stdout, progress on stderr; scripts/report.py turns the lines into report/accuracy.md and plots.
  *
  *   softhap_bench accuracy [--quick] [--jobs N] [FILTER]
@@ -215,7 +215,7 @@ static void bar_build(bar_t* b, int ny) {
     sh_mesh_info info;
     CHECK(sh_mesh_get_info(b->mesh, &info));
     int32_t* tris = (int32_t*)xcalloc(3 * (size_t)info.surface_triangle_count, sizeof(int32_t));
-    CHECK(sh_mesh_get_surface_triangles(b->mesh, tris, 3 * (int64_t)info.surface_triangle_count));
+    CHECK(sh_mesh_get_surface_triangles(b->mesh, tris, info.surface_triangle_count));
     b->tip_weight = (double*)xcalloc((size_t)b->node_count, sizeof(double));
     const double tip = kLength - 1e-12;
     double area_sum = 0.0;
@@ -279,8 +279,8 @@ static sh_body_id add_bar(sh_world* world, const bar_t* b, sh_material_model mod
         def.implicit.newton_max_iterations = method->newton > 0 ? method->newton : 1;
         def.implicit.newton_tolerance = kNewtonTolerance;
     }
-    sh_body_id body = SH_NULL_BODY;
-    CHECK(sh_world_add_fem_body(world, &def, &body));
+    sh_body_id body = SH_NULL_ID;
+    CHECK(sh_fem_body_create(world, &def, &body));
     CHECK(sh_body_fix_nodes(world, body, b->fixed, b->fixed_count));
     return body;
 }
@@ -347,7 +347,7 @@ static void run_dynamic(const bar_t* b, sh_material_model model, const method_t*
     r->substep_warnings = warnings[SH_WARN_SUBSTEPPED];
     r->inverted_warnings = warnings[SH_WARN_INVERTED];
     r->x = (double*)xcalloc(3 * (size_t)b->node_count, sizeof(double));
-    CHECK(sh_body_get_positions(world, body, r->x, 3 * (int64_t)b->node_count));
+    CHECK(sh_body_get_positions(world, body, r->x, b->node_count));
     CHECK(sh_world_destroy(world));
 }
 
@@ -362,35 +362,96 @@ static void mesh_fields(FILE* out, const bar_t* b) {
             b->node_count, b->tet_count);
 }
 
+/* One method's sweep of time steps into runs[*run_count..] (see the header); the largest step
+ * count of an explicit run into *finest_explicit. */
+static void sweep_method(const bar_t* b, const resolution_t* res, const material_t* mat, const method_t* method,
+                         run_t* runs, int* run_count, int* finest_explicit) {
+    const double start = now_s();
+    int stable = 0, count = 0;
+    if (method->integrator != SH_INTEGRATOR_IMPLICIT_EULER) {
+        const double dtc = body_dt_critical(b, mat->model, method);
+        for (int k = 0; k <= res->levels; ++k) {
+            const int n = steps_for(dtc * pow(2.0, -0.5 * k));
+            run_dynamic(b, mat->model, method, n, &runs[*run_count]);
+            stable += runs[*run_count].status == SH_OK;
+            if (n > *finest_explicit) *finest_explicit = n;
+            ++*run_count, ++count;
+        }
+    } else {
+        const int max_steps = method->newton > 1 ? res->newton_max_steps : res->implicit_max_steps;
+        for (int n = 10; n <= max_steps; n *= 2) {
+            run_dynamic(b, mat->model, method, n, &runs[*run_count]);
+            stable += runs[*run_count].status == SH_OK;
+            ++*run_count, ++count;
+        }
+    }
+    fprintf(stderr, "accuracy: dynamic ny=%d %-12s %-22s %d runs (%d ok) in %.1f s\n", res->ny, mat->name,
+            method->name, count, stable, now_s() - start);
+}
+
+/* The reference's line; returns its largest node displacement from rest, the error's scale. */
+static double print_dynamic_reference(FILE* out, const bar_t* b, const material_t* mat, const run_t* ref) {
+    double deflection = 0.0;
+    for (int i = 0; i < b->node_count; ++i) {
+        double d2 = 0.0;
+        for (int k = 0; k < 3; ++k) d2 += (ref->x[3 * i + k] - b->rest[3 * i + k]) * (ref->x[3 * i + k] - b->rest[3 * i + k]);
+        if (d2 > deflection * deflection) deflection = sqrt(d2);
+    }
+    fprintf(out, "{\"study\":\"dynamic_reference\"");
+    mesh_fields(out, b);
+    fprintf(out, ",\"material\":\"%s\",\"method\":\"rk4\",\"steps\":%d", mat->name, ref->steps);
+    jnum(out, "dt", ref->dt);
+    jnum(out, "dt_critical", ref->dt_critical);
+    jnum(out, "wall_s", ref->wall_s);
+    jnum(out, "cpu_s", ref->cpu_s);
+    jnum(out, "max_displacement", deflection);
+    jnum(out, "tip_z", tip_displacement(b, ref->x, 2));
+    jnum(out, "tip_x", tip_displacement(b, ref->x, 0));
+    fprintf(out, ",\"inverted_warnings\":%llu}\n", (unsigned long long)ref->inverted_warnings);
+    return deflection;
+}
+
+/* One run's line: its error against the reference, relative to the reference's deflection. */
+static void print_dynamic_run(FILE* out, const bar_t* b, const material_t* mat, const run_t* run, const run_t* ref,
+                              double deflection) {
+    double error = NAN;
+    if (run->status == SH_OK) {
+        double worst = 0.0;
+        for (int i = 0; i < b->node_count; ++i) {
+            double d2 = 0.0;
+            for (int k = 0; k < 3; ++k) d2 += (run->x[3 * i + k] - ref->x[3 * i + k]) * (run->x[3 * i + k] - ref->x[3 * i + k]);
+            if (d2 > worst) worst = d2;
+        }
+        error = sqrt(worst) / deflection;
+    }
+    fprintf(out, "{\"study\":\"dynamic\"");
+    mesh_fields(out, b);
+    fprintf(out, ",\"material\":\"%s\",\"method\":\"%s\",\"steps\":%d", mat->name, run->method->name, run->steps);
+    jnum(out, "dt", run->dt);
+    jnum(out, "dt_critical", run->dt_critical);
+    jnum(out, "dt_over_critical", run->dt / run->dt_critical);
+    fprintf(out, ",\"status\":\"%s\",\"failed_step\":%d", status_name(run->status), run->failed_step);
+    jnum(out, "wall_s", run->wall_s);
+    jnum(out, "cpu_s", run->cpu_s);
+    jnum(out, "error", error);
+    if (run->method->integrator == SH_INTEGRATOR_IMPLICIT_EULER) {
+        jnum(out, "newton_mean", run->newton_mean);
+        fprintf(out, ",\"newton_max\":%d", run->newton_max);
+    }
+    fprintf(out, ",\"substep_warnings\":%llu,\"inverted_warnings\":%llu", (unsigned long long)run->substep_warnings,
+            (unsigned long long)run->inverted_warnings);
+    fprintf(out, ",\"reference\":\"rk4\"");
+    jnum(out, "reference_dt", ref->dt);
+    fprintf(out, "}\n");
+}
+
+/* One resolution and material: every method's sweep, the reference, then the lines. */
 static void job_dynamic(FILE* out, const resolution_t* res, const material_t* mat) {
     bar_t b;
     bar_build(&b, res->ny);
     run_t* runs = (run_t*)xcalloc(64, sizeof(run_t));
     int run_count = 0, finest_explicit = 0;
-    for (int m = 0; m < kMethodCount; ++m) {
-        const method_t* method = &kMethods[m];
-        const double start = now_s();
-        int stable = 0, count = 0;
-        if (method->integrator != SH_INTEGRATOR_IMPLICIT_EULER) {
-            const double dtc = body_dt_critical(&b, mat->model, method);
-            for (int k = 0; k <= res->levels; ++k) {
-                const int n = steps_for(dtc * pow(2.0, -0.5 * k));
-                run_dynamic(&b, mat->model, method, n, &runs[run_count]);
-                stable += runs[run_count].status == SH_OK;
-                if (n > finest_explicit) finest_explicit = n;
-                ++run_count, ++count;
-            }
-        } else {
-            const int max_steps = method->newton > 1 ? res->newton_max_steps : res->implicit_max_steps;
-            for (int n = 10; n <= max_steps; n *= 2) {
-                run_dynamic(&b, mat->model, method, n, &runs[run_count]);
-                stable += runs[run_count].status == SH_OK;
-                ++run_count, ++count;
-            }
-        }
-        fprintf(stderr, "accuracy: dynamic ny=%d %-12s %-22s %d runs (%d ok) in %.1f s\n", res->ny, mat->name,
-                method->name, count, stable, now_s() - start);
-    }
+    for (int m = 0; m < kMethodCount; ++m) sweep_method(&b, res, mat, &kMethods[m], runs, &run_count, &finest_explicit);
 
     /* Reference: RK4 at a step 16x smaller than the smallest explicit step swept. */
     const double start = now_s();
@@ -402,55 +463,9 @@ static void job_dynamic(FILE* out, const resolution_t* res, const material_t* ma
         fprintf(stderr, "softhap_bench accuracy: the reference run failed (%s)\n", status_name(ref.status));
         exit(1);
     }
-    double deflection = 0.0;
-    for (int i = 0; i < b.node_count; ++i) {
-        double d2 = 0.0;
-        for (int k = 0; k < 3; ++k) d2 += (ref.x[3 * i + k] - b.rest[3 * i + k]) * (ref.x[3 * i + k] - b.rest[3 * i + k]);
-        if (d2 > deflection * deflection) deflection = sqrt(d2);
-    }
-    fprintf(out, "{\"study\":\"dynamic_reference\"");
-    mesh_fields(out, &b);
-    fprintf(out, ",\"material\":\"%s\",\"method\":\"rk4\",\"steps\":%d", mat->name, ref.steps);
-    jnum(out, "dt", ref.dt);
-    jnum(out, "dt_critical", ref.dt_critical);
-    jnum(out, "wall_s", ref.wall_s);
-    jnum(out, "cpu_s", ref.cpu_s);
-    jnum(out, "max_displacement", deflection);
-    jnum(out, "tip_z", tip_displacement(&b, ref.x, 2));
-    jnum(out, "tip_x", tip_displacement(&b, ref.x, 0));
-    fprintf(out, ",\"inverted_warnings\":%llu}\n", (unsigned long long)ref.inverted_warnings);
-
+    const double deflection = print_dynamic_reference(out, &b, mat, &ref);
     for (int r = 0; r < run_count; ++r) {
-        const run_t* run = &runs[r];
-        double error = NAN;
-        if (run->status == SH_OK) {
-            double worst = 0.0;
-            for (int i = 0; i < b.node_count; ++i) {
-                double d2 = 0.0;
-                for (int k = 0; k < 3; ++k) d2 += (run->x[3 * i + k] - ref.x[3 * i + k]) * (run->x[3 * i + k] - ref.x[3 * i + k]);
-                if (d2 > worst) worst = d2;
-            }
-            error = sqrt(worst) / deflection;
-        }
-        fprintf(out, "{\"study\":\"dynamic\"");
-        mesh_fields(out, &b);
-        fprintf(out, ",\"material\":\"%s\",\"method\":\"%s\",\"steps\":%d", mat->name, run->method->name, run->steps);
-        jnum(out, "dt", run->dt);
-        jnum(out, "dt_critical", run->dt_critical);
-        jnum(out, "dt_over_critical", run->dt / run->dt_critical);
-        fprintf(out, ",\"status\":\"%s\",\"failed_step\":%d", status_name(run->status), run->failed_step);
-        jnum(out, "wall_s", run->wall_s);
-        jnum(out, "cpu_s", run->cpu_s);
-        jnum(out, "error", error);
-        if (run->method->integrator == SH_INTEGRATOR_IMPLICIT_EULER) {
-            jnum(out, "newton_mean", run->newton_mean);
-            fprintf(out, ",\"newton_max\":%d", run->newton_max);
-        }
-        fprintf(out, ",\"substep_warnings\":%llu,\"inverted_warnings\":%llu", (unsigned long long)run->substep_warnings,
-                (unsigned long long)run->inverted_warnings);
-        fprintf(out, ",\"reference\":\"rk4\"");
-        jnum(out, "reference_dt", ref.dt);
-        fprintf(out, "}\n");
+        print_dynamic_run(out, &b, mat, &runs[r], &ref, deflection);
         free(runs[r].x);
     }
     free(ref.x);
@@ -492,7 +507,7 @@ static void job_static_eb(FILE* out, int ny) {
         const sh_status st = sh_world_solve_static(world, &sd, &rep);
         const double wall = now_s() - t0;
         const double cpu = cpu_s() - c0;
-        CHECK(sh_body_get_positions(world, body, x, 3 * (int64_t)b.node_count));
+        CHECK(sh_body_get_positions(world, body, x, b.node_count));
         const double w = -tip_displacement(&b, x, 2);
         /* Timoshenko: add the shear deflection F L / (kappa G A), Cowper's kappa for a square. */
         const double shear = 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu);
@@ -534,7 +549,7 @@ static void job_static_nonlinear(FILE* out, int ny) {
         sh_static_def_default(&sd);
         sd.tolerance = kStaticTolerance;
         CHECK(sh_world_solve_static(world, &sd, NULL));
-        CHECK(sh_body_get_positions(world, body, x, 3 * (int64_t)b.node_count));
+        CHECK(sh_body_get_positions(world, body, x, b.node_count));
         compliance = -tip_displacement(&b, x, 2);
         CHECK(sh_world_destroy(world));
     }
@@ -565,7 +580,7 @@ static void job_static_nonlinear(FILE* out, int ny) {
             }
             const double wall = now_s() - t0;
             const double cpu = cpu_s() - c0;
-            CHECK(sh_body_get_positions(world, body, x, 3 * (int64_t)b.node_count));
+            CHECK(sh_body_get_positions(world, body, x, b.node_count));
             const double w = -tip_displacement(&b, x, 2);
             fprintf(out, "{\"study\":\"static_nonlinear\"");
             mesh_fields(out, &b);
@@ -621,8 +636,8 @@ static void job_oscillator(FILE* out) {
             def.damping_mass = 0.0;
             def.implicit.newton_max_iterations = method->newton > 0 ? method->newton : 1;
             def.implicit.newton_tolerance = kNewtonTolerance;
-            sh_body_id body = SH_NULL_BODY;
-            CHECK(sh_world_add_spring_body(world, &def, &body));
+            sh_body_id body = SH_NULL_ID;
+            CHECK(sh_spring_body_create(world, &def, &body));
             const int32_t fixed = 0;
             CHECK(sh_body_fix_nodes(world, body, &fixed, 1));
             const double start[6] = {0.0, 0.0, 0.0, kOscRest + kOscAmplitude, 0.0, 0.0};
@@ -640,8 +655,8 @@ static void job_oscillator(FILE* out) {
             const double wall = now_s() - t0;
             const double cpu = cpu_s() - c0;
             double x[6], v[6];
-            CHECK(sh_body_get_positions(world, body, x, 6));
-            CHECK(sh_body_get_velocities(world, body, v, 6));
+            CHECK(sh_body_get_positions(world, body, x, 2));
+            CHECK(sh_body_get_velocities(world, body, v, 2));
             const double dx = x[3] - kOscRest - exact_x, dv = (v[3] - exact_v) / omega;
             fprintf(out, "{\"study\":\"oscillator\",\"method\":\"%s\",\"steps\":%d", method->name, steps);
             jnum(out, "dt", dt);
@@ -778,6 +793,67 @@ static void usage(void) {
             "  scripts/report.py FILE.jsonl report/ writes report/accuracy.md and plots\n");
 }
 
+/* The jobs of the run (the quick set with --quick) that the filter keeps, longest first in
+ * run_jobs; returns their count. */
+static int build_jobs(job_t jobs[64], const char* filter) {
+    int count = 0;
+    const resolution_t* resolutions = g_quick ? kQuickResolutions : kResolutions;
+    const int resolution_count = g_quick ? (int)(sizeof kQuickResolutions / sizeof kQuickResolutions[0])
+                                         : (int)(sizeof kResolutions / sizeof kResolutions[0]);
+    static const double kMaterialCost[kMaterialCount] = {1.0, 1.5, 3.5, 1.5};
+    for (int r = 0; r < resolution_count; ++r)
+        for (int m = 0; m < kMaterialCount; ++m) {
+            job_t j = {kJobDynamic, &resolutions[r], &kMaterials[m], resolutions[r].ny,
+                       kMaterialCost[m] * pow(8.0, resolutions[r].ny)};
+            jobs[count++] = j;
+        }
+    {
+        const int* nys = g_quick ? kQuickStaticNy : kStaticNy;
+        const int ny_count = g_quick ? (int)(sizeof kQuickStaticNy / sizeof kQuickStaticNy[0])
+                                     : (int)(sizeof kStaticNy / sizeof kStaticNy[0]);
+        for (int k = 0; k < ny_count; ++k) {
+            job_t j = {kJobStaticEb, NULL, NULL, nys[k], 0.01 * nys[k] * nys[k] * nys[k]};
+            jobs[count++] = j;
+        }
+        job_t j = {kJobStaticNonlinear, NULL, NULL, g_quick ? 2 : kNonlinearNy, 10.0};
+        jobs[count++] = j;
+    }
+    {
+        job_t j = {kJobOscillator, NULL, NULL, 0, 1.0};
+        jobs[count++] = j;
+    }
+    if (filter) { /* keep the matching jobs */
+        int kept = 0;
+        for (int j = 0; j < count; ++j) {
+            char name[128];
+            job_name(&jobs[j], name, sizeof name);
+            if (strstr(name, filter)) jobs[kept++] = jobs[j];
+        }
+        count = kept;
+    }
+    return count;
+}
+
+/* The run's first line: the version, the parameters every study shares and the load. */
+static void print_meta(int workers, double load_before) {
+    printf("{\"study\":\"meta\",\"version\":%d,\"quick\":%d,\"jobs\":%d", (int)sh_version(), g_quick, workers);
+    jnum(stdout, "length_m", kLength);
+    jnum(stdout, "side_m", kSide);
+    jnum(stdout, "young_Pa", kYoung);
+    jnum(stdout, "poisson", kPoisson);
+    jnum(stdout, "density", kDensity);
+    jnum(stdout, "gravity", kGravity);
+    jnum(stdout, "damping_mass", kAlpha);
+    jnum(stdout, "damping_stiffness", kBeta);
+    jnum(stdout, "end_time", kEndTime);
+    fprintf(stdout, ",\"reference_factor\":%d", kRefFactor);
+    jnum(stdout, "newton_tolerance", kNewtonTolerance);
+    jnum(stdout, "osc_omega", sqrt(kOscStiffness / kOscMass));
+    jnum(stdout, "osc_end_time", kOscEndTime);
+    jnum(stdout, "loadavg_before", load_before);
+    fprintf(stdout, ",\"cholmod\":%d}\n", (sh_build_features() & SH_FEATURE_CHOLMOD) ? 1 : 0);
+}
+
 int run_accuracy(int argc, char** argv) {
     int workers = 2;
     const char* filter = NULL;
@@ -803,60 +879,10 @@ int run_accuracy(int argc, char** argv) {
     }
 
     job_t jobs[64];
-    int count = 0;
-    const resolution_t* resolutions = g_quick ? kQuickResolutions : kResolutions;
-    const int resolution_count = g_quick ? (int)(sizeof kQuickResolutions / sizeof kQuickResolutions[0])
-                                         : (int)(sizeof kResolutions / sizeof kResolutions[0]);
-    static const double kMaterialCost[kMaterialCount] = {1.0, 1.5, 3.5, 1.5};
-    for (int r = 0; r < resolution_count; ++r)
-            for (int m = 0; m < kMaterialCount; ++m) {
-                job_t j = {kJobDynamic, &resolutions[r], &kMaterials[m], resolutions[r].ny,
-                           kMaterialCost[m] * pow(8.0, resolutions[r].ny)};
-                jobs[count++] = j;
-            }
-    {
-        const int* nys = g_quick ? kQuickStaticNy : kStaticNy;
-        const int ny_count = g_quick ? (int)(sizeof kQuickStaticNy / sizeof kQuickStaticNy[0])
-                                     : (int)(sizeof kStaticNy / sizeof kStaticNy[0]);
-        for (int k = 0; k < ny_count; ++k) {
-            job_t j = {kJobStaticEb, NULL, NULL, nys[k], 0.01 * nys[k] * nys[k] * nys[k]};
-            jobs[count++] = j;
-        }
-        job_t j = {kJobStaticNonlinear, NULL, NULL, g_quick ? 2 : kNonlinearNy, 10.0};
-        jobs[count++] = j;
-    }
-    {
-        job_t j = {kJobOscillator, NULL, NULL, 0, 1.0};
-        jobs[count++] = j;
-    }
-    if (filter) { /* keep the matching jobs */
-        int kept = 0;
-        for (int j = 0; j < count; ++j) {
-            char name[128];
-            job_name(&jobs[j], name, sizeof name);
-            if (strstr(name, filter)) jobs[kept++] = jobs[j];
-        }
-        count = kept;
-    }
-
+    const int count = build_jobs(jobs, filter);
     const double load_before = load_average();
     const double start = now_s();
-    printf("{\"study\":\"meta\",\"version\":%d,\"quick\":%d,\"jobs\":%d", (int)sh_version(), g_quick, workers);
-    jnum(stdout, "length_m", kLength);
-    jnum(stdout, "side_m", kSide);
-    jnum(stdout, "young_Pa", kYoung);
-    jnum(stdout, "poisson", kPoisson);
-    jnum(stdout, "density", kDensity);
-    jnum(stdout, "gravity", kGravity);
-    jnum(stdout, "damping_mass", kAlpha);
-    jnum(stdout, "damping_stiffness", kBeta);
-    jnum(stdout, "end_time", kEndTime);
-    fprintf(stdout, ",\"reference_factor\":%d", kRefFactor);
-    jnum(stdout, "newton_tolerance", kNewtonTolerance);
-    jnum(stdout, "osc_omega", sqrt(kOscStiffness / kOscMass));
-    jnum(stdout, "osc_end_time", kOscEndTime);
-    jnum(stdout, "loadavg_before", load_before);
-    fprintf(stdout, ",\"cholmod\":%d}\n", (sh_build_features() & SH_FEATURE_CHOLMOD) ? 1 : 0);
+    print_meta(workers, load_before);
     const int failed = run_jobs(jobs, count, workers);
     const double total = now_s() - start;
     printf("{\"study\":\"meta_end\"");

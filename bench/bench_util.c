@@ -1,4 +1,4 @@
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* sched_getcpu, sched_setaffinity */
 #include "bench_util.h"
 
 #include <math.h>
@@ -6,6 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#ifdef __linux__
+#include <sched.h>
+#endif
 
 #ifndef SOFTHAP_BENCH_MESH_DIR
 #define SOFTHAP_BENCH_MESH_DIR "../shared/meshes"
@@ -65,6 +68,18 @@ stats summarize(double* v, int n) {
 
 double norm3(const double* a) { return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
 
+double distance3(const double* a, const double* b) {
+    const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    return norm3(d);
+}
+
+void triangle_cross(const double* a, const double* b, const double* c, double n[3]) {
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    n[0] = u[1] * v[2] - u[2] * v[1];
+    n[1] = u[2] * v[0] - u[0] * v[2];
+    n[2] = u[0] * v[1] - u[1] * v[0];
+}
+
 int name_matches(const char* name, const char* filter) { return !filter || strstr(name, filter) != NULL; }
 
 int bench_filter_arg(const char* arg, const char** filter, void (*usage)(void)) {
@@ -94,6 +109,7 @@ const char* bench_find_mesh_dir(const char* given, const char* probe) {
     const char* candidates[] = {getenv("SOFTHAP_MESHES"), SOFTHAP_BENCH_MESH_DIR, "../shared/meshes", "../../shared/meshes"};
     for (size_t k = 0; k < sizeof candidates / sizeof candidates[0]; ++k)
         if (candidates[k] && file_exists(candidates[k], probe)) return candidates[k];
+    fprintf(stderr, "softhap_bench: meshes not found; pass --meshes DIR\n");
     return NULL;
 }
 
@@ -117,8 +133,8 @@ int bench_load_scaled_mesh(const char* dir, const char* file, const double* turn
     const int32_t n = info.node_count, t = info.tet_count;
     double* nodes = (double*)xmalloc(sizeof(double) * 3 * (size_t)n);
     int32_t* tets = (int32_t*)xmalloc(sizeof(int32_t) * 4 * (size_t)t);
-    CHECK(sh_mesh_get_nodes(raw, nodes, 3 * (int64_t)n));
-    CHECK(sh_mesh_get_tets(raw, tets, 4 * (int64_t)t));
+    CHECK(sh_mesh_get_nodes(raw, nodes, n));
+    CHECK(sh_mesh_get_tets(raw, tets, t));
     CHECK(sh_mesh_destroy(raw));
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
@@ -150,4 +166,73 @@ int bench_load_scaled_mesh(const char* dir, const char* file, const double* turn
     free(tets);
     *out_nodes = nodes;
     return 1;
+}
+
+int32_t* bench_surface_triangles(const sh_mesh* mesh, int32_t* out_count) {
+    sh_mesh_info info;
+    CHECK(sh_mesh_get_info(mesh, &info));
+    int32_t* tris = (int32_t*)xmalloc(sizeof(int32_t) * 3 * (size_t)info.surface_triangle_count);
+    CHECK(sh_mesh_get_surface_triangles(mesh, tris, info.surface_triangle_count));
+    *out_count = info.surface_triangle_count;
+    return tris;
+}
+
+sh_world* bench_world_create(int gravity) {
+    sh_world_def wd;
+    sh_world_def_default(&wd);
+    if (!gravity) wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0.0;
+    sh_world* world = NULL;
+    CHECK(sh_world_create(&wd, &world));
+    return world;
+}
+
+sh_fem_body_def bench_fem_body_def(const sh_mesh* mesh, sh_material_model model, double young, double poisson,
+                                   double density) {
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.material.model = model;
+    def.material.young = young;
+    def.material.poisson = poisson;
+    def.material.density = density;
+    return def;
+}
+
+sh_collider_def bench_sphere_def(double radius, const double position[3]) {
+    sh_collider_def def;
+    sh_collider_def_default(&def);
+    def.shape.kind = SH_SHAPE_SPHERE;
+    def.shape.radius = radius;
+    for (int k = 0; k < 3; ++k) def.position[k] = position[k];
+    return def;
+}
+
+int bench_current_cpu(void) {
+#ifdef __linux__
+    return sched_getcpu();
+#else
+    return -1;
+#endif
+}
+
+void bench_pin_thread(int cpu) {
+#ifdef __linux__
+    if (cpu < 0) return;
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    sched_setaffinity(0, sizeof set, &set); /* 0: the calling thread */
+#else
+    (void)cpu;
+#endif
+}
+
+double bench_load_average(double unknown) {
+    double load = unknown;
+    FILE* f = fopen("/proc/loadavg", "r");
+    if (f) {
+        if (fscanf(f, "%lf", &load) != 1) load = unknown;
+        fclose(f);
+    }
+    return load;
 }

@@ -1,5 +1,6 @@
 /* Helpers shared by the softhap_bench subcommands: a fatal status check, a monotonic clock,
- * order statistics of timing samples, case filters and names, the mesh folder and meshes. */
+ * order statistics of timing samples, case filters and names, the mesh folder and meshes, the
+ * defs of the bodies and tools the benches build, and CPU pinning. */
 #ifndef SOFTHAP_BENCH_UTIL_H
 #define SOFTHAP_BENCH_UTIL_H
 
@@ -39,6 +40,12 @@ stats summarize(double* v, int n);
 /* Euclidean length of a 3-vector. */
 double norm3(const double* a);
 
+/* Distance between the points a and b. */
+double distance3(const double* a, const double* b);
+
+/* (b - a) x (c - a): the normal of triangle abc (its length twice the area), not normalised. */
+void triangle_cross(const double* a, const double* b, const double* c, double n[3]);
+
 /* 1 if a case named name is wanted: no filter, or name contains filter. */
 int name_matches(const char* name, const char* filter);
 
@@ -51,7 +58,8 @@ int bench_filter_arg(const char* arg, const char** filter, void (*usage)(void));
 const char* material_name(sh_material_model model);
 
 /* The mesh folder: given if not NULL, else the first of $SOFTHAP_MESHES, the build's default,
- * ../shared/meshes and ../../shared/meshes that holds probe (a file name). NULL if none. */
+ * ../shared/meshes and ../../shared/meshes that holds probe (a file name). NULL, with a message
+ * on stderr, if none does. */
 const char* bench_find_mesh_dir(const char* given, const char* probe);
 
 /* Loads dir/file as it is; NULL with a message on stderr if it does not load. */
@@ -64,5 +72,31 @@ sh_mesh* bench_load_mesh(const char* dir, const char* file);
  * a message on stderr if the file does not load. */
 int bench_load_scaled_mesh(const char* dir, const char* file, const double* turn, double size, sh_mesh** out_mesh,
                            double** out_nodes);
+
+/* The mesh's surface triangles (3 node indices each, outward; caller frees), their count in
+ * *out_count. */
+int32_t* bench_surface_triangles(const sh_mesh* mesh, int32_t* out_count);
+
+/* A world with gravity off (so that a tool's force is the contact alone) if !gravity, else the
+ * default world (gravity -9.81 m/s^2 along z). */
+sh_world* bench_world_create(int gravity);
+
+/* The default FEM body def for mesh with an isotropic material of the given model, Young's
+ * modulus (Pa), Poisson ratio and density (kg/m^3); the caller sets the rest. */
+sh_fem_body_def bench_fem_body_def(const sh_mesh* mesh, sh_material_model model, double young, double poisson,
+                                   double density);
+
+/* The default collider def of a sphere of radius (m) centred at position. */
+sh_collider_def bench_sphere_def(double radius, const double position[3]);
+
+/* The CPU the calling thread runs on; -1 where unknown (or not Linux). */
+int bench_current_cpu(void);
+
+/* Pins the calling thread to cpu (Linux; nothing if cpu < 0 or elsewhere), so that its cache and
+ * timings stay put. */
+void bench_pin_thread(int cpu);
+
+/* The 1-minute load average from /proc/loadavg; unknown if it cannot be read. */
+double bench_load_average(double unknown);
 
 #endif

@@ -106,8 +106,8 @@ static int press_triangle(const double* x, const int32_t* tris, int32_t count, c
         const double* a = &x[3 * tris[3 * t]];
         const double* b = &x[3 * tris[3 * t + 1]];
         const double* c = &x[3 * tris[3 * t + 2]];
-        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        double n[3];
+        triangle_cross(a, b, c, n);
         const double length = norm3(n);
         for (int k = 0; k < 3; ++k) n[k] /= length;
         if (!(n[2] > kLevelNormalZ)) continue;
@@ -136,12 +136,12 @@ static int load_liver(const char* dir, liver* l) {
     l->node_count = info.node_count;
     l->tet_count = info.tet_count;
     double* x = (double*)xmalloc(sizeof(double) * 3 * (size_t)info.node_count);
-    int32_t* tris = (int32_t*)xmalloc(sizeof(int32_t) * 3 * (size_t)info.surface_triangle_count);
-    CHECK(sh_mesh_get_nodes(l->mesh, x, 3 * (int64_t)info.node_count));
-    CHECK(sh_mesh_get_surface_triangles(l->mesh, tris, 3 * (int64_t)info.surface_triangle_count));
+    CHECK(sh_mesh_get_nodes(l->mesh, x, info.node_count));
+    int32_t tri_count;
+    int32_t* tris = bench_surface_triangles(l->mesh, &tri_count);
     double base[3], centroid[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 1.0};
     fix_base(x, info.node_count, l, base);
-    const int found = press_triangle(x, tris, info.surface_triangle_count, base, centroid, normal);
+    const int found = press_triangle(x, tris, tri_count, base, centroid, normal);
     free(x);
     free(tris);
     if (!found) {
@@ -162,24 +162,13 @@ static void free_liver(liver* l) {
 /* A world without gravity holding the liver as one implicit-Euler body of the given model, its
  * base fixed, and the sphere tool at l->start (its id in *tool). */
 static sh_world* make_world(const liver* l, sh_material_model model, sh_tool_id* tool) {
-    sh_world_def wd;
-    sh_world_def_default(&wd);
-    wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0.0;
-    sh_world* world = NULL;
-    CHECK(sh_world_create(&wd, &world));
-    sh_fem_body_def def;
-    sh_fem_body_def_default(&def);
-    def.mesh = l->mesh;
-    def.material = (sh_material){.model = model, .young = kYoung, .poisson = kPoisson, .density = kDensity};
+    sh_world* world = bench_world_create(0);
+    sh_fem_body_def def = bench_fem_body_def(l->mesh, model, kYoung, kPoisson, kDensity);
     def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
     sh_body_id body;
-    CHECK(sh_world_add_fem_body(world, &def, &body));
+    CHECK(sh_fem_body_create(world, &def, &body));
     CHECK(sh_body_fix_nodes(world, body, l->fixed, l->fixed_count));
-    sh_collider_def td;
-    sh_collider_def_default(&td);
-    td.shape.kind = SH_SHAPE_SPHERE;
-    td.shape.radius = kToolRadius;
-    for (int k = 0; k < 3; ++k) td.position[k] = l->start[k];
+    sh_collider_def td = bench_sphere_def(kToolRadius, l->start);
     td.contact.stiffness = kToolStiffness;
     td.contact.exponent = kToolExponent;
     td.contact.static_friction = td.contact.dynamic_friction = kToolFriction;
@@ -296,10 +285,7 @@ int run_palpation(int argc, char** argv) {
         }
     }
     const char* dir = bench_find_mesh_dir(given_dir, kMeshFile);
-    if (!dir) {
-        fprintf(stderr, "softhap_bench: meshes not found; pass --meshes DIR\n");
-        return 1;
-    }
+    if (!dir) return 1;
     liver l;
     if (!load_liver(dir, &l)) return 1;
     fprintf(stderr, "palpation: %s/%s: %d nodes, %d tets, %d fixed; tool starts at (%.4f, %.4f, %.4f) m\n", dir,

@@ -24,7 +24,7 @@
  *
  * Public API only; C99 (plus POSIX clocks and, on Linux, pinning to the current CPU).
  */
-#define _GNU_SOURCE
+#define _GNU_SOURCE /* M_PI */
 #include <softhap/softhap.h>
 
 #include "accuracy.h"
@@ -37,9 +37,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#ifdef __linux__
-#include <sched.h>
-#endif
 
 #ifndef SOFTHAP_BENCH_MESH_DIR
 #define SOFTHAP_BENCH_MESH_DIR "../shared/meshes"
@@ -101,13 +98,9 @@ static int load_mesh_file(const char* file, const char* name, bench_mesh* m) {
 
     m->edge_count = m->info.edge_count;
     int32_t* edges = (int32_t*)xmalloc(sizeof(int32_t) * 2 * (size_t)m->edge_count);
-    CHECK(sh_mesh_get_edges(m->mesh, edges, 2 * (int64_t)m->edge_count));
+    CHECK(sh_mesh_get_edges(m->mesh, edges, m->edge_count));
     double sum = 0.0;
-    for (int32_t e = 0; e < m->edge_count; ++e) {
-        const double* a = &nodes[3 * edges[2 * e]];
-        const double* b = &nodes[3 * edges[2 * e + 1]];
-        sum += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-    }
+    for (int32_t e = 0; e < m->edge_count; ++e) sum += distance3(&nodes[3 * edges[2 * e]], &nodes[3 * edges[2 * e + 1]]);
     m->mean_edge = sum / m->edge_count;
     free(edges);
     return 1;
@@ -140,18 +133,12 @@ static const body_kind kKinds[] = {{"linear", SH_MATERIAL_LINEAR},
 
 static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_integrator integrator,
                            const sh_implicit_settings* implicit) {
-    sh_body_id body = SH_NULL_BODY;
+    sh_body_id body = SH_NULL_ID;
     if (model >= 0) {
-        sh_fem_body_def def;
-        sh_fem_body_def_default(&def);
-        def.mesh = m->mesh;
-        def.material.model = (sh_material_model)model;
-        def.material.young = kYoung;
-        def.material.poisson = kPoisson;
-        def.material.density = kDensity;
+        sh_fem_body_def def = bench_fem_body_def(m->mesh, (sh_material_model)model, kYoung, kPoisson, kDensity);
         def.integrator = integrator;
         if (implicit) def.implicit = *implicit;
-        CHECK(sh_world_add_fem_body(world, &def, &body));
+        CHECK(sh_fem_body_create(world, &def, &body));
     } else {
         /* A rod of section l^2 and length l has axial stiffness E l; nodes share the mass. */
         sh_spring_body_def def;
@@ -162,7 +149,7 @@ static sh_body_id add_body(sh_world* world, const bench_mesh* m, int model, sh_i
         def.node_mass = kDensity * m->info.volume / (m->info.node_count - m->info.orphan_node_count);
         def.integrator = integrator;
         if (implicit) def.implicit = *implicit;
-        CHECK(sh_world_add_spring_body(world, &def, &body));
+        CHECK(sh_spring_body_create(world, &def, &body));
     }
     CHECK(sh_body_fix_nodes(world, body, m->fixed, m->fixed_count));
     return body;
@@ -224,14 +211,12 @@ static timing time_steps(sh_world* world, double dt, int with_report, double bud
         if (st != SH_OK) ++t.failed;
         if (with_report && report.substeps > t.substeps) t.substeps = report.substeps;
     }
-    double sum = 0.0;
-    for (int s = 0; s < t.steps; ++s) sum += ns[s];
-    qsort(ns, (size_t)t.steps, sizeof(double), cmp_double);
-    t.mean_ns = sum / t.steps;
+    const stats st = summarize(ns, t.steps); /* sorts ns */
+    t.mean_ns = st.mean;
     t.min_ns = ns[0];
-    t.median_ns = median(ns, t.steps);
-    t.p99_ns = quantile(ns, t.steps, 0.99);
-    t.p999_ns = quantile(ns, t.steps, 0.999);
+    t.median_ns = st.median;
+    t.p99_ns = st.p99;
+    t.p999_ns = st.p999;
     free(ns);
     CHECK(sh_world_step(world, dt, &report));
     t.last = report;
@@ -268,10 +253,7 @@ static void run_case(const bench_mesh* m, const body_kind* kind, const char* fil
     snprintf(name[1], sizeof name[1], "%s+report/%s", kind->name, m->name);
     for (int with_report = 0; with_report < 2; ++with_report) {
         if (!name_matches(name[with_report], filter)) continue;
-        sh_world_def wd;
-        sh_world_def_default(&wd);
-        sh_world* world = NULL;
-        CHECK(sh_world_create(&wd, &world));
+        sh_world* world = bench_world_create(1);
         const sh_body_id body = add_body(world, m, kind->model, SH_INTEGRATOR_SYMPLECTIC_EULER, NULL);
         const double dt = kDtFraction * body_dt_crit(world, body);
         const timing t = time_steps(world, dt, with_report, with_report ? kReportSeconds : kCaseSeconds, NULL);
@@ -299,10 +281,7 @@ static void run_integrators(const char* filter) {
         char name[256];
         snprintf(name, sizeof name, "integrator/%s/stvk/%s", kIntegrators[k].name, m.name);
         if (!name_matches(name, filter)) continue;
-        sh_world_def wd;
-        sh_world_def_default(&wd);
-        sh_world* world = NULL;
-        CHECK(sh_world_create(&wd, &world));
+        sh_world* world = bench_world_create(1);
         const sh_body_id body = add_body(world, &m, SH_MATERIAL_STVK, kIntegrators[k].integrator, NULL);
         const double dt = 0.1 * body_dt_crit(world, body);
         const reset_plan reset = {body, &m, zeros, 200};
@@ -332,77 +311,102 @@ static void set_ramp_gravity(sh_world* world, double t) {
     CHECK(sh_world_set_gravity(world, g));
 }
 
+/* The implicit settings of the body def's defaults with the given linear solver (and
+ * --factor-reuse, if given). */
+static sh_implicit_settings implicit_settings(sh_linear_solver solver) {
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    sh_implicit_settings implicit = def.implicit;
+    implicit.linear_solver = solver;
+    if (g_factor_reuse >= 0.0) implicit.factor_reuse = g_factor_reuse;
+    return implicit;
+}
+
+/* Per-step samples of one implicit case. */
+typedef struct {
+    double* wall; /* ns per step, after the first */
+    double factorize, solve, first_step; /* s, s, ns */
+    int factorizations, failed;
+    long linear_iterations;
+} implicit_run;
+
+/* The first step (the solver's analysis, kept apart), then steps timed steps; ramp: gravity
+ * follows set_ramp_gravity. */
+static void step_implicit(sh_world* world, int ramp, int steps, const char* name, implicit_run* r) {
+    sh_step_report report;
+    for (int s = -1; s < steps; ++s) {
+        if (ramp) set_ramp_gravity(world, (s + 1) * kImplicitDt);
+        const double t0 = now_ns();
+        const sh_status st = sh_world_step(world, kImplicitDt, &report);
+        const double ns = now_ns() - t0;
+        if (st != SH_OK) {
+            if (!r->failed) fprintf(stderr, "softhap_bench: %s step %d: %s\n", name, s, sh_last_error_message());
+            ++r->failed;
+        }
+        if (s < 0) {
+            r->first_step = ns;
+            continue;
+        }
+        r->wall[s] = ns;
+        r->factorize += report.factorize_seconds;
+        r->solve += report.solve_seconds;
+        r->factorizations += report.factorize_seconds > 0.0;
+        r->linear_iterations += report.linear_iterations;
+    }
+}
+
+/* An implicit case's JSON line (sorts the step times). */
+static void print_implicit(const char* name, const bench_mesh* m, int steps, implicit_run* r) {
+    double sum = 0.0;
+    for (int s = 0; s < steps; ++s) sum += r->wall[s];
+    const stats t = summarize(r->wall, steps);
+    printf("{\"case\":\"%s\",\"tets\":%d,\"dofs\":%d,\"dt\":%g,\"median_ms\":%.3f,\"p99_ms\":%.3f,"
+           "\"p999_ms\":%.3f,\"max_ms\":%.3f,\"mean_ms\":%.3f,\"min_ms\":%.3f,\"factorize_ms_mean\":%.3f,"
+           "\"solve_ms_mean\":%.3f,\"other_ms_mean\":%.3f,\"factorizations\":%d,\"linear_iterations_mean\":%.2f,"
+           "\"first_step_ms\":%.1f,\"steps\":%d,\"failed_steps\":%d}\n",
+           name, m->info.tet_count, 3 * (m->info.node_count - m->info.orphan_node_count - m->fixed_count), kImplicitDt,
+           t.median * 1e-6, t.p99 * 1e-6, t.p999 * 1e-6, t.max * 1e-6, t.mean * 1e-6, r->wall[0] * 1e-6,
+           r->factorize / steps * 1e3, r->solve / steps * 1e3, (sum * 1e-9 - r->factorize - r->solve) / steps * 1e3,
+           r->factorizations, (double)r->linear_iterations / steps, r->first_step * 1e-6, steps, r->failed);
+    fflush(stdout);
+}
+
+/* One scenario, body kind and linear solver in a fresh world. */
+static void implicit_case(const bench_mesh* m, const char* scenario, const body_kind* kind, sh_linear_solver solver,
+                          const char* name, int steps) {
+    sh_world* world = bench_world_create(1);
+    const sh_implicit_settings implicit = implicit_settings(solver);
+    add_body(world, m, kind->model, SH_INTEGRATOR_IMPLICIT_EULER, &implicit);
+    implicit_run r;
+    memset(&r, 0, sizeof r);
+    r.wall = (double*)xmalloc(sizeof(double) * (size_t)steps);
+    step_implicit(world, strcmp(scenario, "ramp") == 0, steps, name, &r);
+    print_implicit(name, m, steps, &r);
+    free(r.wall);
+    CHECK(sh_world_destroy(world));
+}
+
+/* Every wanted scenario, body kind and linear solver (CHOLMOD where built in). */
 static void run_implicit(const char* filter) {
     static const struct {
         const char* name;
         sh_linear_solver solver;
     } kSolvers[] = {{"cholmod", SH_LINEAR_SOLVER_CHOLMOD}, {"ldlt", SH_LINEAR_SOLVER_LDLT}, {"cg", SH_LINEAR_SOLVER_CG}};
+    static const char* const kScenarios[] = {"swing", "ramp"};
     const int steps = g_steps > 0 ? g_steps : 100;
     bench_mesh m;
     if (!load_mesh("raptorTetra_19409", &m)) exit(1);
-    static const char* const kScenarios[] = {"swing", "ramp"};
     for (size_t c = 0; c < sizeof kScenarios / sizeof kScenarios[0]; ++c)
-    for (size_t j = 0; j < sizeof kKinds / sizeof kKinds[0]; ++j) {
-        for (size_t k = 0; k < sizeof kSolvers / sizeof kSolvers[0]; ++k) {
-            char name[256];
-            snprintf(name, sizeof name, "implicit/%s/%s/%s/%s", kScenarios[c], kKinds[j].name, kSolvers[k].name, m.name);
-            if (!name_matches(name, filter)) continue;
-            if (kSolvers[k].solver == SH_LINEAR_SOLVER_CHOLMOD && !(sh_build_features() & SH_FEATURE_CHOLMOD)) continue;
-            sh_world_def wd;
-            sh_world_def_default(&wd);
-            sh_world* world = NULL;
-            CHECK(sh_world_create(&wd, &world));
-            sh_implicit_settings implicit;
-            {   /* the body def's defaults, with the solver chosen */
-                sh_fem_body_def def;
-                sh_fem_body_def_default(&def);
-                implicit = def.implicit;
-            }
-            implicit.linear_solver = kSolvers[k].solver;
-            if (g_factor_reuse >= 0.0) implicit.factor_reuse = g_factor_reuse;
-            add_body(world, &m, kKinds[j].model, SH_INTEGRATOR_IMPLICIT_EULER, &implicit);
-            const int ramp = strcmp(kScenarios[c], "ramp") == 0;
-            double* wall = (double*)xmalloc(sizeof(double) * (size_t)steps);
-            double factorize = 0.0, solve = 0.0, first_step = 0.0;
-            int factorizations = 0, failed = 0;
-            long linear_iterations = 0;
-            sh_step_report report;
-            for (int s = -1; s < steps; ++s) { /* step -1: first step (analysis), reported apart */
-                if (ramp) set_ramp_gravity(world, (s + 1) * kImplicitDt);
-                const double t0 = now_ns();
-                const sh_status st = sh_world_step(world, kImplicitDt, &report);
-                const double ns = now_ns() - t0;
-                if (st != SH_OK) {
-                    if (!failed) fprintf(stderr, "softhap_bench: %s step %d: %s\n", name, s, sh_last_error_message());
-                    ++failed;
-                }
-                if (s < 0) {
-                    first_step = ns;
+        for (size_t j = 0; j < sizeof kKinds / sizeof kKinds[0]; ++j)
+            for (size_t k = 0; k < sizeof kSolvers / sizeof kSolvers[0]; ++k) {
+                char name[256];
+                snprintf(name, sizeof name, "implicit/%s/%s/%s/%s", kScenarios[c], kKinds[j].name, kSolvers[k].name,
+                         m.name);
+                if (!name_matches(name, filter)) continue;
+                if (kSolvers[k].solver == SH_LINEAR_SOLVER_CHOLMOD && !(sh_build_features() & SH_FEATURE_CHOLMOD))
                     continue;
-                }
-                wall[s] = ns;
-                factorize += report.factorize_seconds;
-                solve += report.solve_seconds;
-                factorizations += report.factorize_seconds > 0.0;
-                linear_iterations += report.linear_iterations;
+                implicit_case(&m, kScenarios[c], &kKinds[j], kSolvers[k].solver, name, steps);
             }
-            double sum = 0.0;
-            for (int s = 0; s < steps; ++s) sum += wall[s];
-            qsort(wall, (size_t)steps, sizeof(double), cmp_double);
-            printf("{\"case\":\"%s\",\"tets\":%d,\"dofs\":%d,\"dt\":%g,\"median_ms\":%.3f,\"p99_ms\":%.3f,"
-                   "\"p999_ms\":%.3f,\"max_ms\":%.3f,\"mean_ms\":%.3f,\"min_ms\":%.3f,\"factorize_ms_mean\":%.3f,"
-                   "\"solve_ms_mean\":%.3f,\"other_ms_mean\":%.3f,\"factorizations\":%d,\"linear_iterations_mean\":%.2f,"
-                   "\"first_step_ms\":%.1f,\"steps\":%d,\"failed_steps\":%d}\n",
-                   name, m.info.tet_count, 3 * (m.info.node_count - m.info.orphan_node_count - m.fixed_count), kImplicitDt,
-                   median(wall, steps) * 1e-6, quantile(wall, steps, 0.99) * 1e-6, quantile(wall, steps, 0.999) * 1e-6,
-                   wall[steps - 1] * 1e-6, sum / steps * 1e-6, wall[0] * 1e-6, factorize / steps * 1e3,
-                   solve / steps * 1e3, (sum * 1e-9 - factorize - solve) / steps * 1e3, factorizations,
-                   (double)linear_iterations / steps, first_step * 1e-6, steps, failed);
-            fflush(stdout);
-            free(wall);
-            CHECK(sh_world_destroy(world));
-        }
-    }
     free_mesh(&m);
 }
 
@@ -438,58 +442,50 @@ typedef struct {
     double dt;
 } contact_run;
 
+/* The table under m's body and the tool pressed into its highest surface node (see above); the
+ * tool's id, and its centre in position. */
+static sh_tool_id add_table_and_tool(sh_world* world, const bench_mesh* m, double position[3]) {
+    sh_collider_def table;
+    sh_collider_def_default(&table);
+    table.shape.kind = SH_SHAPE_PLANE; /* normal +z */
+    table.position[2] = kContactTablePress;
+    table.contact.stiffness = kContactStiffness;
+    table.contact.damping = 0.0;
+    table.contact.static_friction = 0.5;
+    table.contact.dynamic_friction = 0.4;
+    sh_obstacle_id obstacle;
+    CHECK(sh_obstacle_create(world, &table, &obstacle));
+
+    int32_t tri_count;
+    int32_t* tris = bench_surface_triangles(m->mesh, &tri_count);
+    int32_t top = tris[0];
+    for (int32_t i = 1; i < 3 * tri_count; ++i)
+        if (m->rest[3 * tris[i] + 2] > m->rest[3 * top + 2]) top = tris[i];
+    free(tris);
+    for (int c = 0; c < 3; ++c) position[c] = m->rest[3 * top + c];
+    position[2] += kContactToolRadius - kContactToolPress;
+    sh_collider_def tool_def = bench_sphere_def(kContactToolRadius, position);
+    tool_def.contact.stiffness = kContactStiffness;
+    tool_def.contact.damping = 0.0;
+    tool_def.contact.static_friction = 0.3;
+    tool_def.contact.dynamic_friction = 0.2;
+    sh_tool_id tool = SH_NULL_ID;
+    CHECK(sh_tool_create(world, &tool_def, &tool));
+    return tool;
+}
+
 /* Steps m's body (with the table and the tool if colliders) and fills r. */
 static void run_contact_world(const bench_mesh* m, int colliders, int steps, const char* name, contact_run* r) {
-    sh_world_def wd;
-    sh_world_def_default(&wd);
-    sh_world* world = NULL;
-    CHECK(sh_world_create(&wd, &world));
-    sh_fem_body_def def;
-    sh_fem_body_def_default(&def);
-    def.mesh = m->mesh;
-    def.material.model = SH_MATERIAL_STVK;
-    def.material.young = kYoung;
-    def.material.poisson = kPoisson;
-    def.material.density = kDensity;
+    sh_world* world = bench_world_create(1);
+    sh_fem_body_def def = bench_fem_body_def(m->mesh, SH_MATERIAL_STVK, kYoung, kPoisson, kDensity);
     def.integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
     def.on_unstable = SH_UNSTABLE_SUBSTEP;
     sh_body_id body;
-    CHECK(sh_world_add_fem_body(world, &def, &body));
+    CHECK(sh_fem_body_create(world, &def, &body));
     r->dt = kDtFraction * body_dt_crit(world, body);
-
-    sh_tool_id tool = 0;
-    sh_collider_def tool_def;
-    sh_collider_def_default(&tool_def);
-    if (colliders) {
-        sh_collider_def table;
-        sh_collider_def_default(&table);
-        table.shape.kind = SH_SHAPE_PLANE; /* normal +z */
-        table.position[2] = kContactTablePress;
-        table.contact.stiffness = kContactStiffness;
-        table.contact.damping = 0.0;
-        table.contact.static_friction = 0.5;
-        table.contact.dynamic_friction = 0.4;
-        sh_obstacle_id obstacle;
-        CHECK(sh_obstacle_create(world, &table, &obstacle));
-
-        /* The highest surface node. */
-        const int32_t tri_count = m->info.surface_triangle_count;
-        int32_t* tris = (int32_t*)xmalloc(sizeof(int32_t) * 3 * (size_t)tri_count);
-        CHECK(sh_mesh_get_surface_triangles(m->mesh, tris, 3 * (int64_t)tri_count));
-        int32_t top = tris[0];
-        for (int32_t i = 1; i < 3 * tri_count; ++i)
-            if (m->rest[3 * tris[i] + 2] > m->rest[3 * top + 2]) top = tris[i];
-        free(tris);
-        tool_def.shape.kind = SH_SHAPE_SPHERE;
-        tool_def.shape.radius = kContactToolRadius;
-        for (int c = 0; c < 3; ++c) tool_def.position[c] = m->rest[3 * top + c];
-        tool_def.position[2] += kContactToolRadius - kContactToolPress;
-        tool_def.contact.stiffness = kContactStiffness;
-        tool_def.contact.damping = 0.0;
-        tool_def.contact.static_friction = 0.3;
-        tool_def.contact.dynamic_friction = 0.2;
-        CHECK(sh_tool_create(world, &tool_def, &tool));
-    }
+    double tool_position[3];
+    sh_tool_id tool = SH_NULL_ID;
+    if (colliders) tool = add_table_and_tool(world, m, tool_position);
     const double orientation[4] = {1.0, 0.0, 0.0, 0.0};
 
     r->wall = (double*)xmalloc(sizeof(double) * (size_t)steps);
@@ -499,7 +495,7 @@ static void run_contact_world(const bench_mesh* m, int colliders, int steps, con
     r->substeps = r->contact_substeps = 1;
     sh_step_report report;
     for (int s = -kWarmupSteps; s < steps; ++s) {
-        if (colliders) CHECK(sh_tool_set_pose(world, tool, tool_def.position, orientation));
+        if (colliders) CHECK(sh_tool_set_pose(world, tool, tool_position, orientation));
         const double t0 = now_ns();
         const sh_status st = sh_world_step(world, r->dt, &report);
         const double ns = now_ns() - t0;
@@ -609,22 +605,9 @@ int main(int argc, char** argv) {
         char probe[256];
         snprintf(probe, sizeof probe, "%s.vtu", kMeshes[0]);
         g_mesh_dir = bench_find_mesh_dir(g_mesh_dir, probe);
-        if (!g_mesh_dir) {
-            fprintf(stderr, "softhap_bench: meshes not found; pass --meshes DIR\n");
-            return 1;
-        }
+        if (!g_mesh_dir) return 1;
     }
-#ifdef __linux__
-    {   /* One core: stay on the CPU we started on, so the cache and timings stay put. */
-        const int cpu = sched_getcpu();
-        if (cpu >= 0) {
-            cpu_set_t set;
-            CPU_ZERO(&set);
-            CPU_SET(cpu, &set);
-            sched_setaffinity(0, sizeof set, &set);
-        }
-    }
-#endif
+    bench_pin_thread(bench_current_cpu()); /* one core: the one we started on */
     if (sh_version() != SH_VERSION) {
         fprintf(stderr, "softhap_bench: library version %d, header %d\n", (int)sh_version(), SH_VERSION);
         return 1;

@@ -181,7 +181,7 @@ typedef struct trace_row {
 } trace_row;
 
 typedef struct run {
-    /* set up by main */
+    /* set up by create_run and create_tool_and_haptic */
     sh_world* world;
     sh_haptic* haptic;
     const liver_path* path;
@@ -237,20 +237,78 @@ static void move_hand(hand* h, const liver_path* path, long tick, double dt, con
     }
 }
 
+/* Asks for SCHED_FIFO (the error, if refused, goes to r->fifo_error) and a 1 ns timer slack,
+ * so that the thread wakes as close to the time asked as it can. */
+static void enter_realtime(run* r) {
+    struct sched_param param;
+    memset(&param, 0, sizeof param);
+    param.sched_priority = kFifoPriority;
+    r->fifo_error = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+}
+
+/* More than two periods late: drops the deadlines passed (counted). The hand moves on through
+ * them holding the last force, as a device holds its last command; the next step covers them.
+ * Returns the ticks dropped. */
+static long drop_missed(run* r, hand* h, long* tick, int64_t late, double dt, const double force[3]) {
+    long missed, j;
+    if (late <= 2 * r->period_ns) return 0;
+    missed = (long)(late / r->period_ns);
+    if (missed > r->ticks - 1 - *tick) missed = r->ticks - 1 - *tick;
+    for (j = 0; j < missed; ++j) move_hand(h, r->path, (*tick)++, dt, force);
+    r->device_missed += missed;
+    return missed;
+}
+
+/* Adds the tick's output to the run's statistics: the force, how deep the hand is below the
+ * touching height, the buffer, contact and faults. */
+static void add_tick_stats(run* r, long tick, double dt, const hand* h, const sh_haptic_output* out) {
+    const double magnitude = sqrt(out->force[0] * out->force[0] + out->force[1] * out->force[1] +
+                                  out->force[2] * out->force[2]);
+    double along, below, touching[3];
+    int k;
+    if (!isfinite(magnitude)) r->bad_force = 1;
+    if (magnitude > r->largest_force) r->largest_force = magnitude;
+    target_at(tick * dt, &along, &below);
+    liver_path_point(r->path, along, 0.0, touching);
+    if (touching[2] - h->x[2] > r->deepest) r->deepest = touching[2] - h->x[2];
+    if (tick * dt <= kPressEnd) {
+        r->press_depth = touching[2] - h->x[2];
+        r->press_force = magnitude;
+    }
+    if (out->buffer_tets > r->most_tets) r->most_tets = out->buffer_tets;
+    if (out->buffer_nodes > r->most_nodes) r->most_nodes = out->buffer_nodes;
+    if (out->substeps > r->most_substeps) r->most_substeps = out->substeps;
+    r->contact_ticks += out->contact;
+    for (k = 0; k < 5; ++k) r->fault_ticks[k] += (out->faults >> k) & 1u;
+}
+
+/* Keeps the tick as a trace row (written after the run: the device thread never prints). */
+static void add_trace_row(run* r, long tick, double dt, const hand* h, const sh_haptic_output* out) {
+    trace_row* row = &r->rows[r->row_count++];
+    int k;
+    row->t = tick * dt;
+    for (k = 0; k < 3; ++k) {
+        row->position[k] = h->x[k];
+        row->force[k] = out->force[k];
+    }
+    row->contact = out->contact;
+    row->buffer_tets = out->buffer_tets;
+    row->data_age = out->data_age;
+    row->faults = out->faults;
+}
+
+/* The device loop: on each deadline, the haptic step renders the force at the hand's position
+ * and the hand moves on under it. */
 static void* device_thread(void* arg) {
     run* r = (run*)arg;
     const double dt = 1.0 / r->rate, identity[4] = {1.0, 0.0, 0.0, 0.0};
-    struct sched_param param;
     double force[3] = {0.0, 0.0, 0.0}, along, below;
     long tick = 0, next_row = 0;
     hand h;
     int k;
 
-    memset(&param, 0, sizeof param);
-    param.sched_priority = kFifoPriority;
-    r->fifo_error = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
-    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL); /* wake as close to the time asked as can be */
-
+    enter_realtime(r);
     memset(&h, 0, sizeof h);
     target_at(0.0, &along, &below);
     liver_path_point(r->path, along, below, h.target);
@@ -258,23 +316,13 @@ static void* device_thread(void* arg) {
     while (tick < r->ticks) {
         const int64_t deadline = r->start_ns + tick * r->period_ns;
         const int64_t woke = wait_for(deadline, kSpinNs);
-        long missed = 0;
         int64_t before, after;
         sh_haptic_output out;
         sh_status status;
-        double touching[3], magnitude;
+        long missed;
 
-        /* More than two periods late: drop the deadlines passed. The hand moves on through
-         * them holding the last force, as a device holds its last command; the next step
-         * covers them. */
         r->lateness[r->executed] = (double)(woke - deadline) * 1e-9;
-        if (woke - deadline > 2 * r->period_ns) {
-            long j;
-            missed = (long)((woke - deadline) / r->period_ns);
-            if (missed > r->ticks - 1 - tick) missed = r->ticks - 1 - tick;
-            for (j = 0; j < missed; ++j) move_hand(&h, r->path, tick++, dt, force);
-            r->device_missed += missed;
-        }
+        missed = drop_missed(r, &h, &tick, woke - deadline, dt, force);
 
         /* The device reads the hand's position, the haptic step renders the force. */
         before = now_ns();
@@ -285,32 +333,9 @@ static void* device_thread(void* arg) {
         for (k = 0; k < 3; ++k) force[k] = out.force[k];
 
         /* Statistics and the trace, at this tick's time. */
-        magnitude = sqrt(force[0] * force[0] + force[1] * force[1] + force[2] * force[2]);
-        if (!isfinite(magnitude)) r->bad_force = 1;
-        if (magnitude > r->largest_force) r->largest_force = magnitude;
-        target_at(tick * dt, &along, &below);
-        liver_path_point(r->path, along, 0.0, touching);
-        if (touching[2] - h.x[2] > r->deepest) r->deepest = touching[2] - h.x[2];
-        if (tick * dt <= kPressEnd) {
-            r->press_depth = touching[2] - h.x[2];
-            r->press_force = magnitude;
-        }
-        if (out.buffer_tets > r->most_tets) r->most_tets = out.buffer_tets;
-        if (out.buffer_nodes > r->most_nodes) r->most_nodes = out.buffer_nodes;
-        if (out.substeps > r->most_substeps) r->most_substeps = out.substeps;
-        r->contact_ticks += out.contact;
-        for (k = 0; k < 5; ++k) r->fault_ticks[k] += (out.faults >> k) & 1u;
+        add_tick_stats(r, tick, dt, &h, &out);
         if (tick >= next_row) {
-            trace_row* row = &r->rows[r->row_count++];
-            row->t = tick * dt;
-            for (k = 0; k < 3; ++k) {
-                row->position[k] = h.x[k];
-                row->force[k] = force[k];
-            }
-            row->contact = out.contact;
-            row->buffer_tets = out.buffer_tets;
-            row->data_age = out.data_age;
-            row->faults = out.faults;
+            add_trace_row(r, tick, dt, &h, &out);
             while (next_row <= tick) next_row += r->decimate;
         }
 
@@ -411,18 +436,20 @@ static void summarise(run* r) {
                 (unsigned long long)warnings[SH_WARN_CAPACITY], (unsigned long long)warnings[SH_WARN_UNSTABLE]);
 }
 
-/* Runs the device at rate (Hz) beside the sim thread for kRunTime, appends the trace to stdout
- * and the summary to stderr. Returns 0 on success. */
-static int run_at(liver_scene* scene, const liver_path* path, double rate, int decimate, int* fifo_noticed) {
+/* Releases the run and its arrays. */
+static void destroy_run(run* r) {
+    free(r->lateness);
+    free(r->step_time);
+    free(r->rows);
+    free(r->model_time);
+    free(r);
+}
+
+/* A run at rate (Hz) on the scene's world, with everything its threads write allocated and
+ * touched beforehand, so that the device thread never faults a page in. NULL if out of memory. */
+static run* create_run(liver_scene* scene, const liver_path* path, double rate, int decimate) {
     run* r = calloc(1, sizeof *r);
-    sh_collider_def tool_def;
-    sh_haptic_def haptic_def;
-    sh_tool_id tool = 0;
-    pthread_t device, sim;
-    double along, below;
-    int ok = 0;
-    long i;
-    if (!r) return 1;
+    if (!r) return NULL;
     r->world = scene->world;
     r->path = path;
     r->rate = rate;
@@ -437,15 +464,22 @@ static int run_at(liver_scene* scene, const liver_path* path, double rate, int d
     atomic_init(&r->device_done, 0);
     if (!r->lateness || !r->step_time || !r->rows || !r->model_time) {
         fprintf(stderr, "haptic_loop: out of memory\n");
-        goto done;
+        destroy_run(r);
+        return NULL;
     }
     touch_pages(r->lateness, (size_t)r->ticks * sizeof(double));
     touch_pages(r->step_time, (size_t)r->ticks * sizeof(double));
     touch_pages(r->rows, (size_t)(r->ticks / decimate + 1) * sizeof(trace_row));
     touch_pages(r->model_time, (size_t)r->model_capacity * sizeof(double));
+    return r;
+}
 
-    /* The liver back to rest, the tool 1 cm above the start, a haptic context on it. */
-    if (liver_scene_reset(scene) != 0) goto done;
+/* The tool 1 cm above the path's start and a haptic context on it (into r->haptic). 0 on
+ * success. */
+static int create_tool_and_haptic(liver_scene* scene, const liver_path* path, run* r, sh_tool_id* tool) {
+    sh_collider_def tool_def;
+    sh_haptic_def haptic_def;
+    double along, below;
     sh_collider_def_default(&tool_def);
     tool_def.shape.kind = SH_SHAPE_SPHERE;
     tool_def.shape.radius = kToolRadius;
@@ -455,40 +489,69 @@ static int run_at(liver_scene* scene, const liver_path* path, double rate, int d
     tool_def.contact.damping = 1.5;   /* s/m */
     tool_def.contact.static_friction = 0.3;
     tool_def.contact.dynamic_friction = 0.2;
-    CHECK(sh_tool_create(scene->world, &tool_def, &tool));
+    CHECK(sh_tool_create(scene->world, &tool_def, tool));
     sh_haptic_def_default(&haptic_def);
-    haptic_def.tool = tool;
-    haptic_def.dt = 1.0 / rate;
+    haptic_def.tool = *tool;
+    haptic_def.dt = 1.0 / r->rate;
     haptic_def.stale_after = kStaleAfter;
     CHECK(sh_haptic_create(scene->world, &haptic_def, &r->haptic));
+    return 0;
 
-    /* Both loops start on the same deadline, once both threads exist. */
+done:
+    return 1;
+}
+
+/* Runs the sim and device threads until the device's last deadline; both loops start on the
+ * same deadline, once both threads exist. 0 on success. */
+static int run_threads(run* r) {
+    pthread_t device, sim;
     r->start_ns = now_ns() + 20000000;
     if (pthread_create(&sim, NULL, sim_thread, r) != 0) {
         fprintf(stderr, "haptic_loop: cannot start the sim thread\n");
-        goto done;
+        return 1;
     }
     if (pthread_create(&device, NULL, device_thread, r) != 0) {
         fprintf(stderr, "haptic_loop: cannot start the device thread\n");
         atomic_store(&r->device_done, 1);
         pthread_join(sim, NULL);
-        goto done;
+        return 1;
     }
     pthread_join(device, NULL);
     pthread_join(sim, NULL);
+    return 0;
+}
+
+/* The run's trace rows as CSV on stdout. */
+static void print_trace(const run* r) {
+    long i;
+    for (i = 0; i < r->row_count; ++i) {
+        const trace_row* row = &r->rows[i];
+        printf("%.0f,%.5f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%d,%.5f,%u\n", r->rate, row->t, row->position[0],
+               row->position[1], row->position[2], row->force[0], row->force[1], row->force[2], row->contact,
+               row->buffer_tets, row->data_age, row->faults);
+    }
+    fflush(stdout);
+}
+
+/* Runs the device at rate (Hz) beside the sim thread for kRunTime, appends the trace to stdout
+ * and the summary to stderr. Returns 0 on success. */
+static int run_at(liver_scene* scene, const liver_path* path, double rate, int decimate, int* fifo_noticed) {
+    run* r = create_run(scene, path, rate, decimate);
+    sh_tool_id tool = SH_NULL_ID;
+    int ok = 0;
+    if (!r) return 1;
+
+    /* The liver back to rest, the tool 1 cm above the start, a haptic context on it. */
+    if (liver_scene_reset(scene) != 0) goto done;
+    if (create_tool_and_haptic(scene, path, r, &tool) != 0) goto done;
+    if (run_threads(r) != 0) goto done;
 
     if (r->fifo_error && !*fifo_noticed) {
         fprintf(stderr, "haptic_loop: notice: SCHED_FIFO not permitted (%s): the device thread ran at normal "
                 "priority\n", strerror(r->fifo_error));
         *fifo_noticed = 1;
     }
-    for (i = 0; i < r->row_count; ++i) {
-        const trace_row* row = &r->rows[i];
-        printf("%.0f,%.5f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%d,%.5f,%u\n", rate, row->t, row->position[0],
-               row->position[1], row->position[2], row->force[0], row->force[1], row->force[2], row->contact,
-               row->buffer_tets, row->data_age, row->faults);
-    }
-    fflush(stdout);
+    print_trace(r);
     summarise(r);
     if (r->step_status != SH_OK)
         fprintf(stderr, "haptic_loop: %.0f Hz: sh_haptic_step returned %s\n", rate, sh_status_string(r->step_status));
@@ -497,12 +560,8 @@ static int run_at(liver_scene* scene, const liver_path* path, double rate, int d
 
 done:
     sh_haptic_destroy(r->haptic); /* NULL is fine */
-    if (tool) sh_tool_destroy(scene->world, tool);
-    free(r->lateness);
-    free(r->step_time);
-    free(r->rows);
-    free(r->model_time);
-    free(r);
+    if (!SH_ID_IS_NULL(tool)) sh_tool_destroy(scene->world, tool);
+    destroy_run(r);
     return ok ? 0 : 1;
 }
 

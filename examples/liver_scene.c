@@ -118,50 +118,49 @@ static const char* integrator_name(sh_integrator integrator) {
     return (int)integrator >= 0 && integrator < SH_INTEGRATOR_COUNT ? kNames[integrator] : "?";
 }
 
-int liver_scene_create(const liver_scene_def* def, liver_scene* out) {
+/* Loads the mesh and turns it so that the file's +y side (the flattest) faces down:
+ * (x, y, z) -> (x, z, -y), a proper rotation. The turned nodes make a new mesh (*turned); out
+ * gets the node and tet counts, and out->x (allocated here) the turned nodes. 0 on success. */
+static int load_turned(const liver_scene_def* def, liver_scene* out, sh_mesh** turned) {
     sh_mesh* file_mesh = NULL;
-    sh_mesh* turned = NULL;
-    double* damping = NULL;
     int32_t* tets = NULL;
-    int32_t* base = NULL;
-    int ok = 0;
-    int32_t i;
-    int step, steps;
     sh_mesh_info info;
-    sh_world_def world_def;
-    sh_fem_body_def body_def;
-    sh_body_info body_info;
-    sh_obstacle_id table;
-    sh_contact_state table_state;
-    sh_step_report report;
-    double scale, translation[3], extent = 0.0, settle_wall = 0.0;
+    int32_t i;
+    int ok = 0;
 
-    memset(out, 0, sizeof *out);
-    out->program = def->program;
-
-    /* 1. The mesh: turned so that the file's +y side (the flattest) faces down, (x, y, z) ->
-     *    (x, z, -y), a proper rotation, then scaled to a 16 cm liver centred over the origin
-     *    with its lowest point on the table (z = 0). */
     CHECK(sh_mesh_load(def->mesh_path, &file_mesh));
     CHECK(sh_mesh_get_info(file_mesh, &info));
     out->node_count = info.node_count;
     out->tet_count = info.tet_count;
     out->x = malloc(sizeof(double) * 3 * (size_t)info.node_count);
-    damping = malloc(sizeof(double) * (size_t)info.node_count);
     tets = malloc(sizeof(int32_t) * 4 * (size_t)info.tet_count);
-    out->triangles = malloc(sizeof(int32_t) * 3 * (size_t)info.surface_triangle_count);
-    if (!out->x || !damping || !tets || !out->triangles) {
+    if (!out->x || !tets) {
         fprintf(stderr, "%s: out of memory\n", def->program);
         goto done;
     }
-    CHECK(sh_mesh_get_nodes(file_mesh, out->x, 3 * (int64_t)info.node_count));
-    CHECK(sh_mesh_get_tets(file_mesh, tets, 4 * (int64_t)info.tet_count));
+    CHECK(sh_mesh_get_nodes(file_mesh, out->x, info.node_count));
+    CHECK(sh_mesh_get_tets(file_mesh, tets, info.tet_count));
     for (i = 0; i < info.node_count; ++i) {
         const double y = out->x[3 * i + 1], z = out->x[3 * i + 2];
         out->x[3 * i + 1] = z;
         out->x[3 * i + 2] = -y;
     }
-    CHECK(sh_mesh_create(out->x, info.node_count, tets, info.tet_count, &turned));
+    CHECK(sh_mesh_create(out->x, info.node_count, tets, info.tet_count, turned));
+    ok = 1;
+
+done:
+    sh_mesh_destroy(file_mesh); /* NULL is fine */
+    free(tets);
+    return ok ? 0 : 1;
+}
+
+/* Scales the turned mesh to a kLiverSize liver centred over the origin with its lowest point on
+ * the table (z = 0) into out->mesh, and reads its surface triangles. 0 on success. */
+static int place_on_table(const liver_scene_def* def, const sh_mesh* turned, liver_scene* out) {
+    sh_mesh_info info;
+    double scale, translation[3], extent = 0.0;
+    int i;
+
     CHECK(sh_mesh_get_info(turned, &info));
     for (i = 0; i < 3; ++i)
         if (info.bounds_max[i] - info.bounds_min[i] > extent) extent = info.bounds_max[i] - info.bounds_min[i];
@@ -172,13 +171,29 @@ int liver_scene_create(const liver_scene_def* def, liver_scene* out) {
     CHECK(sh_mesh_transform(turned, scale, translation, &out->mesh));
     CHECK(sh_mesh_get_info(out->mesh, &info));
     out->triangle_count = info.surface_triangle_count;
-    CHECK(sh_mesh_get_surface_triangles(out->mesh, out->triangles, 3 * (int64_t)out->triangle_count));
+    out->triangles = malloc(sizeof(int32_t) * 3 * (size_t)out->triangle_count);
+    if (!out->triangles) {
+        fprintf(stderr, "%s: out of memory\n", def->program);
+        return 1;
+    }
+    CHECK(sh_mesh_get_surface_triangles(out->mesh, out->triangles, out->triangle_count));
     fprintf(stderr, "%s: %s: %d nodes, %d tets, %d surface triangles, scaled by %.4g to "
             "%.1f x %.1f x %.1f cm\n", def->program, def->mesh_path, out->node_count, info.tet_count,
             out->triangle_count, scale, (info.bounds_max[0] - info.bounds_min[0]) * 100,
             (info.bounds_max[1] - info.bounds_min[1]) * 100, (info.bounds_max[2] - info.bounds_min[2]) * 100);
+    return 0;
 
-    /* 2. The world, the liver and a frictionless table to settle on. */
+done:
+    return 1;
+}
+
+/* The world under gravity, the liver as a corotational body in it and a frictionless table to
+ * settle on (its id in *table). 0 on success. */
+static int create_world(const liver_scene_def* def, liver_scene* out, sh_obstacle_id* table) {
+    sh_world_def world_def;
+    sh_fem_body_def body_def;
+    sh_body_info body_info;
+
     sh_world_def_default(&world_def); /* gravity (0, 0, -9.81) m/s^2 */
     CHECK(sh_world_create(&world_def, &out->world));
     sh_fem_body_def_default(&body_def);
@@ -190,19 +205,38 @@ int liver_scene_create(const liver_scene_def* def, liver_scene* out) {
     body_def.integrator = def->integrator;
     body_def.on_unstable = SH_UNSTABLE_SUBSTEP;
     body_def.damping_mass = 2.0;        /* 1/s */
-    CHECK(sh_world_add_fem_body(out->world, &body_def, &out->body));
+    CHECK(sh_fem_body_create(out->world, &body_def, &out->body));
     CHECK(sh_body_get_info(out->world, out->body, &body_info));
     out->total_mass = body_info.total_mass;
     out->dt_critical = body_info.dt_critical;
-    CHECK(add_table(out->world, 0.0, &table));
+    CHECK(add_table(out->world, 0.0, table));
     fprintf(stderr, "%s: mass %.0f g, corotational E = %.0f kPa, nu = %.2f; %s at dt = %g ms (critical "
             "explicit step %.3f ms)\n", def->program, out->total_mass * 1e3, body_def.material.young * 1e-3,
             body_def.material.poisson, integrator_name(def->integrator), def->dt * 1e3, body_info.dt_critical * 1e3);
+    return 0;
 
-    /* 3. Settle with heavy damping, then clear it and put friction on the table. */
+done:
+    return 1;
+}
+
+/* Lets the liver settle for kSettleTime under heavy per-node damping, so that it comes to rest
+ * quickly, then clears the damping. Prints how well it settled: the table should carry its
+ * weight. 0 on success. */
+static int settle(const liver_scene_def* def, liver_scene* out, sh_obstacle_id table) {
+    double* damping = malloc(sizeof(double) * (size_t)out->node_count);
+    const int steps = (int)(kSettleTime / def->dt + 0.5);
+    sh_contact_state table_state;
+    sh_step_report report;
+    double settle_wall = 0.0;
+    int32_t i;
+    int step, ok = 0;
+
+    if (!damping) {
+        fprintf(stderr, "%s: out of memory\n", def->program);
+        return 1;
+    }
     for (i = 0; i < out->node_count; ++i) damping[i] = kSettleDamping;
     CHECK(sh_body_set_node_damping(out->world, out->body, damping, out->node_count));
-    steps = (int)(kSettleTime / def->dt + 0.5);
     for (step = 0; step < steps; ++step) {
         CHECK(sh_world_step(out->world, def->dt, &report));
         settle_wall += report.wall_seconds;
@@ -213,30 +247,55 @@ int liver_scene_create(const liver_scene_def* def, liver_scene* out) {
             "%.3f N (weight %.3f N) on %d nodes, %.3f mm deep\n", def->program, kSettleTime, settle_wall * 1e3,
             report.kinetic_energy, -table_state.force[2], out->total_mass * 9.81, table_state.contact_count,
             table_state.max_depth * 1e3);
+    ok = 1;
+
+done:
+    free(damping);
+    return ok ? 0 : 1;
+}
+
+/* Fixes the nodes within def->base_height of the table to it. 0 on success. */
+static int fix_base(const liver_scene_def* def, liver_scene* out) {
+    int32_t* base = malloc(sizeof(int32_t) * (size_t)out->node_count);
+    int32_t i, count = 0;
+    int ok = 0;
+
+    if (!base) {
+        fprintf(stderr, "%s: out of memory\n", def->program);
+        return 1;
+    }
+    for (i = 0; i < out->node_count; ++i)
+        if (out->x[3 * i + 2] < def->base_height) base[count++] = i;
+    CHECK(sh_body_fix_nodes(out->world, out->body, base, count));
+    fprintf(stderr, "%s: %d nodes within %.0f mm of the table fixed to it\n", def->program, count,
+            def->base_height * 1e3);
+    ok = 1;
+
+done:
+    free(base);
+    return ok ? 0 : 1;
+}
+
+int liver_scene_create(const liver_scene_def* def, liver_scene* out) {
+    sh_mesh* turned = NULL;
+    sh_obstacle_id table;
+    int ok = 0;
+
+    memset(out, 0, sizeof *out);
+    out->program = def->program;
+    if (load_turned(def, out, &turned) != 0) goto done;
+    if (place_on_table(def, turned, out) != 0) goto done;
+    if (create_world(def, out, &table) != 0) goto done;
+    if (settle(def, out, table) != 0) goto done;
+    /* Settled: the frictionless table goes, one with the friction asked for takes its place. */
     CHECK(sh_obstacle_destroy(out->world, table));
     CHECK(add_table(out->world, def->table_friction, &out->table));
-    CHECK(sh_body_get_positions(out->world, out->body, out->x, 3 * (int64_t)out->node_count));
-    if (def->base_height > 0.0) {
-        int32_t count = 0;
-        base = malloc(sizeof(int32_t) * (size_t)out->node_count);
-        if (!base) {
-            fprintf(stderr, "%s: out of memory\n", def->program);
-            goto done;
-        }
-        for (i = 0; i < out->node_count; ++i)
-            if (out->x[3 * i + 2] < def->base_height) base[count++] = i;
-        CHECK(sh_body_fix_nodes(out->world, out->body, base, count));
-        fprintf(stderr, "%s: %d nodes within %.0f mm of the table fixed to it\n", def->program, count,
-                def->base_height * 1e3);
-    }
+    CHECK(sh_body_get_positions(out->world, out->body, out->x, out->node_count));
+    if (def->base_height > 0.0 && fix_base(def, out) != 0) goto done;
     ok = 1;
 
 done:
     sh_mesh_destroy(turned); /* NULL is fine */
-    sh_mesh_destroy(file_mesh);
-    free(damping);
-    free(tets);
-    free(base);
     if (!ok) liver_scene_destroy(out);
     return ok ? 0 : 1;
 }
@@ -264,28 +323,21 @@ done:
     return ok ? 0 : 1;
 }
 
-int liver_scene_find_path(const liver_scene* scene, double tool_radius, double length, liver_path* out) {
-    static const double kDirections[8][2] = {{1.0, 0.0}, {-1.0, 0.0}, {0.0, 1.0}, {0.0, -1.0},
-                                             {0.70710678118654752, 0.70710678118654752},
-                                             {-0.70710678118654752, 0.70710678118654752},
-                                             {0.70710678118654752, -0.70710678118654752},
-                                             {-0.70710678118654752, -0.70710678118654752}};
-    enum { kSamples = LIVER_PATH_SAMPLES };
+/* The eight directions a path may take, seen from above. */
+static const double kDirections[8][2] = {{1.0, 0.0}, {-1.0, 0.0}, {0.0, 1.0}, {0.0, -1.0},
+                                         {0.70710678118654752, 0.70710678118654752},
+                                         {-0.70710678118654752, 0.70710678118654752},
+                                         {0.70710678118654752, -0.70710678118654752},
+                                         {-0.70710678118654752, -0.70710678118654752}};
+
+/* The largest nearly level facet of the top (tilted at most 18 degrees) over at least
+ * kMinThickness of tissue: its index, and its centre into out->start. -1 if there is none. */
+static int32_t find_start_facet(const liver_scene* scene, liver_path* out) {
     const double* x = scene->x;
     const int32_t* tris = scene->triangles;
-    const int32_t tri_count = scene->triangle_count;
-    double best_area = 0.0, best_turn = INFINITY, n0[3];
+    double best_area = 0.0;
     int32_t t, facet = -1;
-    int dir, k, side, i;
-
-    memset(out, 0, sizeof *out);
-    out->direction[0] = 1.0;
-    out->length = length;
-    out->tool_radius = tool_radius;
-    /* The centre of the largest nearly level facet of the top, then the direction along which
-     * the facets under the tool (on the path and half a radius to either side) turn least from
-     * that facet. */
-    for (t = 0; t < tri_count; ++t) {
+    for (t = 0; t < scene->triangle_count; ++t) {
         const double* a = &x[3 * tris[3 * t]];
         const double* b = &x[3 * tris[3 * t + 1]];
         const double* c = &x[3 * tris[3 * t + 2]];
@@ -295,35 +347,70 @@ int liver_scene_find_path(const liver_scene* scene, double tool_radius, double l
         const double cx = (a[0] + b[0] + c[0]) / 3.0, cy = (a[1] + b[1] + c[1]) / 3.0;
         double height;
         if (w[2] < 0.95 * 2.0 * area || area <= best_area) continue; /* tilted over 18 deg, or smaller */
-        if (top_triangle(x, tris, tri_count, cx, cy, &height) != t) continue; /* not on top */
+        if (top_triangle(x, tris, scene->triangle_count, cx, cy, &height) != t) continue; /* not on top */
         if (height < kMinThickness) continue;
         best_area = area;
         facet = t;
         out->start[0] = cx;
         out->start[1] = cy;
     }
+    return facet;
+}
+
+/* How far the facets under a tool going from path->start along dir turn from the normal n0:
+ * the largest 1 - cos(angle) over the path and half a radius to either side of it. INFINITY if
+ * the tool would leave the top or its tissue grow thin; the search stops early once the turn
+ * reaches `enough` (a better direction is already known). */
+static double path_turn(const liver_scene* scene, const liver_path* path, const double dir[2], const double n0[3],
+                        double enough) {
+    double turn = 0.0;
+    int k, side;
+    for (k = 0; k < LIVER_PATH_SAMPLES && turn < enough; ++k)
+        for (side = -1; side <= 1; ++side) {
+            const double s = path->length * k / (LIVER_PATH_SAMPLES - 1), o = 0.5 * path->tool_radius * side;
+            const double px = path->start[0] + s * dir[0] - o * dir[1];
+            const double py = path->start[1] + s * dir[1] + o * dir[0];
+            double n[3], height;
+            const int32_t hit = top_triangle(scene->x, scene->triangles, scene->triangle_count, px, py, &height);
+            if (hit < 0 || height < kMinThickness) return INFINITY;
+            triangle_normal(scene->x, &scene->triangles[3 * hit], n);
+            if (1.0 - (n[0] * n0[0] + n[1] * n0[1] + n[2] * n0[2]) > turn)
+                turn = 1.0 - (n[0] * n0[0] + n[1] * n0[1] + n[2] * n0[2]);
+        }
+    return turn;
+}
+
+/* Samples the touching height along the path. */
+static void sample_heights(const liver_scene* scene, liver_path* out) {
+    enum { kSamples = LIVER_PATH_SAMPLES };
+    int i;
+    for (i = 0; i < kSamples; ++i)
+        out->heights[i] = touch_height(scene->x, scene->triangles, scene->triangle_count,
+                                       out->start[0] + out->length * i / (kSamples - 1) * out->direction[0],
+                                       out->start[1] + out->length * i / (kSamples - 1) * out->direction[1],
+                                       out->tool_radius);
+}
+
+/* The start at the centre of the largest level facet of the top, then the direction along
+ * which the facets under the tool turn least from that facet: the coarse surface gives a
+ * sphere little support where it straddles a sharp edge (see liver_scene.h). */
+int liver_scene_find_path(const liver_scene* scene, double tool_radius, double length, liver_path* out) {
+    double best_turn = INFINITY, n0[3];
+    int32_t facet;
+    int dir;
+
+    memset(out, 0, sizeof *out);
+    out->direction[0] = 1.0;
+    out->length = length;
+    out->tool_radius = tool_radius;
+    facet = find_start_facet(scene, out);
     if (facet < 0) {
         fprintf(stderr, "%s: no level facet on the liver's top\n", scene->program);
         return 1;
     }
-    triangle_normal(x, &tris[3 * facet], n0);
+    triangle_normal(scene->x, &scene->triangles[3 * facet], n0);
     for (dir = 0; dir < 8; ++dir) {
-        double turn = 0.0; /* largest 1 - cos(angle) between n0 and a facet under the tool */
-        for (k = 0; k < kSamples && turn < best_turn; ++k)
-            for (side = -1; side <= 1; ++side) {
-                const double s = length * k / (kSamples - 1), o = 0.5 * tool_radius * side;
-                const double px = out->start[0] + s * kDirections[dir][0] - o * kDirections[dir][1];
-                const double py = out->start[1] + s * kDirections[dir][1] + o * kDirections[dir][0];
-                double n[3], height;
-                const int32_t hit = top_triangle(x, tris, tri_count, px, py, &height);
-                if (hit < 0 || height < kMinThickness) {
-                    turn = INFINITY;
-                    break;
-                }
-                triangle_normal(x, &tris[3 * hit], n);
-                if (1.0 - (n[0] * n0[0] + n[1] * n0[1] + n[2] * n0[2]) > turn)
-                    turn = 1.0 - (n[0] * n0[0] + n[1] * n0[1] + n[2] * n0[2]);
-            }
+        const double turn = path_turn(scene, out, kDirections[dir], n0, best_turn);
         if (turn < best_turn) {
             best_turn = turn;
             out->direction[0] = kDirections[dir][0];
@@ -338,12 +425,10 @@ int liver_scene_find_path(const liver_scene* scene, double tool_radius, double l
     fprintf(stderr, "%s: path from (%.1f, %.1f) cm along (%.2f, %.2f), over facets within %.0f degrees "
             "of the first\n", scene->program, out->start[0] * 100, out->start[1] * 100, out->direction[0],
             out->direction[1], acos(1.0 - best_turn) * 180.0 / kPi);
-    for (i = 0; i < kSamples; ++i)
-        out->heights[i] = touch_height(x, tris, tri_count, out->start[0] + length * i / (kSamples - 1) * out->direction[0],
-                                       out->start[1] + length * i / (kSamples - 1) * out->direction[1], tool_radius);
+    sample_heights(scene, out);
     fprintf(stderr, "%s: the tool would touch the settled surface with its centre at z = %.2f cm at the "
             "start, %.2f cm in the middle, %.2f cm at the end\n", scene->program, out->heights[0] * 100,
-            out->heights[kSamples / 2] * 100, out->heights[kSamples - 1] * 100);
+            out->heights[LIVER_PATH_SAMPLES / 2] * 100, out->heights[LIVER_PATH_SAMPLES - 1] * 100);
     return 0;
 }
 

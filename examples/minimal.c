@@ -35,12 +35,12 @@ int main(void) {
     sh_fem_body_def_default(&body_def); /* StVK, E = 3 kPa, nu = 0.45, rho = 1000 kg/m^3 */
     body_def.mesh = mesh;
     body_def.damping_mass = 5.0; /* 1/s */
-    CHECK(sh_world_add_fem_body(world, &body_def, &body));
+    CHECK(sh_fem_body_create(world, &body_def, &body));
     CHECK(sh_body_fix_nodes(world, body, top, 4));
 
     for (i = 0; i < 100; ++i) CHECK(sh_world_step(world, 0.001, &report)); /* 100 x 1 ms */
 
-    CHECK(sh_body_get_positions(world, body, x, 8 * 3));
+    CHECK(sh_body_get_positions(world, body, x, 8));
     for (i = 0; i < 8; ++i) lowest = x[3 * i + 2] < lowest ? x[3 * i + 2] : lowest;
     printf("lowest node z = %.6f m (rest 0)\n", lowest);
     printf("energies: kinetic %.3e J, elastic %.3e J, potential %.3e J (dt_crit %.2e s)\n",

@@ -97,125 +97,198 @@ static void tool_position(double t, const liver_path* path, double out[3]) {
     liver_path_point(path, slide, below, out);
 }
 
-int main(int argc, char** argv) {
-    const char* integrator_name = argc > 2 ? argv[2] : "symplectic";
-    const double identity[4] = {1.0, 0.0, 0.0, 0.0};
-    liver_scene_def scene_def;
-    liver_scene scene;
-    liver_path path;
-    int exit_code = 1;
-    sh_collider_def tool_def;
-    sh_tool_id tool;
-    sh_contact_state tool_state;
-    sh_step_report report;
-    uint64_t warnings[SH_WARN_COUNT];
-    double dt, pose[3], row_wall, wall_sum = 0.0, wall_max = 0.0;
-    double peak_normal = 0.0, peak_depth = 0.0, slide_along = 0.0, slide_normal = 0.0, after_lift = 0.0;
-    double touch_z = NAN, fit_sxx = 0.0, fit_sxy = 0.0, fit_sx = 0.0, fit_sy = 0.0;
-    int step, steps_per_row, row, rows, slide_rows = 0, fit_rows = 0, max_substeps = 1;
-    int max_contact_substeps = 1;
+/* The wall time and sub-steps of the steps so far. */
+typedef struct step_stats {
+    double wall_sum, wall_max;  /* s */
+    int max_substeps, max_contact_substeps;
+} step_stats;
 
-    memset(&scene, 0, sizeof scene);
-    scene_def.program = "palpation";
-    scene_def.mesh_path = argc > 1 ? argv[1] : "../shared/meshes/liver.msh";
-    scene_def.table_friction = 0.6;
-    scene_def.base_height = 0.0;
-    if (strcmp(integrator_name, "symplectic") == 0) {
-        scene_def.integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
-        dt = 1e-4; /* s: see the header on friction */
-    } else if (strcmp(integrator_name, "implicit") == 0) {
-        scene_def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
-        dt = 1e-2; /* s: a 100 Hz organ step */
+/* What the summary reports, gathered row by row. */
+typedef struct force_summary {
+    double peak_normal, peak_depth;    /* N, m */
+    double touch_z;                    /* tool height at the first touch (m); NAN before it */
+    double fit_sx, fit_sy, fit_sxx, fit_sxy; /* least-squares sums of log d and log F */
+    int fit_rows;
+    double slide_along, slide_normal;  /* sums of the force along the slide and of force_z (N) */
+    int slide_rows;
+    double after_lift;                 /* largest |F| after lift-off (N) */
+} force_summary;
+
+/* Sets the scene's integrator and the host step (s) for the name given on the command line.
+ * 0 on success; 1 for an unknown name. */
+static int choose_integrator(const char* name, liver_scene_def* def) {
+    if (strcmp(name, "symplectic") == 0) {
+        def->integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
+        def->dt = 1e-4; /* s: see the header on friction */
+    } else if (strcmp(name, "implicit") == 0) {
+        def->integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+        def->dt = 1e-2; /* s: a 100 Hz organ step */
     } else {
-        fprintf(stderr, "usage: palpation [mesh [symplectic|implicit]]\n");
-        return 2;
+        return 1;
     }
-    scene_def.dt = dt;
-    steps_per_row = (int)(kRowTime / dt + 0.5);
+    return 0;
+}
 
-    /* 1. The liver, settled on the table, and the path across its top. */
-    if (liver_scene_create(&scene_def, &scene) != 0) goto done;
-    if (liver_scene_find_path(&scene, kToolRadius, kSlide, &path) != 0) goto done;
-
-    /* 2. The tool, 1 cm above the start. */
+/* The sphere tool, at the trajectory's start 1 cm above the path. 0 on success. */
+static int create_tool(liver_scene* scene, const liver_path* path, sh_tool_id* tool) {
+    sh_collider_def tool_def;
     sh_collider_def_default(&tool_def);
     tool_def.shape.kind = SH_SHAPE_SPHERE;
     tool_def.shape.radius = kToolRadius;
-    tool_position(0.0, &path, tool_def.position);
+    tool_position(0.0, path, tool_def.position);
     tool_def.contact.stiffness = 1e6;        /* N/m^1.5: 0.2-0.3 mm at a few newtons */
     tool_def.contact.damping = 1.5;          /* s/m: damps a node chattering on the tool */
     tool_def.contact.static_friction = 0.3;
     tool_def.contact.dynamic_friction = 0.2;
-    CHECK(sh_tool_create(scene.world, &tool_def, &tool));
+    CHECK(sh_tool_create(scene->world, &tool_def, tool));
+    return 0;
 
-    /* 3. The palpation: a row every kRowTime. */
-    printf("t,tool_x,tool_y,tool_z,force_x,force_y,force_z,contacts,max_depth,step_ms\n");
-    rows = (int)(kEnd / kRowTime + 0.5);
-    for (row = 1; row <= rows; ++row) {
-        double t = 0.0, d;
-        row_wall = 0.0;
-        for (step = 1; step <= steps_per_row; ++step) {
-            t = ((row - 1) * steps_per_row + step) * dt;
-            tool_position(t, &path, pose);
-            CHECK(sh_tool_set_pose(scene.world, tool, pose, identity));
-            CHECK(sh_world_step(scene.world, dt, &report));
-            row_wall += report.wall_seconds;
-            if (report.wall_seconds > wall_max) wall_max = report.wall_seconds;
-            if (report.substeps > max_substeps) max_substeps = report.substeps;
-            if (report.contact_substeps > max_contact_substeps) max_contact_substeps = report.contact_substeps;
-        }
-        wall_sum += row_wall;
-        CHECK(sh_tool_get_contact(scene.world, tool, &tool_state));
-        if (!isfinite(tool_state.force[0]) || !isfinite(tool_state.force[1]) || !isfinite(tool_state.force[2])) {
-            fprintf(stderr, "palpation: non-finite force at t = %g s\n", t);
-            goto done;
-        }
-        printf("%.2f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%d,%.3e,%.4f\n", t, pose[0], pose[1], pose[2],
-               tool_state.force[0], tool_state.force[1], tool_state.force[2], tool_state.contact_count,
-               tool_state.max_depth, row_wall / steps_per_row * 1e3);
-        if (tool_state.force[2] > peak_normal) peak_normal = tool_state.force[2];
-        if (tool_state.max_depth > peak_depth) peak_depth = tool_state.max_depth;
-        /* The press: fit log F = p log d + c, d the travel below the first touch (the row's
-         * tool height plus its penetration then). */
-        if (t <= kPressEnd && tool_state.contact_count > 0 && isnan(touch_z)) touch_z = pose[2] + tool_state.max_depth;
-        d = touch_z - pose[2];
-        if (t > kApproachEnd && t <= kPressEnd && d > 0.2 * kIndentation && tool_state.force[2] > 0.0) {
-            const double lx = log(d), ly = log(tool_state.force[2]);
-            fit_sx += lx;
-            fit_sy += ly;
-            fit_sxx += lx * lx;
-            fit_sxy += lx * ly;
-            ++fit_rows;
-        }
-        /* The slide after its first 0.1 s. */
-        if (t > kHold1End + 0.1 && t <= kSlideEnd) {
-            slide_along += tool_state.force[0] * path.direction[0] + tool_state.force[1] * path.direction[1];
-            slide_normal += tool_state.force[2];
-            ++slide_rows;
-        }
-        if (t > kLiftEnd) {
-            const double f = sqrt(tool_state.force[0] * tool_state.force[0] + tool_state.force[1] * tool_state.force[1] +
-                                  tool_state.force[2] * tool_state.force[2]);
-            if (f > after_lift) after_lift = f;
-        }
+done:
+    return 1;
+}
+
+/* The steps of CSV row `row` (1-based): the tool moved along the trajectory before each step.
+ * The last step's time and tool position go to *t and pose; the row's wall time to *row_wall.
+ * 0 on success. */
+static int step_row(liver_scene* scene, sh_tool_id tool, const liver_path* path, int row, int steps_per_row,
+                    double dt, double* t, double pose[3], double* row_wall, step_stats* stats) {
+    const double identity[4] = {1.0, 0.0, 0.0, 0.0};
+    sh_step_report report;
+    int step;
+    *row_wall = 0.0;
+    for (step = 1; step <= steps_per_row; ++step) {
+        *t = ((row - 1) * steps_per_row + step) * dt;
+        tool_position(*t, path, pose);
+        CHECK(sh_tool_set_pose(scene->world, tool, pose, identity));
+        CHECK(sh_world_step(scene->world, dt, &report));
+        *row_wall += report.wall_seconds;
+        if (report.wall_seconds > stats->wall_max) stats->wall_max = report.wall_seconds;
+        if (report.substeps > stats->max_substeps) stats->max_substeps = report.substeps;
+        if (report.contact_substeps > stats->max_contact_substeps)
+            stats->max_contact_substeps = report.contact_substeps;
     }
-    CHECK(sh_world_get_warnings(scene.world, warnings));
-    fprintf(stderr, "palpation: peak normal force %.3f N, deepest tool penetration %.3f mm\n", peak_normal,
-            peak_depth * 1e3);
-    if (fit_rows > 1)
+    stats->wall_sum += *row_wall;
+    return 0;
+
+done:
+    return 1;
+}
+
+/* Adds a row's force to the summary at time t with the tool at pose. */
+static void summarise_row(force_summary* s, double t, const double pose[3], const sh_contact_state* state,
+                          const liver_path* path) {
+    double d;
+    if (state->force[2] > s->peak_normal) s->peak_normal = state->force[2];
+    if (state->max_depth > s->peak_depth) s->peak_depth = state->max_depth;
+    /* The press: fit log F = p log d + c, d the travel below the first touch (the row's tool
+     * height plus its penetration then). */
+    if (t <= kPressEnd && state->contact_count > 0 && isnan(s->touch_z)) s->touch_z = pose[2] + state->max_depth;
+    d = s->touch_z - pose[2];
+    if (t > kApproachEnd && t <= kPressEnd && d > 0.2 * kIndentation && state->force[2] > 0.0) {
+        const double lx = log(d), ly = log(state->force[2]);
+        s->fit_sx += lx;
+        s->fit_sy += ly;
+        s->fit_sxx += lx * lx;
+        s->fit_sxy += lx * ly;
+        ++s->fit_rows;
+    }
+    /* The slide after its first 0.1 s, once the tool has started to move. */
+    if (t > kHold1End + 0.1 && t <= kSlideEnd) {
+        s->slide_along += state->force[0] * path->direction[0] + state->force[1] * path->direction[1];
+        s->slide_normal += state->force[2];
+        ++s->slide_rows;
+    }
+    if (t > kLiftEnd) {
+        const double f = sqrt(state->force[0] * state->force[0] + state->force[1] * state->force[1] +
+                              state->force[2] * state->force[2]);
+        if (f > s->after_lift) s->after_lift = f;
+    }
+}
+
+/* The palpation: one CSV row every kRowTime, each added to the summary. 0 on success; 1 if a
+ * call fails or a force is not finite. */
+static int palpate(liver_scene* scene, sh_tool_id tool, const liver_path* path, double dt, force_summary* summary,
+                   step_stats* stats) {
+    const int steps_per_row = (int)(kRowTime / dt + 0.5);
+    const int rows = (int)(kEnd / kRowTime + 0.5);
+    sh_contact_state state;
+    int row;
+    printf("t,tool_x,tool_y,tool_z,force_x,force_y,force_z,contacts,max_depth,step_ms\n");
+    for (row = 1; row <= rows; ++row) {
+        double t = 0.0, pose[3], row_wall;
+        if (step_row(scene, tool, path, row, steps_per_row, dt, &t, pose, &row_wall, stats) != 0) return 1;
+        CHECK(sh_tool_get_contact(scene->world, tool, &state));
+        if (!isfinite(state.force[0]) || !isfinite(state.force[1]) || !isfinite(state.force[2])) {
+            fprintf(stderr, "palpation: non-finite force at t = %g s\n", t);
+            return 1;
+        }
+        printf("%.2f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%d,%.3e,%.4f\n", t, pose[0], pose[1], pose[2], state.force[0],
+               state.force[1], state.force[2], state.contact_count, state.max_depth, row_wall / steps_per_row * 1e3);
+        summarise_row(summary, t, pose, &state, path);
+    }
+    return 0;
+
+done:
+    return 1;
+}
+
+/* The summary on stderr: the forces, the press's power-law exponent, the slide's friction, and
+ * the cost of the steps. */
+static void print_summary(const force_summary* s, const step_stats* stats, const liver_path* path, double dt,
+                          const uint64_t warnings[SH_WARN_COUNT]) {
+    const int steps = (int)(kEnd / kRowTime + 0.5) * (int)(kRowTime / dt + 0.5);
+    fprintf(stderr, "palpation: peak normal force %.3f N, deepest tool penetration %.3f mm\n", s->peak_normal,
+            s->peak_depth * 1e3);
+    if (s->fit_rows > 1)
         fprintf(stderr, "palpation: press: F ~ d^%.2f (least-squares fit over %d rows, d = %.1f to %.1f mm below the "
-                "first touch)\n", (fit_rows * fit_sxy - fit_sx * fit_sy) / (fit_rows * fit_sxx - fit_sx * fit_sx),
-                fit_rows, 0.2 * kIndentation * 1e3, (touch_z - (path.heights[0] - kIndentation)) * 1e3);
-    if (slide_rows > 0)
+                "first touch)\n",
+                (s->fit_rows * s->fit_sxy - s->fit_sx * s->fit_sy) / (s->fit_rows * s->fit_sxx - s->fit_sx * s->fit_sx),
+                s->fit_rows, 0.2 * kIndentation * 1e3, (s->touch_z - (path->heights[0] - kIndentation)) * 1e3);
+    if (s->slide_rows > 0)
         fprintf(stderr, "palpation: slide: mean force %.3f N along the sliding direction (friction and the slope "
-                "ahead), mean force_z %.3f N\n", slide_along / slide_rows, slide_normal / slide_rows);
-    fprintf(stderr, "palpation: largest force after lift-off %.2e N\n", after_lift);
+                "ahead), mean force_z %.3f N\n", s->slide_along / s->slide_rows, s->slide_normal / s->slide_rows);
+    fprintf(stderr, "palpation: largest force after lift-off %.2e N\n", s->after_lift);
     fprintf(stderr, "palpation: %d steps of %g ms: mean %.3f ms, max %.3f ms per step (%.2f s of wall time per "
             "simulated second), up to %d sub-steps and %d contact sub-steps; warnings: unstable %llu, inverted "
             "%llu, capacity %llu\n",
-            rows * steps_per_row, dt * 1e3, wall_sum / (rows * steps_per_row) * 1e3, wall_max * 1e3, wall_sum / kEnd,
-            max_substeps, max_contact_substeps, (unsigned long long)warnings[SH_WARN_UNSTABLE],
+            steps, dt * 1e3, stats->wall_sum / steps * 1e3, stats->wall_max * 1e3, stats->wall_sum / kEnd,
+            stats->max_substeps, stats->max_contact_substeps, (unsigned long long)warnings[SH_WARN_UNSTABLE],
             (unsigned long long)warnings[SH_WARN_INVERTED], (unsigned long long)warnings[SH_WARN_CAPACITY]);
+}
+
+int main(int argc, char** argv) {
+    const char* integrator_name = argc > 2 ? argv[2] : "symplectic";
+    liver_scene_def scene_def;
+    liver_scene scene;
+    liver_path path;
+    sh_tool_id tool;
+    force_summary summary;
+    step_stats stats;
+    uint64_t warnings[SH_WARN_COUNT];
+    int exit_code = 1;
+
+    memset(&scene, 0, sizeof scene);
+    memset(&summary, 0, sizeof summary);
+    summary.touch_z = NAN;
+    memset(&stats, 0, sizeof stats);
+    stats.max_substeps = stats.max_contact_substeps = 1;
+    scene_def.program = "palpation";
+    scene_def.mesh_path = argc > 1 ? argv[1] : "../shared/meshes/liver.msh";
+    scene_def.table_friction = 0.6;
+    scene_def.base_height = 0.0;
+    if (choose_integrator(integrator_name, &scene_def) != 0) {
+        fprintf(stderr, "usage: palpation [mesh [symplectic|implicit]]\n");
+        return 2;
+    }
+
+    /* The liver settled on the table, the path across its top, the tool 1 cm above its start. */
+    if (liver_scene_create(&scene_def, &scene) != 0) goto done;
+    if (liver_scene_find_path(&scene, kToolRadius, kSlide, &path) != 0) goto done;
+    if (create_tool(&scene, &path, &tool) != 0) goto done;
+
+    if (palpate(&scene, tool, &path, scene_def.dt, &summary, &stats) != 0) goto done;
+    CHECK(sh_world_get_warnings(scene.world, warnings));
+    print_summary(&summary, &stats, &path, scene_def.dt, warnings);
     exit_code = 0;
 
 done:

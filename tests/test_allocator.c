@@ -159,7 +159,7 @@ static void test_counting_allocator_sees_everything_freed(void** state) {
     sh_fem_body_def_default(&def);
     def.mesh = mesh;
     sh_body_id body;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_fem_body_create(world, &def, &body));
     int32_t fixed[32];
     const int32_t fixed_count = x0_nodes(4, 2, 2, fixed);
     assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
@@ -225,7 +225,7 @@ static void test_restore_default_allocator(void** state) {
     sh_fem_body_def_default(&def);
     def.mesh = mesh;
     sh_body_id body;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_fem_body_create(world, &def, &body));
     assert_ok(sh_world_step(world, 1e-3, NULL));
     assert_ok(sh_mesh_destroy(mesh));
     assert_ok(sh_world_destroy(world));
@@ -250,12 +250,12 @@ static int add_bodies(sh_world* world, const sh_mesh* mesh, const int32_t* fixed
         def.damping_mass = 1.0;
         def.damping_stiffness = k == 0 ? 1e-4 : 0.0;
         sh_body_id body;
-        assert_ok(sh_world_add_fem_body(world, &def, &body));
+        assert_ok(sh_fem_body_create(world, &def, &body));
         assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
         const int32_t region[4] = {0, 5, 7, 12};
-        const sh_material materials[3] = {{SH_MATERIAL_LINEAR, 5e3, 0.4, 1000},
-                                          {SH_MATERIAL_COROTATIONAL, 8e3, 0.3, 1100},
-                                          {SH_MATERIAL_NEOHOOKEAN, 4e3, 0.45, 1050}};
+        const sh_material materials[3] = {sh_test_material(SH_MATERIAL_LINEAR, 5e3, 0.4, 1000),
+                                          sh_test_material(SH_MATERIAL_COROTATIONAL, 8e3, 0.3, 1100),
+                                          sh_test_material(SH_MATERIAL_NEOHOOKEAN, 4e3, 0.45, 1050)};
         assert_ok(sh_body_set_material(world, body, region, 4, &materials[k % 3]));
         double damping[64];
         assert_true(mesh_info.node_count <= 64);
@@ -279,7 +279,7 @@ static int add_bodies(sh_world* world, const sh_mesh* mesh, const int32_t* fixed
             spring.params.table = table;
             spring.params.table_rows = 4;
             spring.damping_mass = 0.5;
-            assert_ok(sh_world_add_spring_body(world, &spring, &body));
+            assert_ok(sh_spring_body_create(world, &spring, &body));
             assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
             out[count++] = body;
         }
@@ -297,12 +297,12 @@ static void touch_bodies(sh_world* world, const sh_body_id* bodies, int count, c
     for (int b = 0; b < count; ++b) {
         assert_ok(sh_body_get_info(world, bodies[b], &info));
         assert_int_equal(sh_body_is_valid(world, bodies[b]), 1);
-        assert_ok(sh_body_get_positions(world, bodies[b], buffer, 3 * 64));
+        assert_ok(sh_body_get_positions(world, bodies[b], buffer, 64));
         assert_ok(sh_body_set_positions(world, bodies[b], buffer, info.node_count));
-        assert_ok(sh_body_get_velocities(world, bodies[b], buffer, 3 * 64));
+        assert_ok(sh_body_get_velocities(world, bodies[b], buffer, 64));
         assert_ok(sh_body_set_velocities(world, bodies[b], buffer, info.node_count));
         assert_ok(sh_body_get_masses(world, bodies[b], buffer, 3 * 64));
-        assert_ok(sh_body_get_elastic_forces(world, bodies[b], buffer, 3 * 64));
+        assert_ok(sh_body_get_elastic_forces(world, bodies[b], buffer, 64));
         assert_ok(sh_body_get_elastic_energy(world, bodies[b], &energy));
         for (int i = 0; i < 3 * info.node_count; ++i) buffer[i] = 1e-4;
         assert_ok(sh_body_set_external_forces(world, bodies[b], buffer, info.node_count));
@@ -396,7 +396,7 @@ static void test_step_with_rollbacks_allocates_nothing(void** state) {
     destroy_world_checking_leaks(scene.world);
 }
 
-/* sh_world_remove_body is tagged Alloc: none: removing bodies (the first removal included)
+/* sh_body_destroy is tagged Alloc: none: removing bodies (the first removal included)
  * allocates nothing, and so it cannot fail with SH_ERR_OUT_OF_MEMORY. */
 static void test_remove_body_allocates_nothing(void** state) {
     (void)state;
@@ -407,10 +407,10 @@ static void test_remove_body_allocates_nothing(void** state) {
     sh_fem_body_def_default(&def);
     def.mesh = mesh;
     sh_body_id bodies[4];
-    for (int i = 0; i < 4; ++i) assert_ok(sh_world_add_fem_body(world, &def, &bodies[i]));
+    for (int i = 0; i < 4; ++i) assert_ok(sh_fem_body_create(world, &def, &bodies[i]));
     reset_counts();
-    for (int i = 0; i < 4; ++i) assert_ok(sh_world_remove_body(world, bodies[i]));
-    if (g.attempts != 0) print_error("sh_world_remove_body: %zu allocation(s) for 4 removals\n", g.attempts);
+    for (int i = 0; i < 4; ++i) assert_ok(sh_body_destroy(world, bodies[i]));
+    if (g.attempts != 0) print_error("sh_body_destroy: %zu allocation(s) for 4 removals\n", g.attempts);
     const size_t attempts = g.attempts;
     assert_ok(sh_mesh_destroy(mesh));
     destroy_world_checking_leaks(world);
@@ -429,7 +429,7 @@ static void test_rejected_step_allocates_nothing(void** state) {
     def.mesh = mesh;
     def.on_unstable = SH_UNSTABLE_REJECT;
     sh_body_id body;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_fem_body_create(world, &def, &body));
     sh_body_info info;
     assert_ok(sh_body_get_info(world, body, &info));
     reset_counts();
@@ -452,20 +452,20 @@ static void test_set_material_out_of_memory_changes_nothing(void** state) {
     sh_fem_body_def_default(&def);
     def.mesh = mesh;
     sh_body_id body;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_fem_body_create(world, &def, &body));
     assert_ok(sh_mesh_destroy(mesh));
     sh_body_info info;
     assert_ok(sh_body_get_info(world, body, &info));
     assert_true(info.node_count <= 64);
     double x[3 * 64], masses[64], forces[3 * 64], masses_now[64], forces_now[3 * 64];
-    assert_ok(sh_body_get_positions(world, body, x, 3 * 64));
+    assert_ok(sh_body_get_positions(world, body, x, 64));
     for (int i = 0; i < 3 * info.node_count; ++i) x[i] *= 1.0 + 0.01 * (i % 5); /* strained */
     assert_ok(sh_body_set_positions(world, body, x, info.node_count));
     assert_ok(sh_body_get_masses(world, body, masses, 64));
-    assert_ok(sh_body_get_elastic_forces(world, body, forces, 3 * 64));
+    assert_ok(sh_body_get_elastic_forces(world, body, forces, 64));
 
     const int32_t region[3] = {1, 4, 9};
-    const sh_material other = {SH_MATERIAL_COROTATIONAL, 9e3, 0.3, 2500};
+    const sh_material other = sh_test_material(SH_MATERIAL_COROTATIONAL, 9e3, 0.3, 2500);
     int failures = 0;
     for (long n = 0; n < 10000; ++n) {
         reset_counts();
@@ -479,7 +479,7 @@ static void test_set_material_out_of_memory_changes_nothing(void** state) {
         }
         assert_status(status, SH_ERR_OUT_OF_MEMORY);
         assert_ok(sh_body_get_masses(world, body, masses_now, 64));
-        assert_ok(sh_body_get_elastic_forces(world, body, forces_now, 3 * 64));
+        assert_ok(sh_body_get_elastic_forces(world, body, forces_now, 64));
         if (memcmp(masses_now, masses, sizeof(double) * (size_t)info.node_count) != 0 ||
             memcmp(forces_now, forces, sizeof(double) * 3 * (size_t)info.node_count) != 0) {
             print_error("sh_body_set_material failing after %ld allocations returned SH_ERR_OUT_OF_MEMORY but "
@@ -515,17 +515,17 @@ static void test_implicit_step_out_of_memory_changes_nothing(void** state) {
     def.mesh = mesh;
     def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
     sh_body_id body;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_fem_body_create(world, &def, &body));
     assert_ok(sh_mesh_destroy(mesh));
     sh_body_info info;
     assert_ok(sh_body_get_info(world, body, &info));
     assert_true(info.node_count <= 64);
     double x[3 * 64], v[3 * 64], x_now[3 * 64], v_now[3 * 64];
-    assert_ok(sh_body_get_positions(world, body, x, 3 * 64));
+    assert_ok(sh_body_get_positions(world, body, x, 64));
     const int32_t pulled = 0;
     const double target[3] = {x[0] - 1e-3, x[1], x[2]};
     assert_ok(sh_body_prescribe_positions(world, body, &pulled, target, 1));
-    assert_ok(sh_body_get_velocities(world, body, v, 3 * 64));
+    assert_ok(sh_body_get_velocities(world, body, v, 64));
     const size_t bytes = sizeof(double) * 3 * (size_t)info.node_count;
     int failures = 0;
     for (long n = 0; n < 10000; ++n) {
@@ -539,24 +539,24 @@ static void test_implicit_step_out_of_memory_changes_nothing(void** state) {
             break;
         }
         assert_status(status, SH_ERR_OUT_OF_MEMORY);
-        assert_ok(sh_body_get_positions(world, body, x_now, 3 * 64));
-        assert_ok(sh_body_get_velocities(world, body, v_now, 3 * 64));
+        assert_ok(sh_body_get_positions(world, body, x_now, 64));
+        assert_ok(sh_body_get_velocities(world, body, v_now, 64));
         if (memcmp(x_now, x, bytes) != 0 || memcmp(v_now, v, bytes) != 0) {
             print_error("sh_world_step failing after %ld allocations changed the body\n", n);
             ++failures;
         }
     }
-    assert_ok(sh_body_get_positions(world, body, x_now, 3 * 64));
+    assert_ok(sh_body_get_positions(world, body, x_now, 64));
     assert_memory_equal(x_now, target, sizeof target);
     destroy_world_checking_leaks(world);
     assert_int_equal(failures, 0);
 }
 
-/* sh_world_add_spring_body into a garbage id: on failure the id must be SH_NULL_BODY. */
+/* sh_spring_body_create into a garbage id: on failure the id must be (sh_body_id)SH_NULL_ID. */
 static sh_status add_spring_body_or_null(sh_world* world, const sh_spring_body_def* def, sh_body_id* body) {
-    *body = 42;
-    const sh_status status = sh_world_add_spring_body(world, def, body);
-    if (status != SH_OK) assert_true(*body == SH_NULL_BODY);
+    body->value = 42;
+    const sh_status status = sh_spring_body_create(world, def, body);
+    if (status != SH_OK) assert_true(SH_ID_IS_NULL(*body));
     return status;
 }
 
@@ -571,7 +571,7 @@ static sh_status build_and_destroy_scene(const double* nodes, int32_t node_count
     sh_mesh* mesh = NULL;
     sh_status status = SH_OK;
     int stage = 0;
-    sh_body_id body = 42;
+    sh_body_id body = {42};
     sh_world_def world_def;
     sh_world_def_default(&world_def);
 
@@ -592,14 +592,14 @@ static sh_status build_and_destroy_scene(const double* nodes, int32_t node_count
     sh_fem_body_def fem;
     sh_fem_body_def_default(&fem);
     fem.mesh = mesh;
-    status = sh_world_add_fem_body(world, &fem, &body);
+    status = sh_fem_body_create(world, &fem, &body);
     if (status != SH_OK) {
-        assert_true(body == SH_NULL_BODY);
+        assert_true(SH_ID_IS_NULL(body));
         goto done;
     }
     ++stage;
     const int32_t region[2] = {0, 1};
-    const sh_material soft = {SH_MATERIAL_NEOHOOKEAN, 2e3, 0.45, 1000};
+    const sh_material soft = sh_test_material(SH_MATERIAL_NEOHOOKEAN, 2e3, 0.45, 1000);
     status = sh_body_set_material(world, body, region, 2, &soft);
     if (status != SH_OK) goto done;
     ++stage;
@@ -621,10 +621,10 @@ static sh_status build_and_destroy_scene(const double* nodes, int32_t node_count
     status = add_spring_body_or_null(world, &spring, &body);
     if (status != SH_OK) goto done;
     ++stage;
-    status = sh_world_remove_body(world, body);
+    status = sh_body_destroy(world, body);
     if (status != SH_OK) goto done;
     ++stage;
-    status = sh_world_add_spring_body(world, &spring, &body);
+    status = sh_spring_body_create(world, &spring, &body);
     if (status != SH_OK) goto done;
     ++stage;
     sh_step_report report;

@@ -56,7 +56,7 @@ static sh_body_id add_body(sh_world* world, const sh_mesh* mesh, double damping_
     def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
     def.damping_mass = damping_mass;
     sh_body_id id;
-    assert_ok(sh_world_add_fem_body(world, &def, &id));
+    assert_ok(sh_fem_body_create(world, &def, &id));
     return id;
 }
 
@@ -81,7 +81,7 @@ static stack make_stack(double damping_mass) {
     assert_true(s.block_nodes <= kMaxNodes && s.cube_nodes <= kMaxNodes);
 
     double rest[3 * kMaxNodes];
-    assert_ok(sh_mesh_get_nodes(block, rest, 3 * s.block_nodes));
+    assert_ok(sh_mesh_get_nodes(block, rest, s.block_nodes));
     s.fixed_count = sh_test_nodes_at(rest, s.block_nodes, 2, 0.0, s.fixed);
     assert_int_equal(s.fixed_count, 16);
     assert_ok(sh_body_fix_nodes(s.world, s.block, s.fixed, s.fixed_count));
@@ -125,7 +125,7 @@ static stack make_stack(double damping_mass) {
 /* Sum of the block's elastic forces at its fixed nodes: what its supports carry (N). */
 static void support_force(const stack* s, double out[3]) {
     double force[3 * kMaxNodes];
-    assert_ok(sh_body_get_elastic_forces(s->world, s->block, force, 3 * s->block_nodes));
+    assert_ok(sh_body_get_elastic_forces(s->world, s->block, force, s->block_nodes));
     out[0] = out[1] = out[2] = 0.0;
     for (int k = 0; k < s->fixed_count; ++k)
         for (int c = 0; c < 3; ++c) out[c] += force[3 * s->fixed[k] + c];
@@ -142,7 +142,7 @@ static void contact_on_block(const stack* s, double out[3]) {
 /* Mean z of the cube's nodes in its bottom (layer 0) or top (layer 2) plane of the grid. */
 static double cube_layer_height(const stack* s, int layer) {
     double x[3 * kMaxNodes];
-    assert_ok(sh_body_get_positions(s->world, s->cube, x, 3 * s->cube_nodes));
+    assert_ok(sh_body_get_positions(s->world, s->cube, x, s->cube_nodes));
     const int per_layer = 25; /* 5 x 5 nodes */
     double sum = 0.0;
     for (int i = layer * per_layer; i < (layer + 1) * per_layer; ++i) sum += x[3 * i + 2];
@@ -156,7 +156,7 @@ static void stack_centre(const stack* s, double out[3]) {
     for (int b = 0; b < 2; ++b) {
         const int n = b ? s->cube_nodes : s->block_nodes;
         const double* m = b ? s->cube_mass : s->block_mass;
-        assert_ok(sh_body_get_positions(s->world, b ? s->cube : s->block, x, 3 * n));
+        assert_ok(sh_body_get_positions(s->world, b ? s->cube : s->block, x, n));
         for (int i = 0; i < n; ++i) {
             for (int c = 0; c < 3; ++c) out[c] += m[i] * x[3 * i + c];
             mass += m[i];
@@ -246,8 +246,8 @@ static void implicit_stack_settles(void** state) {
     for (int b = 0; b < 2; ++b) {
         const int n = b ? s.cube_nodes : s.block_nodes;
         double settled_x[3 * kMaxNodes], solved_x[3 * kMaxNodes];
-        assert_ok(sh_body_get_positions(s.world, b ? s.cube : s.block, settled_x, 3 * n));
-        assert_ok(sh_body_get_positions(solved.world, b ? solved.cube : solved.block, solved_x, 3 * n));
+        assert_ok(sh_body_get_positions(s.world, b ? s.cube : s.block, settled_x, n));
+        assert_ok(sh_body_get_positions(solved.world, b ? solved.cube : solved.block, solved_x, n));
         for (int j = 0; j < 3 * n; ++j) largest = fmax(largest, fabs(solved_x[j] - settled_x[j]));
     }
     print_message("settled vs static equilibrium: largest node difference %.3g m\n", largest);

@@ -63,8 +63,8 @@ static sh_body_id particle(sh_world* world, double m, double z0, double v, sh_in
     def.node_count = 1;
     def.node_mass = m;
     def.integrator = integrator;
-    sh_body_id body = 0;
-    assert_ok(sh_world_add_spring_body(world, &def, &body));
+    sh_body_id body = SH_NULL_ID;
+    assert_ok(sh_spring_body_create(world, &def, &body));
     const double velocity[3] = {0.0, 0.0, -v};
     assert_ok(sh_body_set_velocities(world, body, velocity, 1));
     return body;
@@ -75,7 +75,7 @@ static sh_obstacle_id floor_plane(sh_world* world, const sh_contact_params* law)
     sh_collider_def_default(&def);
     def.shape.kind = SH_SHAPE_PLANE;
     def.contact = *law;
-    sh_obstacle_id id = 0;
+    sh_obstacle_id id = SH_NULL_ID;
     assert_ok(sh_obstacle_create(world, &def, &id));
     return id;
 }
@@ -92,8 +92,8 @@ static double simulated_ratio(const sh_contact_params* law, double m, double v_i
     for (int i = 0; i < 100000 && !left; ++i) {
         assert_ok(sh_world_step(world, dt, NULL));
         double x[3];
-        assert_ok(sh_body_get_positions(world, body, x, 3));
-        assert_ok(sh_body_get_velocities(world, body, v, 3));
+        assert_ok(sh_body_get_positions(world, body, x, 1));
+        assert_ok(sh_body_get_velocities(world, body, v, 1));
         left = v[2] > 0.0 && x[2] > 0.0;
     }
     assert_true(left);
@@ -142,8 +142,8 @@ static sh_body_id fem_cube(sh_world* world, double a, int n, double x0, double y
     def.material.poisson = 0.3;
     def.integrator = integrator;
     def.damping_mass = 20.0;
-    sh_body_id body = 0;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    sh_body_id body = SH_NULL_ID;
+    assert_ok(sh_fem_body_create(world, &def, &body));
     assert_ok(sh_mesh_destroy(unit));
     assert_ok(sh_mesh_destroy(mesh));
     return body;
@@ -203,7 +203,7 @@ static void test_tool_reaction_balances_the_plane(void** state) {
     def.shape.radius = 0.008;
     def.position[2] = 0.02 + 0.008 + 1e-3;
     def.contact = law;
-    sh_tool_id tool = 0;
+    sh_tool_id tool = SH_NULL_ID;
     assert_ok(sh_tool_create(world, &def, &tool));
     const double q[4] = {1, 0, 0, 0};
     for (int i = 0; i < 400; ++i) {
@@ -246,12 +246,12 @@ static void test_fast_tool_does_not_pass_through_membrane(void** state) {
     def.material.model = SH_MATERIAL_NEOHOOKEAN;
     def.material.young = 3e4; /* soft tissue */
     def.material.poisson = 0.3;
-    sh_body_id membrane = 0;
-    assert_ok(sh_world_add_fem_body(world, &def, &membrane));
+    sh_body_id membrane = SH_NULL_ID;
+    assert_ok(sh_fem_body_create(world, &def, &membrane));
     const sh_mesh_info info = sh_test_mesh_info(mesh);
     double* x = malloc(3 * sizeof(double) * (size_t)info.node_count);
     int32_t* rim = malloc(sizeof(int32_t) * (size_t)info.node_count);
-    assert_ok(sh_mesh_get_nodes(mesh, x, 3 * (int64_t)info.node_count));
+    assert_ok(sh_mesh_get_nodes(mesh, x, info.node_count));
     int32_t rim_count = 0;
     for (int32_t i = 0; i < info.node_count; ++i)
         if (fabs(fabs(x[3 * i]) - 0.01) < 1e-9 || fabs(fabs(x[3 * i + 1]) - 0.01) < 1e-9) rim[rim_count++] = i;
@@ -266,7 +266,7 @@ static void test_fast_tool_does_not_pass_through_membrane(void** state) {
     tool_def.position[0] = cx;
     tool_def.position[1] = cy;
     tool_def.position[2] = 0.003 + radius;
-    sh_tool_id tool = 0;
+    sh_tool_id tool = SH_NULL_ID;
     assert_ok(sh_tool_create(world, &tool_def, &tool));
     const double q[4] = {1, 0, 0, 0};
     double peak = 0.0;
@@ -284,7 +284,7 @@ static void test_fast_tool_does_not_pass_through_membrane(void** state) {
         /* No node of the membrane under the sphere (inside 0.8 of its radius, so away from
          * its equator, where the membrane may wrap up to the centre's height) is above its
          * centre: none came through; and none is deeper in it than half its radius. */
-        assert_ok(sh_body_get_positions(world, membrane, x, 3 * (int64_t)info.node_count));
+        assert_ok(sh_body_get_positions(world, membrane, x, info.node_count));
         for (int32_t k = 0; k < info.node_count; ++k) {
             const double dx = x[3 * k] - cx, dy = x[3 * k + 1] - cy, dz = x[3 * k + 2] - p[2];
             if (dx * dx + dy * dy < 0.64 * radius * radius) assert_true(dz < 0.0);
@@ -348,7 +348,7 @@ static incline incline_create(double theta, const sh_contact_params* law, sh_int
     plane.shape.normal[1] = 0.0;
     plane.shape.normal[2] = cos(theta);
     plane.contact = *law;
-    sh_obstacle_id obstacle = 0;
+    sh_obstacle_id obstacle = SH_NULL_ID;
     assert_ok(sh_obstacle_create(s.world, &plane, &obstacle));
     sh_fem_body_def def;
     sh_fem_body_def_default(&def);
@@ -360,7 +360,7 @@ static incline incline_create(double theta, const sh_contact_params* law, sh_int
     /* Explicit: a little stiffness damping, which leaves rigid motion alone, keeps the cube's
      * own vibration from making its corners chatter on the plane. */
     if (integrator != SH_INTEGRATOR_IMPLICIT_EULER) def.damping_stiffness = 1e-3;
-    assert_ok(sh_world_add_fem_body(s.world, &def, &s.body));
+    assert_ok(sh_fem_body_create(s.world, &def, &s.body));
     assert_ok(sh_mesh_destroy(mesh));
     s.masses = malloc(sizeof(double) * (size_t)s.node_count);
     assert_ok(sh_body_get_masses(s.world, s.body, s.masses, s.node_count));
@@ -373,8 +373,8 @@ static incline incline_create(double theta, const sh_contact_params* law, sh_int
 static void incline_centre(const incline* s, double* position, double* velocity) {
     double* x = malloc(3 * sizeof(double) * (size_t)s->node_count);
     double* v = malloc(3 * sizeof(double) * (size_t)s->node_count);
-    assert_ok(sh_body_get_positions(s->world, s->body, x, 3 * (int64_t)s->node_count));
-    assert_ok(sh_body_get_velocities(s->world, s->body, v, 3 * (int64_t)s->node_count));
+    assert_ok(sh_body_get_positions(s->world, s->body, x, s->node_count));
+    assert_ok(sh_body_get_velocities(s->world, s->body, v, s->node_count));
     *position = *velocity = 0.0;
     for (int32_t i = 0; i < s->node_count; ++i)
         for (int k = 0; k < 3; ++k) {
@@ -516,8 +516,8 @@ static sh_body_id edge_box(sh_world* world, double young, sh_integrator integrat
     def.material.poisson = 0.3;
     def.integrator = integrator;
     def.damping_mass = 50.0;
-    sh_body_id body = 0;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    sh_body_id body = SH_NULL_ID;
+    assert_ok(sh_fem_body_create(world, &def, &body));
     int32_t* bottom = malloc(sizeof(int32_t) * (size_t)*node_count);
     const int count = sh_test_nodes_at(nodes, *node_count, 2, 0.0, bottom);
     assert_ok(sh_body_fix_nodes(world, body, bottom, count));
@@ -564,7 +564,7 @@ static void test_sphere_on_a_convex_edge_is_supported(void** state) {
         def.shape.radius = EDGE_RADIUS;
         def.contact = law;
         edge_tool_centre(points[run], directions[run], depth, def.position);
-        sh_tool_id tool = 0;
+        sh_tool_id tool = SH_NULL_ID;
         assert_ok(sh_tool_create(world, &def, &tool));
         sh_static_def statics;
         sh_static_def_default(&statics);
@@ -604,7 +604,7 @@ static void test_sphere_pushed_into_an_edge_does_not_pass_through(void** state) 
     def.shape.radius = EDGE_RADIUS;
     def.contact.stiffness = 1e5;
     edge_tool_centre(edge_point, bisector, -1e-3, def.position); /* 1 mm clear of the edge */
-    sh_tool_id tool = 0;
+    sh_tool_id tool = SH_NULL_ID;
     assert_ok(sh_tool_create(world, &def, &tool));
     const double q[4] = {1, 0, 0, 0};
     double* x = malloc(3 * sizeof(double) * (size_t)node_count);
@@ -621,7 +621,7 @@ static void test_sphere_pushed_into_an_edge_does_not_pass_through(void** state) 
         const double* f = contact.force;
         const double along = f[0] * bisector[0] + f[1] * bisector[1] + f[2] * bisector[2];
         const double magnitude = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-        assert_ok(sh_body_get_positions(world, box, x, 3 * (int64_t)node_count));
+        assert_ok(sh_body_get_positions(world, box, x, node_count));
         double edge_mid[3] = {0.0, 0.0, 0.0}, deepest = 0.0;
         for (int32_t k = 0; k < node_count; ++k) {
             const double d[3] = {x[3 * k] - centre[0], x[3 * k + 1] - centre[1], x[3 * k + 2] - centre[2]};
@@ -651,7 +651,7 @@ static void test_sphere_pushed_into_an_edge_does_not_pass_through(void** state) 
 /* ---- Degenerate inputs and capacity -------------------------------------------------------- */
 
 static sh_status try_tool(sh_world* world, const sh_collider_def* def) {
-    sh_tool_id id = 0;
+    sh_tool_id id = SH_NULL_ID;
     return sh_tool_create(world, def, &id);
 }
 
@@ -716,12 +716,12 @@ static void test_degenerate_contacts_stay_finite(void** state) {
     const sh_body_id p = particle(world, 1e-3, 0.0, 0.0, SH_INTEGRATOR_SYMPLECTIC_EULER);
     sh_collider_def def;
     sh_collider_def_default(&def); /* sphere at the origin: the particle is at its centre */
-    sh_tool_id tool = 0;
+    sh_tool_id tool = SH_NULL_ID;
     assert_ok(sh_tool_create(world, &def, &tool));
     assert_ok(sh_world_step(world, 1e-5, NULL));
     double x[3], v[3];
-    assert_ok(sh_body_get_positions(world, p, x, 3));
-    assert_ok(sh_body_get_velocities(world, p, v, 3));
+    assert_ok(sh_body_get_positions(world, p, x, 1));
+    assert_ok(sh_body_get_velocities(world, p, v, 1));
     for (int k = 0; k < 3; ++k) assert_true(isfinite(x[k]) && isfinite(v[k]));
     sh_contact_state contact;
     assert_ok(sh_tool_get_contact(world, tool, &contact));
@@ -740,7 +740,7 @@ static void test_degenerate_contacts_stay_finite(void** state) {
     assert_int_equal(sh_tool_is_valid(world, tool), 0);
     assert_status(sh_tool_set_pose(world, tool, far, q), SH_ERR_INVALID_HANDLE);
     assert_status(sh_tool_destroy(world, tool), SH_ERR_INVALID_HANDLE);
-    assert_status(sh_obstacle_destroy(world, tool), SH_ERR_INVALID_HANDLE);
+    assert_status(sh_obstacle_destroy(world, (sh_obstacle_id){tool.value}), SH_ERR_INVALID_HANDLE);
 
     assert_ok(sh_world_destroy(world));
 
@@ -751,14 +751,14 @@ static void test_degenerate_contacts_stay_finite(void** state) {
     def.shape.kind = SH_SHAPE_BOX;
     def.shape.half_extents[0] = def.shape.half_extents[1] = def.shape.half_extents[2] = 0.005;
     def.position[2] = -0.005;
-    sh_obstacle_id box = 0;
+    sh_obstacle_id box = SH_NULL_ID;
     assert_ok(sh_obstacle_create(world, &def, &box));
     assert_ok(sh_world_step(world, 1e-5, NULL));
     assert_ok(sh_obstacle_get_contact(world, box, &contact));
     /* Zero depth up to the round-off of the box's frame (1e-23 m here): a force of that order. */
     assert_true(fabs(contact.force[2]) < 1e-20 && contact.max_depth < 1e-20);
     double* y = malloc(3 * sizeof(double) * 27);
-    assert_ok(sh_body_get_positions(world, cube, y, 81));
+    assert_ok(sh_body_get_positions(world, cube, y, 27));
     for (int k = 0; k < 81; ++k) assert_true(isfinite(y[k]));
     free(y);
     assert_ok(sh_world_destroy(world));
@@ -785,7 +785,7 @@ static void test_contact_capacity_keeps_the_deepest(void** state) {
         def.orientation[1] = sin(0.05);
         def.position[2] = 0.005 - 0.0002;
         def.contact.capacity = run == 0 ? 5 : 4096;
-        sh_tool_id tool = 0;
+        sh_tool_id tool = SH_NULL_ID;
         assert_ok(sh_tool_create(world, &def, &tool));
         sh_step_report report;
         assert_ok(sh_world_step(world, 1e-6, &report));

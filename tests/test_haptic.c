@@ -130,11 +130,11 @@ static scene make_scene(double damping_mass, double tool_z) {
     def.material.poisson = 0.3;
     def.material.density = 1000.0;
     def.damping_mass = damping_mass;
-    assert_ok(sh_world_add_fem_body(s.world, &def, &s.body));
+    assert_ok(sh_fem_body_create(s.world, &def, &s.body));
     const sh_mesh_info info = sh_test_mesh_info(mesh);
     double* x = malloc(3 * sizeof(double) * (size_t)info.node_count);
     int32_t* base = malloc(sizeof(int32_t) * (size_t)info.node_count);
-    assert_ok(sh_mesh_get_nodes(mesh, x, 3 * (int64_t)info.node_count));
+    assert_ok(sh_mesh_get_nodes(mesh, x, info.node_count));
     const int base_count = sh_test_nodes_at(x, info.node_count, 2, 0.0, base);
     assert_ok(sh_body_fix_nodes(s.world, s.body, base, base_count));
     free(x);

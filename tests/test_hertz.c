@@ -139,7 +139,7 @@ static sh_body_id add_block_body(sh_world* world, const block_mesh* b) {
     def.material.young = YOUNG;
     def.material.poisson = POISSON;
     sh_body_id body;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_fem_body_create(world, &def, &body));
     return body;
 }
 
@@ -235,7 +235,7 @@ static void apply_k(exact_solver* s, const double* v, double* out) {
     const double scale = 1e-3 / vmax;
     for (int i = 0; i < n3; ++i) s->x[i] = s->mesh->nodes[i] + scale * v[i];
     assert_ok(sh_body_set_positions(s->world, s->body, s->x, s->n));
-    assert_ok(sh_body_get_elastic_forces(s->world, s->body, s->force, n3));
+    assert_ok(sh_body_get_elastic_forces(s->world, s->body, s->force, n3 / 3));
     for (int i = 0; i < n3; ++i) out[i] = -(s->force[i] - s->f0[i]) / scale;
     ++s->matvecs;
 }
@@ -286,7 +286,7 @@ static exact_solver make_exact_solver(const block_mesh* mesh) {
     s.normal = malloc(sizeof(double) * 3 * s.candidate_count);
     s.gap = malloc(sizeof(double) * s.candidate_count);
     assert_ok(sh_body_set_positions(s.world, s.body, mesh->nodes, s.n));
-    assert_ok(sh_body_get_elastic_forces(s.world, s.body, s.f0, n3));
+    assert_ok(sh_body_get_elastic_forces(s.world, s.body, s.f0, n3 / 3));
     assemble_block_inverse(&s);
     return s;
 }
@@ -436,22 +436,23 @@ static exact_result exact_contact(exact_solver* s, double d, double radius, doub
 
 /* ---- The test ------------------------------------------------------------------------------- */
 
-static void test_sphere_indentation(void** state) {
-    (void)state;
-#ifndef SOFTHAP_TEST_WITH_CHOLMOD
-    /* Eigen's LDLT on 76 k tets would take minutes per solve: the check runs with CHOLMOD. */
-    skip();
-#endif
-    const double t_start = now_seconds();
-    block_mesh mesh = make_block();
-    printf("  mesh: %d nodes, %d tets, block %.0f x %.0f x %.0f mm, finest cell %.2f mm, growth %.1f\n",
-           mesh.node_count, mesh.tet_count, 2e3 * HALF_WIDTH, 2e3 * HALF_WIDTH, 1e3 * DEPTH, 1e3 * H_FINE, GROWTH);
+/* The library's answer at each indentation: the force on the sphere, the deepest penetration and
+ * the contact count of a static solve with penalty contact. */
+typedef struct {
+    double force[INDENTATION_COUNT];
+    double depth[INDENTATION_COUNT];
+    int contacts[INDENTATION_COUNT];
+    double seconds; /* in the static solves */
+} penalty_result;
 
-    /* The library: penalty contact in the static solve. */
+/* The block with its bottom fixed and a sphere tool posed at indentation d (static solve each);
+ * checks at each that the push is straight up and that the fixed bottom carries it. */
+static penalty_result penalty_indentations(const block_mesh* mesh) {
+    penalty_result r = {{0}, {0}, {0}, 0.0};
     sh_world* world = sh_test_world(0.0);
-    const sh_body_id body = add_block_body(world, &mesh);
-    int32_t* bottom = malloc(sizeof(int32_t) * mesh.node_count);
-    const int bottom_count = sh_test_nodes_at(mesh.nodes, mesh.node_count, 2, -DEPTH, bottom);
+    const sh_body_id body = add_block_body(world, mesh);
+    int32_t* bottom = malloc(sizeof(int32_t) * mesh->node_count);
+    const int bottom_count = sh_test_nodes_at(mesh->nodes, mesh->node_count, 2, -DEPTH, bottom);
     assert_true(bottom_count > 0);
     assert_ok(sh_body_fix_nodes(world, body, bottom, bottom_count));
     sh_collider_def cd;
@@ -468,15 +469,9 @@ static void test_sphere_indentation(void** state) {
     sh_static_def sd;
     sh_static_def_default(&sd);
     sd.tolerance = STATIC_TOL;
-    double* elastic = malloc(sizeof(double) * 3 * mesh.node_count);
-
-    const double e_star = YOUNG / (1 - POISSON * POISSON);
-    double penalty_force[INDENTATION_COUNT], depth[INDENTATION_COUNT], hertz[INDENTATION_COUNT];
-    int penalty_contacts[INDENTATION_COUNT];
-    double t_penalty = 0.0;
+    double* elastic = malloc(sizeof(double) * 3 * mesh->node_count);
     for (int j = 0; j < INDENTATION_COUNT; ++j) {
         const double d = kIndentations[j];
-        hertz[j] = 4.0 / 3.0 * e_star * sqrt(RADIUS) * pow(d, 1.5);
         const double position[3] = {0.0, 0.0, RADIUS - d}, orientation[4] = {1, 0, 0, 0};
         assert_ok(sh_tool_set_pose(world, tool, position, orientation));
         sh_static_report report;
@@ -484,18 +479,18 @@ static void test_sphere_indentation(void** state) {
         printf("  penalty d = %.1f mm: %s, %d Newton iterations, %.1f s\n", 1e3 * d, sh_status_string(status),
                report.iterations, report.wall_seconds);
         assert_ok(status);
-        t_penalty += report.wall_seconds;
+        r.seconds += report.wall_seconds;
         sh_contact_state cs;
         assert_ok(sh_tool_get_contact(world, tool, &cs));
-        penalty_force[j] = cs.force[2];
-        depth[j] = cs.max_depth;
-        penalty_contacts[j] = cs.contact_count;
+        r.force[j] = cs.force[2];
+        r.depth[j] = cs.max_depth;
+        r.contacts[j] = cs.contact_count;
         /* The body pushes the sphere up, straight: the mesh is symmetric but for its Kuhn split. */
         assert_true(cs.force[2] > 0.0);
         assert_true(fabs(cs.force[0]) < 1e-3 * cs.force[2] && fabs(cs.force[1]) < 1e-3 * cs.force[2]);
         /* In equilibrium the fixed bottom carries what the sphere pushes: the elastic forces on
          * the free nodes balance the contact forces, and they sum to zero over all nodes. */
-        assert_ok(sh_body_get_elastic_forces(world, body, elastic, 3 * (int64_t)mesh.node_count));
+        assert_ok(sh_body_get_elastic_forces(world, body, elastic, mesh->node_count));
         double bottom_z = 0.0;
         for (int i = 0; i < bottom_count; ++i) bottom_z += elastic[3 * bottom[i] + 2];
         assert_close(-bottom_z / cs.force[2], 1.0, 1e-2);
@@ -503,71 +498,99 @@ static void test_sphere_indentation(void** state) {
     free(elastic);
     free(bottom);
     assert_ok(sh_world_destroy(world));
+    return r;
+}
 
-    /* The exact contact solve on the same mesh. */
-    const double t_exact_start = now_seconds();
-    exact_solver s = make_exact_solver(&mesh);
-    {
-        /* The operator is linear, symmetric and positive: v^T K v > 0 and w^T K v = v^T K w
-         * (this fixes the sign convention of the elastic forces), and zero at rest. */
-        const int n3 = 3 * s.n;
-        double f0_max = 0.0;
-        for (int i = 0; i < n3; ++i) f0_max = fmax(f0_max, fabs(s.f0[i]));
-        assert_true(f0_max < 1e-12);
-        double* v = malloc(sizeof(double) * n3);
-        double* w = malloc(sizeof(double) * n3);
-        double* kv = malloc(sizeof(double) * n3);
-        double* kw = malloc(sizeof(double) * n3);
-        for (int i = 0; i < n3; ++i) {
-            v[i] = 1e-4 * sin(0.37 * i + 0.1);
-            w[i] = 1e-4 * cos(0.23 * i);
-        }
-        project(&s, v);
-        project(&s, w);
-        apply_k(&s, v, kv);
-        apply_k(&s, w, kw);
-        assert_true(dot(v, kv, n3) > 0.0);
-        assert_close(dot(w, kv, n3) / dot(v, kv, n3), dot(v, kw, n3) / dot(v, kv, n3), 1e-9);
-        free(v);
-        free(w);
-        free(kv);
-        free(kw);
+/* The exact solver's operator is linear, symmetric and positive: v^T K v > 0 and w^T K v =
+ * v^T K w (this fixes the sign convention of the elastic forces), and zero at rest. */
+static void check_exact_operator(exact_solver* s) {
+    const int n3 = 3 * s->n;
+    double f0_max = 0.0;
+    for (int i = 0; i < n3; ++i) f0_max = fmax(f0_max, fabs(s->f0[i]));
+    assert_true(f0_max < 1e-12);
+    double* v = malloc(sizeof(double) * n3);
+    double* w = malloc(sizeof(double) * n3);
+    double* kv = malloc(sizeof(double) * n3);
+    double* kw = malloc(sizeof(double) * n3);
+    for (int i = 0; i < n3; ++i) {
+        v[i] = 1e-4 * sin(0.37 * i + 0.1);
+        w[i] = 1e-4 * cos(0.23 * i);
     }
-    exact_result exact[INDENTATION_COUNT];
+    project(s, v);
+    project(s, w);
+    apply_k(s, v, kv);
+    apply_k(s, w, kw);
+    assert_true(dot(v, kv, n3) > 0.0);
+    assert_close(dot(w, kv, n3) / dot(v, kv, n3), dot(v, kw, n3) / dot(v, kv, n3), 1e-9);
+    free(v);
+    free(w);
+    free(kv);
+    free(kw);
+}
+
+/* The exact contact solve of s at each indentation, warm-started from the previous one: its
+ * solution scaled to the new indentation, its contact radius grown as sqrt(d) (Hertz's
+ * a = sqrt(R d)) and by a cell for the first active set. */
+static void exact_indentations(exact_solver* s, exact_result exact[INDENTATION_COUNT]) {
     for (int j = 0; j < INDENTATION_COUNT; ++j) {
         const double d = kIndentations[j], previous_d = j > 0 ? kIndentations[j - 1] : 0.0;
-        /* Warm start: the previous solution scaled to the new indentation, and its contact
-         * radius grown as sqrt(d) (Hertz's a = sqrt(R d)) and by a cell for the first active set. */
         double guess = INFINITY;
         if (j > 0) {
-            for (int i = 0; i < 3 * s.n; ++i) s.u[i] *= d / previous_d;
+            for (int i = 0; i < 3 * s->n; ++i) s->u[i] *= d / previous_d;
             guess = exact[j - 1].radius * sqrt(d / previous_d) + H_FINE;
         }
-        exact[j] = exact_contact(&s, d, guess, EXACT_TOL);
+        exact[j] = exact_contact(s, d, guess, EXACT_TOL);
         printf("  exact   d = %.1f mm: %d nodes in contact, %d active sets, %d CG iterations\n", 1e3 * d,
                exact[j].active_count, exact[j].set_changes, exact[j].cg_iterations);
     }
-    const long matvecs = s.matvecs;
-    free_exact_solver(&s);
-    const double t_exact = now_seconds() - t_exact_start;
+}
 
+/* Prints the three answers side by side; returns the largest penetration over d. */
+static double print_indentation_table(const penalty_result* p, const exact_result exact[INDENTATION_COUNT],
+                                      const double hertz[INDENTATION_COUNT]) {
     printf("  d (mm)  F_penalty (N)  F_exact (N)  F_hertz (N)  pen/hertz  exact/hertz  pen/exact  contacts pen/exact"
            "  depth/d\n");
     double worst_depth = 0.0;
     for (int j = 0; j < INDENTATION_COUNT; ++j) {
         printf("  %6.1f  %13.6f  %11.6f  %11.6f  %9.4f  %11.4f  %9.4f  %9d / %-5d  %7.1e\n", 1e3 * kIndentations[j],
-               penalty_force[j], exact[j].force, hertz[j], penalty_force[j] / hertz[j], exact[j].force / hertz[j],
-               penalty_force[j] / exact[j].force, penalty_contacts[j], exact[j].active_count,
-               depth[j] / kIndentations[j]);
-        worst_depth = fmax(worst_depth, depth[j] / kIndentations[j]);
+               p->force[j], exact[j].force, hertz[j], p->force[j] / hertz[j], exact[j].force / hertz[j],
+               p->force[j] / exact[j].force, p->contacts[j], exact[j].active_count, p->depth[j] / kIndentations[j]);
+        worst_depth = fmax(worst_depth, p->depth[j] / kIndentations[j]);
     }
-    printf("  largest penetration %.1e d; static solves %.1f s, exact solves %.1f s (%ld operator applications), "
-           "total %.1f s\n", worst_depth, t_penalty, t_exact, matvecs, now_seconds() - t_start);
+    return worst_depth;
+}
 
+static void test_sphere_indentation(void** state) {
+    (void)state;
+#ifndef SOFTHAP_TEST_WITH_CHOLMOD
+    /* Eigen's LDLT on 76 k tets would take minutes per solve: the check runs with CHOLMOD. */
+    skip();
+#endif
+    const double t_start = now_seconds();
+    block_mesh mesh = make_block();
+    printf("  mesh: %d nodes, %d tets, block %.0f x %.0f x %.0f mm, finest cell %.2f mm, growth %.1f\n",
+           mesh.node_count, mesh.tet_count, 2e3 * HALF_WIDTH, 2e3 * HALF_WIDTH, 1e3 * DEPTH, 1e3 * H_FINE, GROWTH);
+    const penalty_result penalty = penalty_indentations(&mesh);
+
+    const double t_exact_start = now_seconds();
+    exact_solver s = make_exact_solver(&mesh);
+    check_exact_operator(&s);
+    exact_result exact[INDENTATION_COUNT];
+    exact_indentations(&s, exact);
+    const long matvecs = s.matvecs;
+    free_exact_solver(&s);
+    const double t_exact = now_seconds() - t_exact_start;
+
+    const double e_star = YOUNG / (1 - POISSON * POISSON);
+    double hertz[INDENTATION_COUNT];
+    for (int j = 0; j < INDENTATION_COUNT; ++j) hertz[j] = 4.0 / 3.0 * e_star * sqrt(RADIUS) * pow(kIndentations[j], 1.5);
+    const double worst_depth = print_indentation_table(&penalty, exact, hertz);
+    printf("  largest penetration %.1e d; static solves %.1f s, exact solves %.1f s (%ld operator applications), "
+           "total %.1f s\n", worst_depth, penalty.seconds, t_exact, matvecs, now_seconds() - t_start);
     for (int j = 0; j < INDENTATION_COUNT; ++j) {
-        assert_true(depth[j] < 1e-3 * kIndentations[j]);
-        assert_true(fabs(penalty_force[j] / hertz[j] - 1.0) < 0.15);
-        assert_true(fabs(penalty_force[j] / exact[j].force - 1.0) < 0.05);
+        assert_true(penalty.depth[j] < 1e-3 * kIndentations[j]);
+        assert_true(fabs(penalty.force[j] / hertz[j] - 1.0) < 0.15);
+        assert_true(fabs(penalty.force[j] / exact[j].force - 1.0) < 0.05);
     }
     free_block(&mesh);
 }

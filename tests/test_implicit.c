@@ -57,7 +57,7 @@ static void test_oscillator_order(void** state) {
         for (int n = 1; n * h <= 1.0 + 1e-12; ++n) {
             assert_ok(sh_world_step(world, h, NULL));
             double x[6];
-            assert_ok(sh_body_get_positions(world, body, x, 6));
+            assert_ok(sh_body_get_positions(world, body, x, 2));
             errors[k] = fmax(errors[k], fabs(x[3] - SH_TEST_OSC_REST - SH_TEST_OSC_AMPLITUDE * cos(w * n * h)));
         }
         assert_ok(sh_world_destroy(world));
@@ -95,8 +95,8 @@ static void test_factor_reuse_exact_and_invalidated(void** state) {
                 assert_ok(sh_world_step(world, h, &report));
                 sh_test_oscillator_backward_euler(&stretch, &v, h, c);
                 double xs[6], vs[6];
-                assert_ok(sh_body_get_positions(world, body, xs, 6));
-                assert_ok(sh_body_get_velocities(world, body, vs, 6));
+                assert_ok(sh_body_get_positions(world, body, xs, 2));
+                assert_ok(sh_body_get_velocities(world, body, vs, 2));
                 assert_true(fabs(xs[3] - SH_TEST_OSC_REST - stretch) <= 1e-14 && fabs(vs[3] - v) <= 1e-12);
                 assert_int_equal(report.factorizations, direct ? (n == 0) : 1);
                 total += report.factorizations;
@@ -116,9 +116,9 @@ static void backward_euler_residual(sh_world* world, sh_body_id body, int n, con
     double* x1 = malloc(sizeof(double) * 3 * n);
     double* v1 = malloc(sizeof(double) * 3 * n);
     double* f = malloc(sizeof(double) * 3 * n);
-    assert_ok(sh_body_get_positions(world, body, x1, 3 * n));
-    assert_ok(sh_body_get_velocities(world, body, v1, 3 * n));
-    assert_ok(sh_body_get_elastic_forces(world, body, f, 3 * n));
+    assert_ok(sh_body_get_positions(world, body, x1, n));
+    assert_ok(sh_body_get_velocities(world, body, v1, n));
+    assert_ok(sh_body_get_elastic_forces(world, body, f, n));
     *momentum = *position = 0.0;
     for (int i = 0; i < n; ++i) {
         if (fixed[i]) continue;
@@ -169,14 +169,14 @@ static void test_factor_reuse_nonlinear(void** state) {
         def.implicit.newton_tolerance = 1e-10;
         def.implicit.factor_reuse = k == 0 ? 0.0 : 0.25;
         sh_body_id body;
-        assert_ok(sh_world_add_fem_body(world, &def, &body));
+        assert_ok(sh_fem_body_create(world, &def, &body));
         assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
         assert_ok(sh_body_get_masses(world, body, mass, n));
         double largest_mass = 0.0;
         for (int i = 0; i < n; ++i) largest_mass = fmax(largest_mass, mass[i]);
         for (int s = 0; s < 60; ++s) {
-            assert_ok(sh_body_get_positions(world, body, x0, 3 * n));
-            assert_ok(sh_body_get_velocities(world, body, v0, 3 * n));
+            assert_ok(sh_body_get_positions(world, body, x0, n));
+            assert_ok(sh_body_get_velocities(world, body, v0, n));
             sh_step_report report;
             assert_ok(sh_world_step(world, dt, &report));
             factorizations[k] += report.factorizations;
@@ -188,7 +188,7 @@ static void test_factor_reuse_nonlinear(void** state) {
                 assert_true(position <= 1e-15);
             }
         }
-        assert_ok(sh_body_get_positions(world, body, x[k < 2 ? k : 0], 3 * n));
+        assert_ok(sh_body_get_positions(world, body, x[k < 2 ? k : 0], n));
         if (k == 1) {
             double tip_drop = 0.0;
             for (int j = 0; j < 3 * n; ++j) assert_true(fabs(x[1][j] - x[0][j]) <= 1e-9 * length);
@@ -240,11 +240,11 @@ static void test_backends_agree(void** state) {
         def.implicit.cg_tolerance = 1e-12;
         def.implicit.factor_reuse = 0.0; /* every backend solves the same linearised systems */
         sh_body_id body;
-        assert_ok(sh_world_add_fem_body(world, &def, &body));
+        assert_ok(sh_fem_body_create(world, &def, &body));
         const int32_t clamp[6] = {0, 1, 2, 3, 4, 5};
         assert_ok(sh_body_fix_nodes(world, body, clamp, 6));
         for (int s = 0; s < 10; ++s) assert_ok(sh_world_step(world, 1e-2, NULL));
-        assert_ok(sh_body_get_positions(world, body, k == 0 ? reference : x, 3 * n));
+        assert_ok(sh_body_get_positions(world, body, k == 0 ? reference : x, n));
         if (k > 0)
             for (int j = 0; j < 3 * n; ++j) assert_true(fabs(x[j] - reference[j]) <= 1e-8);
         assert_ok(sh_world_destroy(world));

@@ -65,7 +65,7 @@ static void test_explicit_body_memory(void** state) {
     sh_fem_body_def_default(&def);
     def.mesh = mesh;
     sh_body_id body;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_fem_body_create(world, &def, &body));
     for (int s = 0; s < 3; ++s) assert_ok(sh_world_step(world, 1e-4, NULL));
     const size_t used = g_live_bytes - before;
     const size_t budget = 320 * (size_t)info.tet_count + 420 * (size_t)info.node_count;

@@ -20,8 +20,8 @@ static void test_scale_and_translate(void** state) {
     assert_close(b.volume / 1e-6, a.volume, 1e-12); /* volume scales by s^3 */
     double* x = malloc(sizeof(double) * 3 * a.node_count);
     double* y = malloc(sizeof(double) * 3 * a.node_count);
-    assert_ok(sh_mesh_get_nodes(liver, x, 3 * a.node_count));
-    assert_ok(sh_mesh_get_nodes(moved, y, 3 * a.node_count));
+    assert_ok(sh_mesh_get_nodes(liver, x, a.node_count));
+    assert_ok(sh_mesh_get_nodes(moved, y, a.node_count));
     for (int k = 0; k < 3 * a.node_count; ++k) assert_close(y[k], 0.01 * x[k] + t[k % 3], 1e-15);
     for (int k = 0; k < 3; ++k) assert_close(b.bounds_min[k], 0.01 * a.bounds_min[k] + t[k], 1e-14);
     free(x);

@@ -33,9 +33,9 @@ static bar make_bar(sh_material_model model, double traction) {
     def.material.model = model;
     def.material.young = kYoung;
     def.material.poisson = 0.0;
-    assert_ok(sh_world_add_fem_body(b.world, &def, &b.body));
+    assert_ok(sh_fem_body_create(b.world, &def, &b.body));
     b.rest = malloc(sizeof(double) * 3 * b.n);
-    assert_ok(sh_mesh_get_nodes(b.mesh, b.rest, 3 * b.n));
+    assert_ok(sh_mesh_get_nodes(b.mesh, b.rest, b.n));
     int32_t* fixed = malloc(sizeof(int32_t) * b.n);
     const int fixed_count = sh_test_nodes_at(b.rest, b.n, 0, 0.0, fixed);
     assert_ok(sh_body_fix_nodes(b.world, b.body, fixed, fixed_count));
@@ -43,7 +43,7 @@ static bar make_bar(sh_material_model model, double traction) {
 
     double* force = calloc(3 * (size_t)b.n, sizeof(double));
     int32_t* tris = malloc(sizeof(int32_t) * 3 * info.surface_triangle_count);
-    assert_ok(sh_mesh_get_surface_triangles(b.mesh, tris, 3 * info.surface_triangle_count));
+    assert_ok(sh_mesh_get_surface_triangles(b.mesh, tris, info.surface_triangle_count));
     double area_sum = 0.0;
     for (int t = 0; t < info.surface_triangle_count; ++t) {
         const int32_t* tri = &tris[3 * t];
@@ -71,7 +71,7 @@ static void free_bar(bar* b) {
 
 static void check_uniform_strain(const bar* b, double strain, double tol) {
     double* x = malloc(sizeof(double) * 3 * b->n);
-    assert_ok(sh_body_get_positions(b->world, b->body, x, 3 * b->n));
+    assert_ok(sh_body_get_positions(b->world, b->body, x, b->n));
     for (int i = 0; i < b->n; ++i) {
         assert_true(fabs(x[3 * i] - (1 + strain) * b->rest[3 * i]) <= tol * kLength * fabs(strain));
         assert_true(fabs(x[3 * i + 1] - b->rest[3 * i + 1]) <= tol * kLength * fabs(strain));
@@ -133,14 +133,14 @@ static void test_free_floating_refused(void** state) {
     sh_fem_body_def_default(&def);
     def.mesh = box;
     sh_body_id body;
-    assert_ok(sh_world_add_fem_body(world, &def, &body));
+    assert_ok(sh_fem_body_create(world, &def, &body));
     double before[3 * 27], after[3 * 27];
-    assert_ok(sh_body_get_positions(world, body, before, 81));
+    assert_ok(sh_body_get_positions(world, body, before, 27));
     sh_static_def sdef;
     sh_static_def_default(&sdef);
     assert_status(sh_world_solve_static(world, &sdef, NULL), SH_ERR_SOLVER);
     assert_non_null(strstr(sh_last_error_message(), "singular"));
-    assert_ok(sh_body_get_positions(world, body, after, 81));
+    assert_ok(sh_body_get_positions(world, body, after, 27));
     assert_memory_equal(before, after, sizeof before);
     sdef.internal_init = 0;
     assert_status(sh_world_solve_static(world, &sdef, NULL), SH_ERR_UNINITIALIZED_DEF);

@@ -4,10 +4,21 @@
  * The one public header. C99. Conventions (see README):
  *  - every fallible function returns sh_status (SH_OK = 0); sh_last_error_message() gives the
  *    detail of the calling thread's last failure;
- *  - heavy objects (sh_world, sh_mesh) are opaque pointers with create/destroy; bodies are
- *    generation-checked uint64_t ids (0 is null);
- *  - definition structs are initialised by their *_def_default function, then edited;
- *  - units are SI (m, kg, s, N, Pa, N/m); vectors are in the world frame unless said otherwise;
+ *  - lifetimes: sh_X_create makes an object and sh_X_destroy ends it. Objects that stand alone
+ *    (sh_mesh, sh_world, sh_haptic) are opaque pointers: sh_X_destroy(pointer). Objects a world
+ *    owns (bodies, tools, obstacles) are generation-checked ids, a distinct struct per kind so
+ *    that one kind's id does not compile where another's is expected: sh_X_create(world, def,
+ *    &id) and sh_X_destroy(world, id). A destroyed or stale pointer or id is
+ *    SH_ERR_INVALID_HANDLE, never a crash; an id whose value is 0 is the null id;
+ *  - outputs are written through parameters named out_* after the inputs; an output array is
+ *    followed by its capacity, counted in the items it holds (nodes, tets, triangles, edges),
+ *    the same unit as the counts the matching setters take; a capacity below what is to be
+ *    written is SH_ERR_INVALID_ARGUMENT, with nothing written;
+ *  - structs passed in whole (every *_def, sh_material, sh_contact_params) are initialised by
+ *    their *_default function, then edited: their internal_init cookie tells a struct that was
+ *    never initialised (SH_ERR_UNINITIALIZED_DEF);
+ *  - units are SI (m, kg, s, N, Pa, N/m), written on every field; vectors are in the world
+ *    frame unless said otherwise;
  *  - "Thread:" says which thread may call (sim, haptic, any); "Alloc:" whether it may allocate
  *    on success (a failing sim-thread call may allocate to format its error message).
  */
@@ -36,12 +47,15 @@ extern "C" {
 #define SH_API
 #endif
 
-/* ------------------------------------------------------------------------------------------ */
-/* Version                                                                                      */
+/** @defgroup sh_api_version Version
+ *  The library's version and optional components.
+ *  @{ */
 
-/** Major version: incremented on ABI-incompatible changes. */
+/** Major version: incremented on ABI-incompatible changes (from 1.0 on; before it, every
+ *  minor version may change the API and ABI: CHANGELOG.md lists what changed). */
 #define SH_VERSION_MAJOR 0
-/** Minor version: incremented when features are added compatibly. */
+/** Minor version: incremented when features are added compatibly (before 1.0: at every
+ *  release). */
 #define SH_VERSION_MINOR 6
 /** Patch version: incremented for fixes. */
 #define SH_VERSION_PATCH 0
@@ -62,8 +76,11 @@ typedef enum sh_feature {
  *  Thread: any. Alloc: none. */
 SH_API uint32_t sh_build_features(void);
 
-/* ------------------------------------------------------------------------------------------ */
-/* Status and errors                                                                            */
+/** @} */
+
+/** @defgroup sh_api_status Status and errors
+ *  Status codes, error messages and warning kinds.
+ *  @{ */
 
 /** Result of every fallible call. */
 typedef enum sh_status {
@@ -109,8 +126,11 @@ typedef enum sh_warning {
     SH_WARN_COUNT = 7           /**< number of warning kinds */
 } sh_warning;
 
-/* ------------------------------------------------------------------------------------------ */
-/* Memory                                                                                       */
+/** @} */
+
+/** @defgroup sh_api_memory Memory
+ *  The allocator every softhap allocation goes through.
+ *  @{ */
 
 /** Host-provided allocator. alloc returns memory aligned to at least `alignment` (a power of
  *  two, at most 64) or NULL; free accepts NULL. */
@@ -125,8 +145,11 @@ typedef struct sh_allocator {
  *  Thread: sim (with no other softhap call running). Alloc: none. */
 SH_API sh_status sh_set_allocator(const sh_allocator* allocator);
 
-/* ------------------------------------------------------------------------------------------ */
-/* Meshes                                                                                       */
+/** @} */
+
+/** @defgroup sh_api_mesh Meshes
+ *  Immutable tetrahedral meshes: create, load, transform, read.
+ *  @{ */
 
 /** An immutable tetrahedral mesh: nodes, tets (reoriented to positive volume) and its outward
  *  surface. Bodies copy what they need; a mesh may be destroyed after a body is made from it. */
@@ -173,38 +196,60 @@ SH_API sh_status sh_mesh_destroy(sh_mesh* mesh);
 /** Fill *out_info. Thread: sim. Alloc: none. */
 SH_API sh_status sh_mesh_get_info(const sh_mesh* mesh, sh_mesh_info* out_info);
 
-/** Copy node positions (node_count x 3 doubles, m) into out; capacity is in doubles.
- *  Thread: sim. Alloc: none. */
-SH_API sh_status sh_mesh_get_nodes(const sh_mesh* mesh, double* out, int64_t capacity);
+/** Copy node positions (node_count x 3 doubles, m) into out_nodes, which has room for
+ *  capacity nodes. Thread: sim. Alloc: none. */
+SH_API sh_status sh_mesh_get_nodes(const sh_mesh* mesh, double* out_nodes, int32_t capacity);
 
-/** Copy tets (tet_count x 4 node indices) into out; capacity is in int32 values.
+/** Copy tets (tet_count x 4 node indices) into out_tets, which has room for capacity tets.
  *  Thread: sim. Alloc: none. */
-SH_API sh_status sh_mesh_get_tets(const sh_mesh* mesh, int32_t* out, int64_t capacity);
+SH_API sh_status sh_mesh_get_tets(const sh_mesh* mesh, int32_t* out_tets, int32_t capacity);
 
 /** Copy surface triangles (surface_triangle_count x 3 node indices, counter-clockwise seen
- *  from outside, so normals point outward) into out; capacity is in int32 values.
- *  Thread: sim. Alloc: none. */
-SH_API sh_status sh_mesh_get_surface_triangles(const sh_mesh* mesh, int32_t* out,
-                                               int64_t capacity);
+ *  from outside, so normals point outward) into out_triangles, which has room for capacity
+ *  triangles. Thread: sim. Alloc: none. */
+SH_API sh_status sh_mesh_get_surface_triangles(const sh_mesh* mesh, int32_t* out_triangles,
+                                               int32_t capacity);
 
-/** Copy unique edges (edge_count x 2 node indices, smaller first, sorted) into out; capacity is
- *  in int32 values. Thread: sim. Alloc: none. */
-SH_API sh_status sh_mesh_get_edges(const sh_mesh* mesh, int32_t* out, int64_t capacity);
+/** Copy unique edges (edge_count x 2 node indices, smaller first, sorted) into out_edges, which
+ *  has room for capacity edges. Thread: sim. Alloc: none. */
+SH_API sh_status sh_mesh_get_edges(const sh_mesh* mesh, int32_t* out_edges, int32_t capacity);
 
 /** Write the mesh as VTK XML unstructured grid (ASCII .vtu). Thread: sim. Alloc: may. */
 SH_API sh_status sh_mesh_write_vtu(const sh_mesh* mesh, const char* path);
 
-/* ------------------------------------------------------------------------------------------ */
-/* World                                                                                        */
+/** @} */
+
+/** @defgroup sh_api_world World
+ *  The world: ids, gravity, warnings and the step.
+ *  @{ */
 
 /** A simulation world: owns bodies and steps them. */
 typedef struct sh_world sh_world;
 
-/** Generation-checked body id. 0 is the null id; a destroyed body's id stays invalid. */
-typedef uint64_t sh_body_id;
+/** Generation-checked id of a body (FEM or mass-spring). value 0 is the null id; a
+ *  destroyed body's id stays invalid, even after its slot serves a new body. */
+typedef struct sh_body_id {
+    uint64_t value; /**< opaque: slot and generation; 0 for the null id */
+} sh_body_id;
 
-/** The null body id. */
-#define SH_NULL_BODY ((sh_body_id)0)
+/** Generation-checked id of a tool; see sh_body_id. */
+typedef struct sh_tool_id {
+    uint64_t value; /**< opaque: slot and generation; 0 for the null id */
+} sh_tool_id;
+
+/** Generation-checked id of a static obstacle; see sh_body_id. */
+typedef struct sh_obstacle_id {
+    uint64_t value; /**< opaque: slot and generation; 0 for the null id */
+} sh_obstacle_id;
+
+/** Initialiser of a null id of any kind: `sh_body_id body = SH_NULL_ID;`. */
+#define SH_NULL_ID {0}
+
+/** 1 if id (of any kind) is the null id, else 0. */
+#define SH_ID_IS_NULL(id) ((id).value == 0)
+
+/** 1 if ids a and b (of the same kind) name the same object, else 0. */
+#define SH_ID_EQUAL(a, b) ((a).value == (b).value)
 
 /** World definition. Initialise with sh_world_def_default. */
 typedef struct sh_world_def {
@@ -230,8 +275,9 @@ SH_API sh_status sh_world_destroy(sh_world* world);
 /** Set gravity (m/s^2). Thread: sim. Alloc: none. */
 SH_API sh_status sh_world_set_gravity(sh_world* world, const double gravity[3]);
 
-/** Read the world's warning counters (SH_WARN_COUNT values) into out. Thread: sim. Alloc: none. */
-SH_API sh_status sh_world_get_warnings(const sh_world* world, uint64_t out[SH_WARN_COUNT]);
+/** Read the world's warning counters, one per sh_warning kind (SH_WARN_COUNT values), into
+ *  out_counts. Thread: sim. Alloc: none. */
+SH_API sh_status sh_world_get_warnings(const sh_world* world, uint64_t out_counts[SH_WARN_COUNT]);
 
 /** What one sh_world_step did and cost. */
 typedef struct sh_step_report {
@@ -275,8 +321,11 @@ typedef struct sh_step_report {
  *  factorisations and CG solves allocate inside CHOLMOD and Eigen, outside sh_set_allocator. */
 SH_API sh_status sh_world_step(sh_world* world, double dt, sh_step_report* report);
 
-/* ------------------------------------------------------------------------------------------ */
-/* Bodies: shared definitions                                                                   */
+/** @} */
+
+/** @defgroup sh_api_body_defs Body definitions
+ *  Integrators, linear solvers, policies and materials shared by body kinds.
+ *  @{ */
 
 /** Time integrators. Forward Euler and RK2 have no stable step for an undamped
  *  elastic body: each step multiplies a mode's energy by 1 + (w dt)^2 (forward Euler) or
@@ -317,16 +366,16 @@ typedef struct sh_implicit_settings {
                                          linearised step that would raise the mechanical
                                          energy with no work done on the body goes on up to 20
                                          iterations towards the step's minimiser */
-    double newton_tolerance;        /**< stop when the residual |g| <= tol max(|g_0|, dt |f|)
+    double newton_tolerance;        /**< (dimensionless) stop when the residual |g| <= tol max(|g_0|, dt |f|)
                                          (f: f_ext + m g and the push of tools and other
                                          bodies at its first iterate) or the velocity correction
                                          <= tol max(|v|, dt |g|, 1e-9 m/s); at the iteration
                                          cap (creeping over friction and contact kinks), a last
                                          correction <= tol L / dt is accepted too, L the bodies'
                                          bounding-box diagonal; default 1e-6 */
-    double cg_tolerance;            /**< CG relative residual; default 1e-8 */
+    double cg_tolerance;            /**< CG relative residual (dimensionless); default 1e-8 */
     int32_t cg_max_iterations;      /**< CG iteration cap; default 2000 */
-    double factor_reuse;            /**< direct solvers (CHOLMOD, LDLT), > 0: the factorisation
+    double factor_reuse;            /**< (dimensionless) direct solvers (CHOLMOD, LDLT), > 0: the factorisation
                                          of M + dt D + dt^2 K is kept across Newton iterations
                                          and steps. An update solved with a kept factorisation
                                          is accepted if it at least halves the residual |g|
@@ -367,16 +416,24 @@ typedef enum sh_material_model {
     SH_MATERIAL_COUNT = 4         /**< number of kinds, not a kind */
 } sh_material_model;
 
-/** An isotropic material. */
+/** An isotropic material. Initialise with sh_material_default. */
 typedef struct sh_material {
+    uint32_t internal_init;  /**< set by sh_material_default; do not touch */
     sh_material_model model; /**< constitutive model */
     double young;            /**< Young's modulus E (Pa), > 0 */
-    double poisson;          /**< Poisson's ratio nu, in (-1, 0.5) */
+    double poisson;          /**< Poisson's ratio nu (dimensionless), in (-1, 0.5) */
     double density;          /**< mass density rho (kg/m^3), > 0 */
 } sh_material;
 
-/* ------------------------------------------------------------------------------------------ */
-/* FEM bodies                                                                                   */
+/** Fill a material with the defaults of soft tissue: StVK, E = 3 kPa, nu = 0.45,
+ *  rho = 1000 kg/m^3. Thread: any. Alloc: none. */
+SH_API void sh_material_default(sh_material* material);
+
+/** @} */
+
+/** @defgroup sh_api_fem_body FEM bodies
+ *  Tetrahedral finite-element bodies.
+ *  @{ */
 
 /** Definition of a tetrahedral FEM body. Initialise with sh_fem_body_def_default. */
 typedef struct sh_fem_body_def {
@@ -392,22 +449,25 @@ typedef struct sh_fem_body_def {
     sh_implicit_settings implicit;  /**< used with SH_INTEGRATOR_IMPLICIT_EULER */
 } sh_fem_body_def;
 
-/** Fill an FEM body def with defaults: StVK, E = 3 kPa, nu = 0.45, rho = 1000 kg/m^3 (soft
- *  tissue), symplectic Euler, sub-stepping. Thread: any. Alloc: none. */
+/** Fill an FEM body def with defaults: sh_material_default's material, symplectic Euler,
+ *  sub-stepping. Thread: any. Alloc: none. */
 SH_API void sh_fem_body_def_default(sh_fem_body_def* def);
 
 /** Create an FEM body from def; nodes start at the mesh's rest positions at rest. Orphan nodes
  *  keep their index, get no mass and are never integrated. Thread: sim. Alloc: may. */
-SH_API sh_status sh_world_add_fem_body(sh_world* world, const sh_fem_body_def* def,
-                                       sh_body_id* out_body);
+SH_API sh_status sh_fem_body_create(sh_world* world, const sh_fem_body_def* def,
+                                    sh_body_id* out_body);
 
 /** Set the material of the listed elements (a region: capsule, parenchyma, vessel). Masses are
  *  recomputed from the new densities. Thread: sim. Alloc: may. */
 SH_API sh_status sh_body_set_material(sh_world* world, sh_body_id body, const int32_t* elements,
                                       int32_t element_count, const sh_material* material);
 
-/* ------------------------------------------------------------------------------------------ */
-/* Mass-spring bodies                                                                           */
+/** @} */
+
+/** @defgroup sh_api_spring_body Mass-spring bodies
+ *  Mass-spring networks.
+ *  @{ */
 
 /** Force laws of a spring of rest length l0 and current length l (tension positive). */
 typedef enum sh_spring_law {
@@ -459,11 +519,14 @@ SH_API void sh_spring_body_def_default(sh_spring_body_def* def);
 /** Create a mass-spring body from def; rest lengths are the initial lengths. A spring of zero
  *  rest length, a repeated node or a non-positive mass is SH_ERR_INVALID_ARGUMENT naming it.
  *  Thread: sim. Alloc: may. */
-SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_def* def,
-                                          sh_body_id* out_body);
+SH_API sh_status sh_spring_body_create(sh_world* world, const sh_spring_body_def* def,
+                                       sh_body_id* out_body);
 
-/* ------------------------------------------------------------------------------------------ */
-/* Bodies: state, boundary conditions, loads                                                    */
+/** @} */
+
+/** @defgroup sh_api_body Body state
+ *  Reading and setting a body's state, boundary conditions and loads.
+ *  @{ */
 
 /** Facts about a body. */
 typedef struct sh_body_info {
@@ -475,8 +538,9 @@ typedef struct sh_body_info {
     double dt_critical;     /**< critical explicit step of its integrator (s); INFINITY if none */
 } sh_body_info;
 
-/** Destroy a body; its id becomes stale. Thread: sim. Alloc: none. */
-SH_API sh_status sh_world_remove_body(sh_world* world, sh_body_id body);
+/** Destroy a body (FEM or mass-spring); its id becomes stale, and its contacts with other
+ *  bodies end. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_destroy(sh_world* world, sh_body_id body);
 
 /** 1 if body is a live body of world, else 0. Thread: sim. Alloc: none. */
 SH_API int32_t sh_body_is_valid(const sh_world* world, sh_body_id body);
@@ -484,26 +548,29 @@ SH_API int32_t sh_body_is_valid(const sh_world* world, sh_body_id body);
 /** Fill *out_info. Thread: sim. Alloc: none. */
 SH_API sh_status sh_body_get_info(const sh_world* world, sh_body_id body, sh_body_info* out_info);
 
-/** Copy positions (node_count x 3, m) into out; capacity in doubles. Thread: sim. Alloc: none. */
-SH_API sh_status sh_body_get_positions(const sh_world* world, sh_body_id body, double* out,
-                                       int64_t capacity);
+/** Copy positions (node_count x 3, m) into out_positions, which has room for capacity nodes.
+ *  Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_positions(const sh_world* world, sh_body_id body,
+                                       double* out_positions, int32_t capacity);
 
 /** Set all positions (node_count x 3, m). Must be finite. Thread: sim. Alloc: none. */
 SH_API sh_status sh_body_set_positions(sh_world* world, sh_body_id body, const double* positions,
                                        int32_t node_count);
 
-/** Copy velocities (node_count x 3, m/s) into out. Thread: sim. Alloc: none. */
-SH_API sh_status sh_body_get_velocities(const sh_world* world, sh_body_id body, double* out,
-                                        int64_t capacity);
+/** Copy velocities (node_count x 3, m/s) into out_velocities, which has room for capacity
+ *  nodes. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_velocities(const sh_world* world, sh_body_id body,
+                                        double* out_velocities, int32_t capacity);
 
 /** Set all velocities (node_count x 3, m/s). Must be finite; fixed and orphan nodes keep
  *  zero velocity. Thread: sim. Alloc: none. */
 SH_API sh_status sh_body_set_velocities(sh_world* world, sh_body_id body,
                                         const double* velocities, int32_t node_count);
 
-/** Copy lumped nodal masses (node_count, kg; 0 for orphans) into out. Thread: sim. Alloc: none. */
-SH_API sh_status sh_body_get_masses(const sh_world* world, sh_body_id body, double* out,
-                                    int64_t capacity);
+/** Copy lumped nodal masses (node_count values, kg; 0 for orphans) into out_masses, which has
+ *  room for capacity nodes. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_masses(const sh_world* world, sh_body_id body, double* out_masses,
+                                    int32_t capacity);
 
 /** Fix nodes at their current positions (velocity zero). Thread: sim. Alloc: none. */
 SH_API sh_status sh_body_fix_nodes(sh_world* world, sh_body_id body, const int32_t* nodes,
@@ -529,10 +596,10 @@ SH_API sh_status sh_body_set_external_forces(sh_world* world, sh_body_id body,
 SH_API sh_status sh_body_set_node_damping(sh_world* world, sh_body_id body,
                                           const double* coefficients, int32_t node_count);
 
-/** Internal elastic nodal forces at the current positions (node_count x 3, N) into out.
- *  Thread: sim. Alloc: none. */
-SH_API sh_status sh_body_get_elastic_forces(const sh_world* world, sh_body_id body, double* out,
-                                            int64_t capacity);
+/** Copy the internal elastic nodal forces at the current positions (node_count x 3, N) into
+ *  out_forces, which has room for capacity nodes. Thread: sim. Alloc: none. */
+SH_API sh_status sh_body_get_elastic_forces(const sh_world* world, sh_body_id body,
+                                            double* out_forces, int32_t capacity);
 
 /** Elastic energy stored at the current positions (J). Thread: sim. Alloc: none. */
 SH_API sh_status sh_body_get_elastic_energy(const sh_world* world, sh_body_id body,
@@ -542,14 +609,11 @@ SH_API sh_status sh_body_get_elastic_energy(const sh_world* world, sh_body_id bo
  *  "velocity". Thread: sim. Alloc: may. */
 SH_API sh_status sh_body_write_vtu(const sh_world* world, sh_body_id body, const char* path);
 
-/* ------------------------------------------------------------------------------------------ */
-/* Tools, obstacles and contact                                                                 */
+/** @} */
 
-/** Generation-checked id of a tool. 0 is the null id. */
-typedef uint64_t sh_tool_id;
-
-/** Generation-checked id of a static obstacle. 0 is the null id. */
-typedef uint64_t sh_obstacle_id;
+/** @defgroup sh_api_contact Tools, obstacles and contact
+ *  Rigid tools posed by the host, static obstacles and the contact law.
+ *  @{ */
 
 /** Kinds of rigid collision shape. */
 typedef enum sh_shape_kind {
@@ -587,18 +651,19 @@ typedef struct sh_shape {
  *  implicit bodies take it proportional to the normal force at the step's start (so a contact
  *  that begins within a step has no friction until the next). */
 typedef struct sh_contact_params {
+    uint32_t internal_init;  /**< set by sh_contact_params_default; do not touch */
     double stiffness;        /**< lambda (N/m^n) per contact point, > 0; default 1e4 */
-    double exponent;         /**< n, >= 1; default 1.5 (Hertz-like) */
+    double exponent;         /**< n (dimensionless), >= 1; default 1.5 (Hertz-like) */
     double damping;          /**< alpha (s/m), >= 0; default 0.2 */
-    double static_friction;  /**< mu_s, >= dynamic_friction; default 0 */
-    double dynamic_friction; /**< mu_d, >= 0; default 0 */
+    double static_friction;  /**< mu_s (dimensionless), >= dynamic_friction; default 0 */
+    double dynamic_friction; /**< mu_d (dimensionless), >= 0; default 0 */
     double slip_velocity;    /**< tangential speed (m/s) below which friction is viscous
                                   (sticking), > 0; default 1e-3 */
     int32_t capacity;        /**< most contact points kept per step; beyond it the deepest are
                                   kept and SH_WARN_CAPACITY is counted; default 4096 */
 } sh_contact_params;
 
-/** Fill contact params with defaults. Thread: any. Alloc: none. */
+/** Fill contact params with defaults (the values above). Thread: any. Alloc: none. */
 SH_API void sh_contact_params_default(sh_contact_params* params);
 
 /** Definition of a tool or an obstacle. Initialise with sh_collider_def_default. */
@@ -629,8 +694,8 @@ SH_API int32_t sh_tool_is_valid(const sh_world* world, sh_tool_id tool);
 
 /** Read the pose the next step takes the tool to (the last one set): position (m) and unit
  *  quaternion (w, x, y, z). Thread: sim. Alloc: none. */
-SH_API sh_status sh_tool_get_pose(const sh_world* world, sh_tool_id tool, double position[3],
-                                  double orientation[4]);
+SH_API sh_status sh_tool_get_pose(const sh_world* world, sh_tool_id tool,
+                                  double out_position[3], double out_orientation[4]);
 
 /** Pose the tool for the next sh_world_step: the step moves it from its last pose to this
  *  one (its velocity is the difference over dt unless set with sh_tool_set_velocity). A
@@ -659,12 +724,13 @@ typedef struct sh_contact_state {
 
 /** Read a tool's reaction wrench (force and torque on the tool, world frame) and contact
  *  measures after the last step, at the step's end state. Thread: sim. Alloc: none. */
-SH_API sh_status sh_tool_get_contact(const sh_world* world, sh_tool_id tool, sh_contact_state* out);
+SH_API sh_status sh_tool_get_contact(const sh_world* world, sh_tool_id tool,
+                                     sh_contact_state* out_state);
 
 /** Read only the reaction wrench of sh_tool_get_contact: force (N) and torque about the tool's
  *  position (N m) on the tool, world frame. Thread: sim. Alloc: none. */
-SH_API sh_status sh_tool_get_wrench(const sh_world* world, sh_tool_id tool, double force[3],
-                                    double torque[3]);
+SH_API sh_status sh_tool_get_wrench(const sh_world* world, sh_tool_id tool,
+                                    double out_force[3], double out_torque[3]);
 
 /** Add a static rigid obstacle (any shape kind; a plane takes position and shape.normal).
  *  Same validation as sh_tool_create. Thread: sim. Alloc: may. */
@@ -680,7 +746,7 @@ SH_API int32_t sh_obstacle_is_valid(const sh_world* world, sh_obstacle_id obstac
 /** Read an obstacle's reaction wrench and contact measures after the last step.
  *  Thread: sim. Alloc: none. */
 SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id obstacle,
-                                         sh_contact_state* out);
+                                         sh_contact_state* out_state);
 
 /** Enable contact between two deformable bodies with params (NULL disables it): each step,
  *  the surface nodes of each body that lie inside the other's tets, or in front of its
@@ -701,8 +767,11 @@ SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id o
 SH_API sh_status sh_world_set_body_contact(sh_world* world, sh_body_id a, sh_body_id b,
                                            const sh_contact_params* params);
 
-/* ------------------------------------------------------------------------------------------ */
-/* Static equilibrium                                                                           */
+/** @} */
+
+/** @defgroup sh_api_static Static equilibrium
+ *  Newton-Raphson statics of every body.
+ *  @{ */
 
 /** Number of residuals kept in sh_static_report.residual_history. */
 #define SH_STATIC_HISTORY 64
@@ -710,10 +779,12 @@ SH_API sh_status sh_world_set_body_contact(sh_world* world, sh_body_id a, sh_bod
 /** Settings of sh_world_solve_static. Initialise with sh_static_def_default. */
 typedef struct sh_static_def {
     uint32_t internal_init;         /**< set by sh_static_def_default; do not touch */
-    double tolerance;               /**< stop when |residual| / |applied load| is below this or
-                                         below the round-off of the internal forces; 1e-10 */
+    double tolerance;               /**< (dimensionless) stop when |residual| / |applied load|
+                                         is below this or below the round-off of the internal
+                                         forces; default 1e-10 */
     int32_t max_iterations;         /**< Newton iterations per load step; default 50 */
-    int32_t load_steps;             /**< apply the loads in this many equal increments; 1 */
+    int32_t load_steps;             /**< apply the loads in this many equal increments;
+                                         default 1 */
     sh_linear_solver linear_solver; /**< default SH_LINEAR_SOLVER_DEFAULT */
 } sh_static_def;
 
@@ -745,9 +816,11 @@ typedef struct sh_static_report {
 SH_API sh_status sh_world_solve_static(sh_world* world, const sh_static_def* def,
                                        sh_static_report* report);
 
+/** @} */
 
-/* ------------------------------------------------------------------------------------------ */
-/* Haptic rendering: the Volumetric Buffer Model                                               */
+/** @defgroup sh_api_haptic Haptic rendering
+ *  The Volumetric Buffer Model stepped on the device thread.
+ *  @{ */
 
 /** A haptic context: a small local explicit FEM model (the Volumetric Buffer Model of
  *  Mendoza & Laugier 2003) around a tool's contact, stepped by sh_haptic_step on the device
@@ -818,7 +891,8 @@ typedef struct sh_haptic_output {
  *  nearest the tool; the world then moves the tool to the latest device pose before each
  *  step, so the full model feels the tool where the device is. Thread: sim. Alloc: may (the
  *  whole arena, once). */
-SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_haptic** out);
+SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def,
+                                  sh_haptic** out_haptic);
 
 /** Destroy a context (after the haptic thread has stopped calling sh_haptic_step on it). It
  *  may outlive its world. NULL is a no-op returning SH_OK; a destroyed pointer returns
@@ -826,23 +900,27 @@ SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_
 SH_API sh_status sh_haptic_destroy(sh_haptic* haptic);
 
 /** Step the buffer by dt to the device pose (position m, orientation unit quaternion
- *  (w, x, y, z), world frame) and fill out. The full model's newest buffer is taken up (its
+ *  (w, x, y, z), world frame) and fill out_output. The full model's newest buffer is taken up (its
  *  interior nodes keep the state the haptic side gave them), its boundary nodes follow the
  *  full model across the full-model step, the interior is integrated explicitly (sub-stepped
  *  below its critical step) under the tool's Hunt-Crossley contact, and the force is the
  *  buffer's push on the tool. Before the first buffer arrives the tool presses on a proxy: the
- *  plane of the last known nearest surface point. out is always filled and finite; bad input
+ *  plane of the last known nearest surface point. out_output is always filled and finite; bad input
  *  (a NULL pointer, a non-finite pose or dt) is a status plus a fault bit, with the force held
  *  and ramping out; a NULL or destroyed context is SH_ERR_INVALID_HANDLE (checked without a
- *  lock, so only as far as the freed memory still says so). Thread: haptic (one thread at a
+ *  lock and without reading the context). Thread: haptic (one thread at a
  *  time per context, concurrent with the sim thread). Alloc: none. Locks: none. */
 SH_API sh_status sh_haptic_step(sh_haptic* haptic, const double position[3],
-                                const double orientation[4], double dt, sh_haptic_output* out);
+                                const double orientation[4], double dt,
+                                sh_haptic_output* out_output);
 
 /** Read the context's warning counters (SH_WARN_COUNT values: SH_WARN_FORCE_CLAMPED for
  *  clamped forces and rates, SH_WARN_CAPACITY for buffers cut to capacity, SH_WARN_UNSTABLE
  *  for roll-backs). Thread: sim. Alloc: none. */
-SH_API sh_status sh_haptic_get_warnings(const sh_haptic* haptic, uint64_t out[SH_WARN_COUNT]);
+SH_API sh_status sh_haptic_get_warnings(const sh_haptic* haptic,
+                                        uint64_t out_counts[SH_WARN_COUNT]);
+
+/** @} */
 
 #ifdef __cplusplus
 }

@@ -13,7 +13,7 @@ using namespace sh;
 
 namespace {
 
-Body& body_of(const sh_world* world, sh_body_id id) { return capi::world_of(world).body(id); }
+Body& body_of(const sh_world* world, sh_body_id id) { return capi::world_of(world).body(id.value); }
 
 void require_node_count(const Body& body, int32_t node_count) {
     SH_REQUIRE(node_count == body.node_count(), SH_ERR_INVALID_ARGUMENT, "node_count = %d, the body has %d nodes", node_count, body.node_count());
@@ -32,12 +32,6 @@ void require_node_indices(const Body& body, const int32_t* nodes, int32_t count)
         SH_REQUIRE(nodes[k] >= 0 && nodes[k] < body.node_count(), SH_ERR_INVALID_ARGUMENT, "nodes[%d] = %d is not a node index in [0, %d)", k, nodes[k], body.node_count());
 }
 
-void copy_out(const vec<double>& source, double* out, int64_t capacity) {
-    capi::require_pointer(out, "out");
-    capi::require_capacity(capacity, static_cast<int64_t>(source.size()), "out");
-    std::copy(source.begin(), source.end(), out);
-}
-
 }  // namespace
 
 extern "C" {
@@ -46,22 +40,22 @@ SH_API sh_status sh_body_set_material(sh_world* world, sh_body_id body, const in
                                       const sh_material* material) {
     return capi::guard([&] {
         World& w = capi::world_of(world);
-        w.body(body);  // validates the id first
-        capi::require_pointer(material, "material");
+        w.body(body.value);  // validates the id first
+        capi::require_initialised(material, "material");
         validate_material(*material, "sh_body_set_material");
         SH_REQUIRE(element_count >= 0, SH_ERR_INVALID_ARGUMENT, "element_count = %d, must be >= 0", element_count);
         if (element_count > 0) capi::require_pointer(elements, "elements");
-        w.set_material(body, elements, element_count, *material);
+        w.set_material(body.value, elements, element_count, *material);
     });
 }
 
-SH_API sh_status sh_world_remove_body(sh_world* world, sh_body_id body) {
-    return capi::guard([&] { capi::world_of(world).remove_body(body); });
+SH_API sh_status sh_body_destroy(sh_world* world, sh_body_id body) {
+    return capi::guard([&] { capi::world_of(world).remove_body(body.value); });
 }
 
 SH_API int32_t sh_body_is_valid(const sh_world* world, sh_body_id body) {
     int32_t valid = 0;
-    capi::guard([&] { valid = capi::world_of(world).is_valid(body) ? 1 : 0; });
+    capi::guard([&] { valid = capi::world_of(world).is_valid(body.value) ? 1 : 0; });
     return valid;
 }
 
@@ -77,21 +71,22 @@ SH_API sh_status sh_body_get_info(const sh_world* world, sh_body_id body, sh_bod
             info.fixed_node_count += b.kinematic[static_cast<size_t>(i)] ? 1 : 0;
             info.total_mass += b.mass[static_cast<size_t>(i)];
         }
-        info.dt_critical = critical_step(b, capi::world_of(world).step_settings(body).integrator);
+        info.dt_critical = critical_step(b, capi::world_of(world).step_settings(body.value).integrator);
         *out_info = info;
     });
 }
 
-SH_API sh_status sh_body_get_positions(const sh_world* world, sh_body_id body, double* out, int64_t capacity) {
-    return capi::guard([&] { copy_out(body_of(world, body).x, out, capacity); });
+SH_API sh_status sh_body_get_positions(const sh_world* world, sh_body_id body, double* out_positions, int32_t capacity) {
+    return capi::guard([&] { capi::copy_out(body_of(world, body).x, 3, out_positions, capacity, "out_positions", "nodes"); });
 }
 
-SH_API sh_status sh_body_get_velocities(const sh_world* world, sh_body_id body, double* out, int64_t capacity) {
-    return capi::guard([&] { copy_out(body_of(world, body).v, out, capacity); });
+SH_API sh_status sh_body_get_velocities(const sh_world* world, sh_body_id body, double* out_velocities,
+                                        int32_t capacity) {
+    return capi::guard([&] { capi::copy_out(body_of(world, body).v, 3, out_velocities, capacity, "out_velocities", "nodes"); });
 }
 
-SH_API sh_status sh_body_get_masses(const sh_world* world, sh_body_id body, double* out, int64_t capacity) {
-    return capi::guard([&] { copy_out(body_of(world, body).mass, out, capacity); });
+SH_API sh_status sh_body_get_masses(const sh_world* world, sh_body_id body, double* out_masses, int32_t capacity) {
+    return capi::guard([&] { capi::copy_out(body_of(world, body).mass, 1, out_masses, capacity, "out_masses", "nodes"); });
 }
 
 SH_API sh_status sh_body_set_positions(sh_world* world, sh_body_id body, const double* positions, int32_t node_count) {
@@ -163,13 +158,14 @@ SH_API sh_status sh_body_set_node_damping(sh_world* world, sh_body_id body, cons
     });
 }
 
-SH_API sh_status sh_body_get_elastic_forces(const sh_world* world, sh_body_id body, double* out, int64_t capacity) {
+SH_API sh_status sh_body_get_elastic_forces(const sh_world* world, sh_body_id body, double* out_forces,
+                                            int32_t capacity) {
     return capi::guard([&] {
         const Body& b = body_of(world, body);
-        capi::require_pointer(out, "out");
-        capi::require_capacity(capacity, static_cast<int64_t>(b.x.size()), "out");
-        std::fill(out, out + b.x.size(), 0.0);
-        b.add_internal_forces(b.x.data(), nullptr, out);
+        capi::require_pointer(out_forces, "out_forces");
+        capi::require_capacity(capacity, static_cast<size_t>(b.node_count()), "out_forces", "nodes");
+        std::fill(out_forces, out_forces + b.x.size(), 0.0);
+        b.add_internal_forces(b.x.data(), nullptr, out_forces);
     });
 }
 

@@ -8,14 +8,17 @@ using namespace sh;
 
 namespace {
 
-// Copies a collider's contact state, with the wrench's parts optional.
-void read_contact(const Collider& c, sh_contact_state* out) {
-    capi::require_pointer(out, "out");
-    *out = c.state;
+// Copies a collider's contact state into out_state.
+void read_contact(const Collider& c, sh_contact_state* out_state) {
+    capi::require_pointer(out_state, "out_state");
+    *out_state = c.state;
 }
 
+// A copy of def, checked for its cookies and its shape kind (the rest is checked by the
+// collider it makes).
 sh_collider_def checked_def(const sh_collider_def* def) {
     capi::require_initialised(def, "def");
+    capi::require_initialised(&def->contact, "def->contact");
     sh_collider_def out = *def;
     const int kind = enum_value(def->shape.kind);
     SH_REQUIRE(kind >= 0 && kind < SH_SHAPE_COUNT, SH_ERR_INVALID_ARGUMENT,
@@ -31,6 +34,7 @@ extern "C" {
 SH_API void sh_contact_params_default(sh_contact_params* params) {
     if (!params) return;
     *params = sh_contact_params{};
+    params->internal_init = capi::kDefInitialised;
     params->stiffness = 1e4;
     params->exponent = 1.5;
     params->damping = 0.2;
@@ -54,44 +58,45 @@ SH_API void sh_collider_def_default(sh_collider_def* def) {
 SH_API sh_status sh_tool_create(sh_world* world, const sh_collider_def* def, sh_tool_id* out_tool) {
     return capi::guard([&] {
         capi::require_pointer(out_tool, "out_tool");
-        *out_tool = 0;
+        *out_tool = sh_tool_id{0};
         World& w = capi::world_of(world);
-        *out_tool = w.add_collider(checked_def(def), true);
+        out_tool->value = w.add_collider(checked_def(def), true);
     });
 }
 
 SH_API sh_status sh_tool_destroy(sh_world* world, sh_tool_id tool) {
-    return capi::guard([&] { capi::world_of(world).remove_collider(tool, true); });
+    return capi::guard([&] { capi::world_of(world).remove_collider(tool.value, true); });
 }
 
 SH_API int32_t sh_tool_is_valid(const sh_world* world, sh_tool_id tool) {
     int32_t valid = 0;
-    capi::guard([&] { valid = capi::world_of(world).is_valid_collider(tool, true) ? 1 : 0; });
+    capi::guard([&] { valid = capi::world_of(world).is_valid_collider(tool.value, true) ? 1 : 0; });
     return valid;
 }
 
 SH_API sh_status sh_tool_set_pose(sh_world* world, sh_tool_id tool, const double position[3],
                                   const double orientation[4]) {
     return capi::guard([&] {
-        Collider& c = capi::world_of(world).collider(tool, true);
+        Collider& c = capi::world_of(world).collider(tool.value, true);
         c.target = checked_pose(position, orientation, "sh_tool_set_pose");
     });
 }
 
-SH_API sh_status sh_tool_get_pose(const sh_world* world, sh_tool_id tool, double position[3], double orientation[4]) {
+SH_API sh_status sh_tool_get_pose(const sh_world* world, sh_tool_id tool, double out_position[3],
+                                  double out_orientation[4]) {
     return capi::guard([&] {
-        const Collider& c = capi::world_of(world).collider(tool, true);
-        capi::require_pointer(position, "position");
-        capi::require_pointer(orientation, "orientation");
-        for (int k = 0; k < 3; ++k) position[k] = c.target.p[k];
-        for (int k = 0; k < 4; ++k) orientation[k] = c.target.q[k];
+        const Collider& c = capi::world_of(world).collider(tool.value, true);
+        capi::require_pointer(out_position, "out_position");
+        capi::require_pointer(out_orientation, "out_orientation");
+        for (int k = 0; k < 3; ++k) out_position[k] = c.target.p[k];
+        for (int k = 0; k < 4; ++k) out_orientation[k] = c.target.q[k];
     });
 }
 
 SH_API sh_status sh_tool_set_velocity(sh_world* world, sh_tool_id tool, const double linear[3],
                                       const double angular[3]) {
     return capi::guard([&] {
-        Collider& c = capi::world_of(world).collider(tool, true);
+        Collider& c = capi::world_of(world).collider(tool.value, true);
         capi::require_pointer(linear, "linear");
         capi::require_pointer(angular, "angular");
         for (int k = 0; k < 3; ++k) {
@@ -106,18 +111,19 @@ SH_API sh_status sh_tool_set_velocity(sh_world* world, sh_tool_id tool, const do
     });
 }
 
-SH_API sh_status sh_tool_get_contact(const sh_world* world, sh_tool_id tool, sh_contact_state* out) {
-    return capi::guard([&] { read_contact(capi::world_of(world).collider(tool, true), out); });
+SH_API sh_status sh_tool_get_contact(const sh_world* world, sh_tool_id tool, sh_contact_state* out_state) {
+    return capi::guard([&] { read_contact(capi::world_of(world).collider(tool.value, true), out_state); });
 }
 
-SH_API sh_status sh_tool_get_wrench(const sh_world* world, sh_tool_id tool, double force[3], double torque[3]) {
+SH_API sh_status sh_tool_get_wrench(const sh_world* world, sh_tool_id tool, double out_force[3],
+                                    double out_torque[3]) {
     return capi::guard([&] {
-        const Collider& c = capi::world_of(world).collider(tool, true);
-        capi::require_pointer(force, "force");
-        capi::require_pointer(torque, "torque");
+        const Collider& c = capi::world_of(world).collider(tool.value, true);
+        capi::require_pointer(out_force, "out_force");
+        capi::require_pointer(out_torque, "out_torque");
         for (int k = 0; k < 3; ++k) {
-            force[k] = c.state.force[k];
-            torque[k] = c.state.torque[k];
+            out_force[k] = c.state.force[k];
+            out_torque[k] = c.state.torque[k];
         }
     });
 }
@@ -125,29 +131,34 @@ SH_API sh_status sh_tool_get_wrench(const sh_world* world, sh_tool_id tool, doub
 SH_API sh_status sh_obstacle_create(sh_world* world, const sh_collider_def* def, sh_obstacle_id* out_obstacle) {
     return capi::guard([&] {
         capi::require_pointer(out_obstacle, "out_obstacle");
-        *out_obstacle = 0;
+        *out_obstacle = sh_obstacle_id{0};
         World& w = capi::world_of(world);
-        *out_obstacle = w.add_collider(checked_def(def), false);
+        out_obstacle->value = w.add_collider(checked_def(def), false);
     });
 }
 
 SH_API sh_status sh_obstacle_destroy(sh_world* world, sh_obstacle_id obstacle) {
-    return capi::guard([&] { capi::world_of(world).remove_collider(obstacle, false); });
+    return capi::guard([&] { capi::world_of(world).remove_collider(obstacle.value, false); });
 }
 
 SH_API int32_t sh_obstacle_is_valid(const sh_world* world, sh_obstacle_id obstacle) {
     int32_t valid = 0;
-    capi::guard([&] { valid = capi::world_of(world).is_valid_collider(obstacle, false) ? 1 : 0; });
+    capi::guard([&] { valid = capi::world_of(world).is_valid_collider(obstacle.value, false) ? 1 : 0; });
     return valid;
 }
 
-SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id obstacle, sh_contact_state* out) {
-    return capi::guard([&] { read_contact(capi::world_of(world).collider(obstacle, false), out); });
+SH_API sh_status sh_obstacle_get_contact(const sh_world* world, sh_obstacle_id obstacle,
+                                         sh_contact_state* out_state) {
+    return capi::guard([&] { read_contact(capi::world_of(world).collider(obstacle.value, false), out_state); });
 }
 
 SH_API sh_status sh_world_set_body_contact(sh_world* world, sh_body_id a, sh_body_id b,
                                            const sh_contact_params* params) {
-    return capi::guard([&] { capi::world_of(world).set_body_contact(a, b, params); });
+    return capi::guard([&] {
+        World& w = capi::world_of(world);
+        if (params) capi::require_initialised(params, "params");
+        w.set_body_contact(a.value, b.value, params);
+    });
 }
 
 }  // extern "C"

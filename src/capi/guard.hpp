@@ -6,7 +6,9 @@
 
 #include <softhap/softhap.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <new>
 
@@ -50,13 +52,22 @@ inline void require_finite(double value, const char* name) {
     if (!std::isfinite(value)) throw Error(SH_ERR_INVALID_ARGUMENT, format("%s is not finite", name));
 }
 
-/// Throws SH_ERR_INVALID_ARGUMENT when an output buffer of `capacity` elements is smaller
-/// than `needed`.
-inline void require_capacity(int64_t capacity, int64_t needed, const char* name) {
-    if (capacity < needed)
-        throw Error(SH_ERR_INVALID_ARGUMENT,
-                    format("%s: capacity %lld is smaller than the %lld values needed",
-                           name, static_cast<long long>(capacity), static_cast<long long>(needed)));
+/// Throws SH_ERR_INVALID_ARGUMENT when the output array `name`, with room for `capacity`
+/// items (nodes, tets, ...: `items` names them), cannot hold the `needed` ones.
+inline void require_capacity(int32_t capacity, size_t needed, const char* name, const char* items) {
+    if (capacity < 0 || static_cast<size_t>(capacity) < needed)
+        throw Error(SH_ERR_INVALID_ARGUMENT, format("%s: capacity %d is smaller than the %zu %s to copy", name,
+                                                    static_cast<int>(capacity), needed, items));
+}
+
+/// Copies source, values_per_item values for each item (3 per node for positions, 4 per tet),
+/// into the output array `name`, which has room for capacity items (`items` names them).
+template <class T, class Vector>
+void copy_out(const Vector& source, size_t values_per_item, T* out, int32_t capacity, const char* name,
+              const char* items) {
+    require_pointer(out, name);
+    require_capacity(capacity, source.size() / values_per_item, name, items);
+    std::copy(source.begin(), source.end(), out);
 }
 
 /// Magic value that *_def_default writes into internal_init.
@@ -68,7 +79,7 @@ void require_initialised(const Def* def, const char* name) {
     require_pointer(def, name);
     if (def->internal_init != kDefInitialised)
         throw Error(SH_ERR_UNINITIALIZED_DEF,
-                    format("%s was not initialised by its *_def_default function", name));
+                    format("%s was not initialised by its *_default function", name));
 }
 
 }  // namespace sh::capi

@@ -45,18 +45,18 @@ SH_API sh_status sh_haptic_memory_bytes(const sh_haptic_def* def, size_t* out_by
     });
 }
 
-SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_haptic** out) {
+SH_API sh_status sh_haptic_create(sh_world* world, const sh_haptic_def* def, sh_haptic** out_haptic) {
     return capi::guard([&] {
-        capi::require_pointer(out, "out");
-        *out = nullptr;
+        capi::require_pointer(out_haptic, "out_haptic");
+        *out_haptic = nullptr;
         World& w = capi::world_of(world);
         const sh_haptic_def d = checked_def(def);
-        SH_REQUIRE(w.is_valid_collider(d.tool, true), SH_ERR_INVALID_HANDLE,
-                   "def->tool = 0x%llx is not a live tool of this world", static_cast<unsigned long long>(d.tool));
+        SH_REQUIRE(w.is_valid_collider(d.tool.value, true), SH_ERR_INVALID_HANDLE,
+                   "def->tool = 0x%llx is not a live tool of this world", static_cast<unsigned long long>(d.tool.value));
         HapticContext* context = sh::create<HapticContext>(w, d);
         try {
             w.add_hook(context);
-            *out = static_cast<sh_haptic*>(const_cast<void*>(capi::register_handle(capi::HandleKind::Haptic, context)));
+            *out_haptic = static_cast<sh_haptic*>(const_cast<void*>(capi::register_handle(capi::HandleKind::Haptic, context)));
         } catch (...) {
             w.remove_hook(context);
             sh::destroy(context);
@@ -76,20 +76,20 @@ SH_API sh_status sh_haptic_destroy(sh_haptic* haptic) {
 }
 
 SH_API sh_status sh_haptic_step(sh_haptic* haptic, const double position[3], const double orientation[4], double dt,
-                                sh_haptic_output* out) {
+                                sh_haptic_output* out_output) {
     // No guard: nothing here throws, and the step must not touch the last-error message's
     // formatting (it allocates). The handle check reads the handle table only.
     auto* context = static_cast<HapticContext*>(capi::find_handle(capi::HandleKind::Haptic, haptic));
     if (!context) return SH_ERR_INVALID_HANDLE;
-    if (!out) return SH_ERR_INVALID_ARGUMENT;
-    return context->step(position, orientation, dt, *out);
+    if (!out_output) return SH_ERR_INVALID_ARGUMENT;
+    return context->step(position, orientation, dt, *out_output);
 }
 
-SH_API sh_status sh_haptic_get_warnings(const sh_haptic* haptic, uint64_t out[SH_WARN_COUNT]) {
+SH_API sh_status sh_haptic_get_warnings(const sh_haptic* haptic, uint64_t out_counts[SH_WARN_COUNT]) {
     return capi::guard([&] {
         HapticContext& context = context_of(haptic);
-        capi::require_pointer(out, "out");
-        context.read_warnings(out);
+        capi::require_pointer(out_counts, "out_counts");
+        context.read_warnings(out_counts);
     });
 }
 

@@ -24,13 +24,6 @@ sh_mesh* publish(TetMesh&& built) {
     }
 }
 
-template <class T>
-void copy_out(const vec<T>& source, T* out, int64_t capacity, const char* name) {
-    capi::require_pointer(out, name);
-    capi::require_capacity(capacity, static_cast<int64_t>(source.size()), name);
-    std::copy(source.begin(), source.end(), out);
-}
-
 }  // namespace
 
 namespace sh::capi {
@@ -117,20 +110,22 @@ SH_API sh_status sh_mesh_get_info(const sh_mesh* mesh, sh_mesh_info* out_info) {
     });
 }
 
-SH_API sh_status sh_mesh_get_nodes(const sh_mesh* mesh, double* out, int64_t capacity) {
-    return capi::guard([&] { copy_out(checked_mesh(mesh).nodes, out, capacity, "out"); });
+SH_API sh_status sh_mesh_get_nodes(const sh_mesh* mesh, double* out_nodes, int32_t capacity) {
+    return capi::guard([&] { capi::copy_out(checked_mesh(mesh).nodes, 3, out_nodes, capacity, "out_nodes", "nodes"); });
 }
 
-SH_API sh_status sh_mesh_get_tets(const sh_mesh* mesh, int32_t* out, int64_t capacity) {
-    return capi::guard([&] { copy_out(checked_mesh(mesh).tets, out, capacity, "out"); });
+SH_API sh_status sh_mesh_get_tets(const sh_mesh* mesh, int32_t* out_tets, int32_t capacity) {
+    return capi::guard([&] { capi::copy_out(checked_mesh(mesh).tets, 4, out_tets, capacity, "out_tets", "tets"); });
 }
 
-SH_API sh_status sh_mesh_get_surface_triangles(const sh_mesh* mesh, int32_t* out, int64_t capacity) {
-    return capi::guard([&] { copy_out(checked_mesh(mesh).surface_triangles, out, capacity, "out"); });
+SH_API sh_status sh_mesh_get_surface_triangles(const sh_mesh* mesh, int32_t* out_triangles, int32_t capacity) {
+    return capi::guard([&] {
+        capi::copy_out(checked_mesh(mesh).surface_triangles, 3, out_triangles, capacity, "out_triangles", "triangles");
+    });
 }
 
-SH_API sh_status sh_mesh_get_edges(const sh_mesh* mesh, int32_t* out, int64_t capacity) {
-    return capi::guard([&] { copy_out(checked_mesh(mesh).edges, out, capacity, "out"); });
+SH_API sh_status sh_mesh_get_edges(const sh_mesh* mesh, int32_t* out_edges, int32_t capacity) {
+    return capi::guard([&] { capi::copy_out(checked_mesh(mesh).edges, 2, out_edges, capacity, "out_edges", "edges"); });
 }
 
 SH_API sh_status sh_mesh_write_vtu(const sh_mesh* mesh, const char* path) {

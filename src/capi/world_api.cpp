@@ -126,11 +126,11 @@ SH_API sh_status sh_world_set_gravity(sh_world* world, const double gravity[3]) 
     });
 }
 
-SH_API sh_status sh_world_get_warnings(const sh_world* world, uint64_t out[SH_WARN_COUNT]) {
+SH_API sh_status sh_world_get_warnings(const sh_world* world, uint64_t out_counts[SH_WARN_COUNT]) {
     return capi::guard([&] {
         const World& w = capi::world_of(world);
-        capi::require_pointer(out, "out");
-        for (int k = 0; k < SH_WARN_COUNT; ++k) out[k] = w.warnings[k];
+        capi::require_pointer(out_counts, "out_counts");
+        for (int k = 0; k < SH_WARN_COUNT; ++k) out_counts[k] = w.warnings[k];
     });
 }
 
@@ -165,33 +165,41 @@ SH_API sh_status sh_world_solve_static(sh_world* world, const sh_static_def* def
     });
 }
 
+SH_API void sh_material_default(sh_material* material) {
+    if (!material) return;
+    *material = sh_material{};
+    material->internal_init = capi::kDefInitialised;
+    material->model = SH_MATERIAL_STVK;
+    material->young = 3000.0;
+    material->poisson = 0.45;
+    material->density = 1000.0;
+}
+
 SH_API void sh_fem_body_def_default(sh_fem_body_def* def) {
     if (!def) return;
     *def = sh_fem_body_def{};
     def->internal_init = capi::kDefInitialised;
-    def->material.model = SH_MATERIAL_STVK;
-    def->material.young = 3000.0;
-    def->material.poisson = 0.45;
-    def->material.density = 1000.0;
+    sh_material_default(&def->material);
     def->integrator = SH_INTEGRATOR_SYMPLECTIC_EULER;
     def->on_unstable = SH_UNSTABLE_SUBSTEP;
     def->runaway_speed = 1e4;
     def->implicit = default_implicit_settings();
 }
 
-SH_API sh_status sh_world_add_fem_body(sh_world* world, const sh_fem_body_def* def, sh_body_id* out_body) {
+SH_API sh_status sh_fem_body_create(sh_world* world, const sh_fem_body_def* def, sh_body_id* out_body) {
     return capi::guard([&] {
         World& w = capi::world_of(world);
         capi::require_pointer(out_body, "out_body");
-        *out_body = SH_NULL_BODY;
+        *out_body = sh_body_id{0};
         capi::require_initialised(def, "def");
+        capi::require_initialised(&def->material, "def->material");
         if (!def->mesh) throw Error(SH_ERR_INVALID_ARGUMENT, "def->mesh is NULL");
         const TetMesh& mesh = capi::mesh_of(def->mesh);
         validate_material(def->material, "def");
         SH_REQUIRE(std::isfinite(def->damping_stiffness) && def->damping_stiffness >= 0.0, SH_ERR_INVALID_ARGUMENT, "def->damping_stiffness = %g s, must be finite and >= 0", def->damping_stiffness);
         const StepSettings settings = step_settings(*def);
         const double damping_mass = checked_damping_mass(*def);
-        *out_body = w.add_fem_body(mesh, def->material, damping_mass, def->damping_stiffness, settings);
+        out_body->value = w.add_fem_body(mesh, def->material, damping_mass, def->damping_stiffness, settings);
     });
 }
 
@@ -208,11 +216,11 @@ SH_API void sh_spring_body_def_default(sh_spring_body_def* def) {
     def->implicit = default_implicit_settings();
 }
 
-SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_def* def, sh_body_id* out_body) {
+SH_API sh_status sh_spring_body_create(sh_world* world, const sh_spring_body_def* def, sh_body_id* out_body) {
     return capi::guard([&] {
         World& w = capi::world_of(world);
         capi::require_pointer(out_body, "out_body");
-        *out_body = SH_NULL_BODY;
+        *out_body = sh_body_id{0};
         capi::require_initialised(def, "def");
         const TetMesh* mesh = def->mesh ? &capi::mesh_of(def->mesh) : nullptr;
         vec<double> nodes;
@@ -240,8 +248,8 @@ SH_API sh_status sh_world_add_spring_body(sh_world* world, const sh_spring_body_
                 if (!mesh->node_used[i]) masses[i] = 0.0;  // orphans stay out of the dynamics
         const StepSettings settings = step_settings(*def);
         const double damping_mass = checked_damping_mass(*def);
-        *out_body = w.add_body(sh::create<SpringBody>(std::move(nodes), std::move(springs), def->params, masses, damping_mass),
-                               settings);
+        out_body->value = w.add_body(
+            sh::create<SpringBody>(std::move(nodes), std::move(springs), def->params, masses, damping_mass), settings);
     });
 }
 

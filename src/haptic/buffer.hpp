@@ -3,6 +3,7 @@
 // with the full model's start and end of step, its surface, and the contact context.
 #pragma once
 
+#include "core/id_pool.hpp"
 #include "haptic/arena.hpp"
 #include "model/tet_block.hpp"
 
@@ -24,7 +25,7 @@ struct BufferCapacity {
 /// One exchanged buffer. The arrays are carved at creation with the capacities; the counts
 /// say how much of them is in use.
 struct Buffer {
-    sh_body_id body = 0;        ///< the body it was cut from (0: none near the tool)
+    Id body = kNullId;       ///< the body it was cut from (0: none near the tool)
     bool tool_alive = true;     ///< false once the tool is destroyed
     int32_t node_count = 0, tet_count = 0, triangle_count = 0, surface_node_count = 0, edge_count = 0;
     int32_t block_begin[SH_MATERIAL_COUNT + 1] = {};  ///< blocks of material model m:

@@ -16,7 +16,7 @@ namespace {
 
 // The tool's nearest FEM surface: which body, which triangle, the point and the distance.
 struct NearestSurface {
-    sh_body_id body = 0;
+    Id body = kNullId;
     const FemBody* fem = nullptr;
     int32_t triangle = -1;
     double point[3] = {};
@@ -25,7 +25,7 @@ struct NearestSurface {
 
 NearestSurface nearest_surface(const World& world, const double p[3]) {
     NearestSurface best;
-    world.for_each_body([&](sh_body_id id, const Body& body) {
+    world.for_each_body([&](Id id, const Body& body) {
         if (!body.is_fem()) return;
         const vec<int32_t>& tris = body.surface_triangles;
         const double* x = body.x.data();
@@ -83,7 +83,7 @@ void deepest_contact(const Collider& tool, NearestSurface& near) {
 
 }  // namespace
 
-void HapticContext::ensure_adjacency(const FemBody& body, sh_body_id id) {
+void HapticContext::ensure_adjacency(const FemBody& body, Id id) {
     if (adjacency_body_ == id && adjacency_tets_ == body.element_count()) return;
     const size_t n = static_cast<size_t>(body.node_count()), tets = static_cast<size_t>(body.element_count());
     const int32_t* nodes = body.element_nodes();
@@ -307,10 +307,10 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
     out.warnings = 0;
     out.has_proxy = false;
     out.period = period;
-    out.tool_alive = world.is_valid_collider(def_.tool, true);
+    out.tool_alive = world.is_valid_collider(def_.tool.value, true);
     extracted_body_ = 0;
     if (!out.tool_alive) return;
-    const Collider& tool = world.collider(def_.tool, true);
+    const Collider& tool = world.collider(def_.tool.value, true);
     // The surface point nearest the tool's centre; once the tool is in the surface, where it
     // is deepest (a long tool's tip, the middle of a flat press).
     NearestSurface near = nearest_surface(world, tool.target.p);

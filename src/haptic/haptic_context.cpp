@@ -84,7 +84,7 @@ size_t HapticContext::memory_bytes(const sh_haptic_def& def) {
 }
 
 HapticContext::HapticContext(World& world, const sh_haptic_def& def)
-    : def_(def), world_(&world), tool_(world.collider(def.tool, true)), filter_(limits_of(def)) {
+    : def_(def), world_(&world), tool_(world.collider(def.tool.value, true)), filter_(limits_of(def)) {
     validate_haptic_def(def);
     tool_.shape.use_allocation_free_queries();
     arena_bytes_ = memory_bytes(def);
@@ -125,14 +125,14 @@ void HapticContext::detach() {
 void HapticContext::before_step(World& world) {
     if (device_index_.take()) {
         const DevicePose& d = device_[device_index_.front()];
-        if (d.valid && world.is_valid_collider(def_.tool, true)) {
-            Collider& tool = world.collider(def_.tool, true);
+        if (d.valid && world.is_valid_collider(def_.tool.value, true)) {
+            Collider& tool = world.collider(def_.tool.value, true);
             tool.target = d.pose;
         }
     }
     // The buffer's boundary moves across the step from where the step starts.
     x_before_body_ = 0;
-    world.for_each_body([&](sh_body_id id, const Body& body) {
+    world.for_each_body([&](Id id, const Body& body) {
         if (id != extracted_body_) return;
         x_before_.assign(body.x.begin(), body.x.end());
         x_before_body_ = id;

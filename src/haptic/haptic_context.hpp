@@ -78,7 +78,7 @@ private:
     void fill_blocks(const FemBody& body, Buffer& out);
     void fill_triangles(const FemBody& body, Buffer& out);
     void fill_surface_features(const FemBody& body, Buffer& out);
-    void ensure_adjacency(const FemBody& body, sh_body_id id);
+    void ensure_adjacency(const FemBody& body, Id id);
 
     // haptic side
     void load_state(const Buffer& b, bool keep);
@@ -111,7 +111,7 @@ private:
     int32_t* id_[2] = {};  ///< body node of each working node
     int current_ = 0;
     int32_t node_count_ = 0;
-    sh_body_id state_body_ = 0;
+    Id state_body_ = kNullId;
     double* force_ = nullptr;  ///< 3 per node
     double* contact_ = nullptr;  ///< 3 per node: the sub-step's contact force on it
     double* saved_x_ = nullptr;
@@ -129,12 +129,12 @@ private:
     std::atomic<uint64_t> warnings_[SH_WARN_COUNT] = {};
 
     // sim side (may allocate)
-    sh_body_id extracted_body_ = 0;  ///< the body of the last extraction
-    sh_body_id adjacency_body_ = 0;
+    Id extracted_body_ = kNullId;  ///< the body of the last extraction
+    Id adjacency_body_ = kNullId;
     int32_t adjacency_tets_ = -1;
     vec<int32_t> node_tet_begin_, node_tet_;  ///< per body node: its tets (CSR)
     vec<double> x_before_;                     ///< the buffer body's x before the step
-    sh_body_id x_before_body_ = 0;
+    Id x_before_body_ = kNullId;
     vec<std::pair<double, int32_t>> ranked_;   ///< candidate tets by distance
     vec<int32_t> local_of_;                    ///< body node -> local node, -1 outside
     vec<uint8_t> in_buffer_;                   ///< per body tet

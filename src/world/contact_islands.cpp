@@ -53,7 +53,7 @@ int32_t ContactIslands::group(size_t slot_count) {
     return island_count();
 }
 
-NewtonProblem& ContactIslands::problem(const sh_body_id* ids_, int32_t count) {
+NewtonProblem& ContactIslands::problem(const Id* ids_, int32_t count) {
     for (Kept& k : kept_)
         if (k.ids.size() == static_cast<size_t>(count) && std::equal(k.ids.begin(), k.ids.end(), ids_)) {
             k.used = true;

@@ -3,6 +3,7 @@
 // them from step to step. A world builds one only once it has body pairs.
 #pragma once
 
+#include "core/id_pool.hpp"
 #include "core/memory.hpp"
 #include "model/body.hpp"
 
@@ -49,7 +50,7 @@ public:
 
     /// The Newton problem kept for the bodies ids[0..count) solved together, made on first
     /// use. Those not asked for since the last drop_unused are destroyed by it.
-    NewtonProblem& problem(const sh_body_id* ids, int32_t count);
+    NewtonProblem& problem(const Id* ids, int32_t count);
 
     /// Destroys the kept problems not asked for since the last call.
     void drop_unused();
@@ -59,12 +60,12 @@ public:
     // One island's members as the caller gathers them (scratch).
     vec<SteppedBody*> stepped;     ///< the members' stepped bodies
     vec<StepDoubling*> doublings;  ///< their step-doubling scratch
-    vec<sh_body_id> ids;           ///< their ids
+    vec<Id> ids;           ///< their ids
 
 private:
     /// A Newton problem kept for one set of bodies solved together.
     struct Kept {
-        vec<sh_body_id> ids;               ///< its bodies, in order
+        vec<Id> ids;               ///< its bodies, in order
         NewtonProblem* problem = nullptr;  ///< owned
         bool used = false;                 ///< asked for since the last drop_unused
     };

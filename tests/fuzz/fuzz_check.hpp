@@ -130,7 +130,7 @@ inline void check_mesh(const sh_mesh* mesh) {
     if (sh_mesh_get_info(mesh, &info) != SH_OK || info.tet_count <= 0)
         violated("a loaded mesh has no tets", sh_last_error_message());
     std::vector<int32_t> tets(4 * static_cast<size_t>(info.tet_count));
-    if (sh_mesh_get_tets(mesh, tets.data(), static_cast<int64_t>(tets.size())) != SH_OK)
+    if (sh_mesh_get_tets(mesh, tets.data(), static_cast<int32_t>(tets.size() / 4)) != SH_OK)
         violated("cannot read a loaded mesh's tets", sh_last_error_message());
     for (const int32_t index : tets)
         if (index < 0 || index >= info.node_count) violated("a loaded tet indexes no node", std::to_string(index));

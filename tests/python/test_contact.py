@@ -65,8 +65,8 @@ def test_new_struct_sizes_computed_by_hand():
     # x86-64/aarch64 SysV layout worked out from the header, independent of any compiler.
     assert ctypes.sizeof(_lib.sh_shape) == 88  # int, pad 4, 5 doubles, pointer, i32, pad, 3 doubles
     assert _lib.sh_shape.normal.offset == 64
-    assert ctypes.sizeof(_lib.sh_contact_params) == 56  # 6 doubles, i32, pad 4
-    assert ctypes.sizeof(_lib.sh_collider_def) == 208  # u32, pad, shape 88, 7 doubles, params
+    assert ctypes.sizeof(_lib.sh_contact_params) == 64  # u32, pad 4, 6 doubles, i32, pad 4
+    assert ctypes.sizeof(_lib.sh_collider_def) == 216  # u32, pad, shape 88, 7 doubles, params
     assert _lib.sh_collider_def.contact.offset == 152
     assert ctypes.sizeof(_lib.sh_contact_state) == 72  # 6 doubles, i32, pad 4, 2 doubles
     # sh_step_report grew by contact_count (i32, pad 4), collision_seconds, contact_substeps
@@ -506,7 +506,7 @@ def test_destroyed_tool_and_obstacle_are_stale():
         plane.destroy()
         assert not tool.is_valid and not tool.valid and not plane.is_valid
         assert other.is_valid
-        assert softhap._c_library.sh_tool_is_valid(world._handle, tool.id) == 0
+        assert softhap._c_library.sh_tool_is_valid(world._handle, softhap._lib.sh_tool_id(tool.id)) == 0
         uses = [
             lambda: tool.set_pose((0.0, 0.0, 0.0)),
             lambda: tool.set_velocity((0.0, 0.0, 0.0)),

@@ -33,6 +33,9 @@ void sh_test_assert_close(double a, double b, double tol, const char* expr, cons
 /** A world with gravity (0, 0, gravity_z). */
 sh_world* sh_test_world(double gravity_z);
 
+/* A material from sh_material_default with these model, E (Pa), nu and rho (kg/m^3). */
+sh_material sh_test_material(sh_material_model model, double young, double poisson, double density);
+
 /** Adds a two-node spring body along x: node 0 at the origin, node 1 at (rest_length, 0, 0),
  *  one spring with params, node masses `mass`, the given integrator and policy. */
 sh_body_id sh_test_spring_pair(sh_world* world, double rest_length, const sh_spring_params* params, double mass,

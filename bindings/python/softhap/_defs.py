@@ -197,11 +197,11 @@ def static_def(arguments: Mapping[str, Any]) -> sh_static_def:
 
 
 def material(arguments: Mapping[str, Any]) -> sh_material:
-    """The material of sh_fem_body_def_default with the fields named in arguments replaced."""
-    definition = sh_fem_body_def()
-    lib.sh_fem_body_def_default(ctypes.byref(definition))
-    fill(definition.material, MATERIAL_FIELDS, arguments)
-    return definition.material
+    """The material of sh_material_default with the fields named in arguments replaced."""
+    result = sh_material()
+    lib.sh_material_default(ctypes.byref(result))
+    fill(result, MATERIAL_FIELDS, arguments)
+    return result
 
 
 def _set_body_options(definition: ctypes.Structure, arguments: Mapping[str, Any]) -> None:
@@ -230,7 +230,7 @@ def _spring_nodes(
     """Point the def at its nodes (an (n, 3) array, or a Mesh whose nodes and, with springs
     None, edges are used) and springs; return the node count."""
     if isinstance(nodes, Mesh):
-        definition.mesh = nodes._require_handle("sh_world_add_spring_body")
+        definition.mesh = nodes._require_handle("sh_spring_body_create")
         node_count = nodes.node_count
     else:
         node_array = _arrays.float_array(nodes, "nodes", (None, 3))
@@ -369,7 +369,7 @@ def collider_def(
     lib.sh_collider_def_default(ctypes.byref(definition))
     arrays: List[Any] = []
     _set_shape(definition.shape, kind, arguments, arrays)
-    if position is not None:  # None, passed explicitly, keeps the C default as it used to
+    if position is not None:  # None keeps the C default (the origin)
         _set_vector(definition.position, position, "position")
     if orientation is not None:
         _set_vector(definition.orientation, orientation, "orientation")

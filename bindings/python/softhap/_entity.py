@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ctypes import Structure
 from typing import TYPE_CHECKING, cast
 
 from ._loaded import closed_error, lib
@@ -13,18 +14,21 @@ if TYPE_CHECKING:
 class WorldEntity:
     """Base of the Python objects that name one entity of a World by its id.
 
-    A subclass sets _kind (the word used in the closed-world error, "body") and _is_valid (the
-    name of the C function telling whether the id is live, "sh_body_is_valid"). The World owns
-    the entity's data; the object keeps its World alive.
+    A subclass sets _kind (the word used in the closed-world error, "body"), _is_valid (the
+    name of the C function telling whether the id is live, "sh_body_is_valid") and _id_type
+    (its C id struct, sh_body_id). The World owns the entity's data; the object keeps its World
+    alive.
     """
 
     _kind: str = ""
     _is_valid: str = ""
+    _id_type: type[Structure] = Structure
 
     def __init__(self, world: World, entity_id: int) -> None:
         """Wrap the id entity_id of world (use the World's add_* methods rather than this)."""
         self._world = world
         self._id = int(entity_id)
+        self._cid = self._id_type(self._id)  # the id as the C functions take it
 
     def __repr__(self) -> str:
         return "<softhap.%s id=%#x>" % (type(self).__name__, self._id)
@@ -44,7 +48,7 @@ class WorldEntity:
         """True while the id names a live entity of an open world."""
         if self._world.closed:
             return False
-        return bool(getattr(lib, self._is_valid)(self._world._handle, self._id))
+        return bool(getattr(lib, self._is_valid)(self._world._handle, self._cid))
 
     def _world_handle(self, function: str) -> int:
         if self._world.closed:

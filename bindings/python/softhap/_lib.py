@@ -144,12 +144,26 @@ SHAPE_KINDS = {
 SH_SHAPE_COUNT = len(SHAPE_KINDS)
 
 # ------------------------------------------------------------------------------------------------
-# Structs. Enums are C ints; sh_body_id, sh_tool_id and sh_obstacle_id are uint64_t; opaque
-# handles are void pointers.
+# Structs. Enums are C ints; opaque handles are void pointers. The ids are distinct one-field
+# structs, as in C, so that ctypes refuses one kind of id where another is expected.
 
-sh_body_id = c_uint64
-sh_tool_id = c_uint64
-sh_obstacle_id = c_uint64
+
+class sh_body_id(Structure):
+    """Mirror of struct sh_body_id (value 0 is the null id)."""
+
+    _fields_ = [("value", c_uint64)]
+
+
+class sh_tool_id(Structure):
+    """Mirror of struct sh_tool_id (value 0 is the null id)."""
+
+    _fields_ = [("value", c_uint64)]
+
+
+class sh_obstacle_id(Structure):
+    """Mirror of struct sh_obstacle_id (value 0 is the null id)."""
+
+    _fields_ = [("value", c_uint64)]
 
 
 class sh_mesh_info(Structure):
@@ -223,6 +237,7 @@ class sh_material(Structure):
     """Mirror of struct sh_material."""
 
     _fields_ = [
+        ("internal_init", c_uint32),
         ("model", c_int),
         ("young", c_double),
         ("poisson", c_double),
@@ -340,6 +355,7 @@ class sh_contact_params(Structure):
     """Mirror of struct sh_contact_params."""
 
     _fields_ = [
+        ("internal_init", c_uint32),
         ("stiffness", c_double),
         ("exponent", c_double),
         ("damping", c_double),
@@ -461,10 +477,10 @@ PROTOTYPES = {
     "sh_mesh_transform": (_status, [_handle, c_double, _pd, POINTER(_handle)]),
     "sh_mesh_destroy": (_status, [_handle]),
     "sh_mesh_get_info": (_status, [_handle, POINTER(sh_mesh_info)]),
-    "sh_mesh_get_nodes": (_status, [_handle, _pd, c_int64]),
-    "sh_mesh_get_tets": (_status, [_handle, _pi, c_int64]),
-    "sh_mesh_get_surface_triangles": (_status, [_handle, _pi, c_int64]),
-    "sh_mesh_get_edges": (_status, [_handle, _pi, c_int64]),
+    "sh_mesh_get_nodes": (_status, [_handle, _pd, c_int32]),
+    "sh_mesh_get_tets": (_status, [_handle, _pi, c_int32]),
+    "sh_mesh_get_surface_triangles": (_status, [_handle, _pi, c_int32]),
+    "sh_mesh_get_edges": (_status, [_handle, _pi, c_int32]),
     "sh_mesh_write_vtu": (_status, [_handle, c_char_p]),
     # world
     "sh_world_def_default": (None, [POINTER(sh_world_def)]),
@@ -474,30 +490,31 @@ PROTOTYPES = {
     "sh_world_get_warnings": (_status, [_handle, POINTER(c_uint64)]),
     "sh_world_step": (_status, [_handle, c_double, POINTER(sh_step_report)]),
     # FEM bodies
+    "sh_material_default": (None, [POINTER(sh_material)]),
     "sh_fem_body_def_default": (None, [POINTER(sh_fem_body_def)]),
-    "sh_world_add_fem_body": (_status, [_handle, POINTER(sh_fem_body_def), POINTER(sh_body_id)]),
+    "sh_fem_body_create": (_status, [_handle, POINTER(sh_fem_body_def), POINTER(sh_body_id)]),
     "sh_body_set_material": (_status, [_handle, sh_body_id, _pi, c_int32, POINTER(sh_material)]),
     # spring bodies
     "sh_spring_body_def_default": (None, [POINTER(sh_spring_body_def)]),
-    "sh_world_add_spring_body": (
+    "sh_spring_body_create": (
         _status,
         [_handle, POINTER(sh_spring_body_def), POINTER(sh_body_id)],
     ),
     # bodies
-    "sh_world_remove_body": (_status, [_handle, sh_body_id]),
+    "sh_body_destroy": (_status, [_handle, sh_body_id]),
     "sh_body_is_valid": (c_int32, [_handle, sh_body_id]),
     "sh_body_get_info": (_status, [_handle, sh_body_id, POINTER(sh_body_info)]),
-    "sh_body_get_positions": (_status, [_handle, sh_body_id, _pd, c_int64]),
+    "sh_body_get_positions": (_status, [_handle, sh_body_id, _pd, c_int32]),
     "sh_body_set_positions": (_status, [_handle, sh_body_id, _pd, c_int32]),
-    "sh_body_get_velocities": (_status, [_handle, sh_body_id, _pd, c_int64]),
+    "sh_body_get_velocities": (_status, [_handle, sh_body_id, _pd, c_int32]),
     "sh_body_set_velocities": (_status, [_handle, sh_body_id, _pd, c_int32]),
-    "sh_body_get_masses": (_status, [_handle, sh_body_id, _pd, c_int64]),
+    "sh_body_get_masses": (_status, [_handle, sh_body_id, _pd, c_int32]),
     "sh_body_fix_nodes": (_status, [_handle, sh_body_id, _pi, c_int32]),
     "sh_body_release_nodes": (_status, [_handle, sh_body_id, _pi, c_int32]),
     "sh_body_prescribe_positions": (_status, [_handle, sh_body_id, _pi, _pd, c_int32]),
     "sh_body_set_external_forces": (_status, [_handle, sh_body_id, _pd, c_int32]),
     "sh_body_set_node_damping": (_status, [_handle, sh_body_id, _pd, c_int32]),
-    "sh_body_get_elastic_forces": (_status, [_handle, sh_body_id, _pd, c_int64]),
+    "sh_body_get_elastic_forces": (_status, [_handle, sh_body_id, _pd, c_int32]),
     "sh_body_get_elastic_energy": (_status, [_handle, sh_body_id, _pd]),
     "sh_body_write_vtu": (_status, [_handle, sh_body_id, c_char_p]),
     # tools, obstacles and contact

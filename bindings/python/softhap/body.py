@@ -11,19 +11,19 @@ from numpy.typing import ArrayLike
 
 from . import _arrays, _defs
 from ._entity import WorldEntity
-from ._lib import sh_body_info
+from ._lib import sh_body_id, sh_body_info
 from ._loaded import check, lib
 from ._record import BodyInfo, record_of
 
 
-def body_id_in(world: object, body: Body, name: str) -> int:
+def body_id_in(world: object, body: Body, name: str) -> sh_body_id:
     """The id of body, checked to be a Body (else TypeError) of world (else ValueError); name
     is the argument's name for the message."""
     if not isinstance(body, Body):
         raise TypeError("%s must be a softhap.Body, got %s" % (name, type(body).__name__))
     if body.world is not world:
         raise ValueError("%r belongs to another world" % (body,))
-    return body.id
+    return body._cid
 
 
 class Body(WorldEntity):
@@ -37,6 +37,7 @@ class Body(WorldEntity):
 
     _kind = "body"
     _is_valid = "sh_body_is_valid"
+    _id_type = sh_body_id
 
     # -- facts ------------------------------------------------------------------------------
 
@@ -46,7 +47,7 @@ class Body(WorldEntity):
         element_count, is_fem, fixed_node_count, total_mass (kg), dt_critical (s)."""
         handle = self._world_handle("sh_body_get_info")
         raw = sh_body_info()
-        check(lib.sh_body_get_info(handle, self._id, ctypes.byref(raw)), "sh_body_get_info")
+        check(lib.sh_body_get_info(handle, self._cid, ctypes.byref(raw)), "sh_body_get_info")
         return record_of(BodyInfo, raw, is_fem=bool(raw.is_fem))
 
     @property
@@ -66,7 +67,7 @@ class Body(WorldEntity):
         n = self.node_count
         out = np.empty((n, columns) if columns else (n,), dtype=np.float64)
         check(
-            getattr(lib, function_name)(handle, self._id, _arrays.double_ptr(out), out.size),
+            getattr(lib, function_name)(handle, self._cid, _arrays.double_ptr(out), n),
             function_name,
         )
         return out
@@ -78,7 +79,7 @@ class Body(WorldEntity):
         handle = self._world_handle(function_name)
         array = self._node_vectors(value, name)
         check(
-            getattr(lib, function_name)(handle, self._id, _arrays.double_ptr(array), array.shape[0]),
+            getattr(lib, function_name)(handle, self._cid, _arrays.double_ptr(array), array.shape[0]),
             function_name,
         )
 
@@ -116,7 +117,7 @@ class Body(WorldEntity):
         handle = self._world_handle("sh_body_get_elastic_energy")
         energy = ctypes.c_double()
         check(
-            lib.sh_body_get_elastic_energy(handle, self._id, ctypes.byref(energy)),
+            lib.sh_body_get_elastic_energy(handle, self._cid, ctypes.byref(energy)),
             "sh_body_get_elastic_energy",
         )
         return energy.value
@@ -127,7 +128,7 @@ class Body(WorldEntity):
         handle = self._world_handle(function_name)
         nodes = _arrays.index_list(indices, "indices")
         check(
-            getattr(lib, function_name)(handle, self._id, _arrays.int32_ptr(nodes), nodes.size),
+            getattr(lib, function_name)(handle, self._cid, _arrays.int32_ptr(nodes), nodes.size),
             function_name,
         )
 
@@ -148,7 +149,7 @@ class Body(WorldEntity):
         check(
             lib.sh_body_prescribe_positions(
                 handle,
-                self._id,
+                self._cid,
                 _arrays.int32_ptr(nodes),
                 _arrays.double_ptr(targets),
                 nodes.size,
@@ -165,11 +166,11 @@ class Body(WorldEntity):
         one-step impulse."""
         handle = self._world_handle("sh_body_set_external_forces")
         if forces is None:
-            status = lib.sh_body_set_external_forces(handle, self._id, None, 0)
+            status = lib.sh_body_set_external_forces(handle, self._cid, None, 0)
         else:
             array = self._node_vectors(forces, "forces")
             status = lib.sh_body_set_external_forces(
-                handle, self._id, _arrays.double_ptr(array), array.shape[0]
+                handle, self._cid, _arrays.double_ptr(array), array.shape[0]
             )
         check(status, "sh_body_set_external_forces")
 
@@ -178,14 +179,14 @@ class Body(WorldEntity):
         damping. coefficients is a scalar (every node), an (n,) array, or None to clear."""
         handle = self._world_handle("sh_body_set_node_damping")
         if coefficients is None:
-            status = lib.sh_body_set_node_damping(handle, self._id, None, 0)
+            status = lib.sh_body_set_node_damping(handle, self._cid, None, 0)
         else:
             n = self.node_count
             if np.ndim(coefficients) == 0:
                 array = np.full(n, float(coefficients))  # type: ignore[arg-type]
             else:
                 array = _arrays.float_array(coefficients, "coefficients", (n,))
-            status = lib.sh_body_set_node_damping(handle, self._id, _arrays.double_ptr(array), n)
+            status = lib.sh_body_set_node_damping(handle, self._cid, _arrays.double_ptr(array), n)
         check(status, "sh_body_set_node_damping")
 
     def set_material(
@@ -210,7 +211,7 @@ class Body(WorldEntity):
         material = _defs.material(arguments)
         check(
             lib.sh_body_set_material(
-                handle, self._id, _arrays.int32_ptr(elements), elements.size, ctypes.byref(material)
+                handle, self._cid, _arrays.int32_ptr(elements), elements.size, ctypes.byref(material)
             ),
             "sh_body_set_material",
         )
@@ -222,7 +223,7 @@ class Body(WorldEntity):
         with point data "velocity"."""
         handle = self._world_handle("sh_body_write_vtu")
         check(
-            lib.sh_body_write_vtu(handle, self._id, _arrays.path_bytes(path)), "sh_body_write_vtu"
+            lib.sh_body_write_vtu(handle, self._cid, _arrays.path_bytes(path)), "sh_body_write_vtu"
         )
 
     def remove(self) -> None:

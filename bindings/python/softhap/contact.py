@@ -23,7 +23,7 @@ from . import _arrays, _defs
 from ._defs import default
 from ._entity import WorldEntity
 from ._handle import OwnedHandle
-from ._lib import sh_contact_state
+from ._lib import sh_contact_state, sh_obstacle_id, sh_tool_id
 from ._loaded import check, lib
 from ._record import Record, record_of
 from .body import Body, body_id_in
@@ -67,7 +67,7 @@ class _Collider(WorldEntity):
     def destroy(self) -> None:
         """Remove it from its world; its id becomes stale."""
         handle = self._world_handle(self._destroy)
-        check(getattr(lib, self._destroy)(handle, self._id), self._destroy)
+        check(getattr(lib, self._destroy)(handle, self._cid), self._destroy)
 
     @property
     def contact_state(self) -> ContactState:
@@ -77,7 +77,7 @@ class _Collider(WorldEntity):
         handle = self._world_handle(self._get_contact)
         raw = sh_contact_state()
         function = getattr(lib, self._get_contact)
-        check(function(handle, self._id, ctypes.byref(raw)), self._get_contact)
+        check(function(handle, self._cid, ctypes.byref(raw)), self._get_contact)
         return _contact_state(raw)
 
     @property
@@ -118,6 +118,7 @@ class Tool(_Collider):
 
     _kind = "tool"
     _is_valid = "sh_tool_is_valid"
+    _id_type = sh_tool_id
     _get_contact = "sh_tool_get_contact"
     _destroy = "sh_tool_destroy"
 
@@ -130,7 +131,7 @@ class Tool(_Collider):
         orientation = np.zeros(4)
         check(
             lib.sh_tool_get_pose(
-                handle, self._id, _arrays.double_ptr(position), _arrays.double_ptr(orientation)
+                handle, self._cid, _arrays.double_ptr(position), _arrays.double_ptr(orientation)
             ),
             "sh_tool_get_pose",
         )
@@ -146,7 +147,7 @@ class Tool(_Collider):
         orientation = _arrays.float_array(orientation, "orientation", (4,))
         check(
             lib.sh_tool_set_pose(
-                handle, self._id, _arrays.double_ptr(position), _arrays.double_ptr(orientation)
+                handle, self._cid, _arrays.double_ptr(position), _arrays.double_ptr(orientation)
             ),
             "sh_tool_set_pose",
         )
@@ -160,7 +161,7 @@ class Tool(_Collider):
         angular = _arrays.float_array(angular, "angular", (3,))
         check(
             lib.sh_tool_set_velocity(
-                handle, self._id, _arrays.double_ptr(linear), _arrays.double_ptr(angular)
+                handle, self._cid, _arrays.double_ptr(linear), _arrays.double_ptr(angular)
             ),
             "sh_tool_set_velocity",
         )
@@ -173,7 +174,7 @@ class Tool(_Collider):
         torque = np.zeros(3)
         check(
             lib.sh_tool_get_wrench(
-                handle, self._id, _arrays.double_ptr(force), _arrays.double_ptr(torque)
+                handle, self._cid, _arrays.double_ptr(force), _arrays.double_ptr(torque)
             ),
             "sh_tool_get_wrench",
         )
@@ -191,6 +192,7 @@ class Obstacle(_Collider):
 
     _kind = "obstacle"
     _is_valid = "sh_obstacle_is_valid"
+    _id_type = sh_obstacle_id
     _get_contact = "sh_obstacle_get_contact"
     _destroy = "sh_obstacle_destroy"
 
@@ -297,7 +299,7 @@ class WorldContacts(OwnedHandle):
         shape kind, its keyword arguments and its pose."""
         handle = self._require_handle(function)
         definition, arrays = _defs.collider_def(kind, arguments, position, orientation)
-        collider = ctypes.c_uint64()
+        collider = (sh_tool_id if function == "sh_tool_create" else sh_obstacle_id)()
         check(
             getattr(lib, function)(handle, ctypes.byref(definition), ctypes.byref(collider)),
             function,

@@ -37,7 +37,7 @@ def _names(bits: int, kinds: Iterable[HapticFault]) -> FrozenSet[str]:
 def _haptic_def(tool: Tool, options: Dict[str, Any]) -> sh_haptic_def:
     definition = sh_haptic_def()
     lib.sh_haptic_def_default(ctypes.byref(definition))
-    definition.tool = tool.id
+    definition.tool = tool._cid
     for name, value in options.items():
         if value is None:
             continue

@@ -122,14 +122,14 @@ class Mesh(OwnedHandle):
         handle = self._require_handle("sh_mesh_get_nodes")
         out = np.empty((self.node_count, 3), dtype=np.float64)
         check(
-            lib.sh_mesh_get_nodes(handle, _arrays.double_ptr(out), out.size), "sh_mesh_get_nodes"
+            lib.sh_mesh_get_nodes(handle, _arrays.double_ptr(out), out.shape[0]), "sh_mesh_get_nodes"
         )
         return out
 
     def _int_table(self, function_name: str, rows: int, columns: int) -> np.ndarray:
         handle = self._require_handle(function_name)
         out = np.empty((rows, columns), dtype=np.int32)
-        check(getattr(lib, function_name)(handle, _arrays.int32_ptr(out), out.size), function_name)
+        check(getattr(lib, function_name)(handle, _arrays.int32_ptr(out), rows), function_name)
         return out
 
     @property

@@ -187,11 +187,11 @@ class World(WorldContacts):
         (SH_ERR_INVALID_ARGUMENT).
         """
         arguments = dict(locals())
-        self._require_handle("sh_world_add_fem_body")
+        self._require_handle("sh_fem_body_create")
         if not isinstance(mesh, Mesh):
             raise TypeError("mesh must be a softhap.Mesh, got %s" % type(mesh).__name__)
-        definition = _defs.fem_body_def(mesh._require_handle("sh_world_add_fem_body"), arguments)
-        return self._add_body("sh_world_add_fem_body", definition)
+        definition = _defs.fem_body_def(mesh._require_handle("sh_fem_body_create"), arguments)
+        return self._add_body("sh_fem_body_create", definition)
 
     def _add_body(self, function_name: str, definition: ctypes.Structure) -> Body:
         """Call the C function function_name(world, &definition, &id) and return the new Body."""
@@ -245,17 +245,17 @@ class World(WorldContacts):
         Unknown names raise ValueError; invalid values raise softhap.Error.
         """
         arguments = dict(locals())
-        self._require_handle("sh_world_add_spring_body")
+        self._require_handle("sh_spring_body_create")
         definition, arrays = _defs.spring_body_def(nodes, springs, law, mass, arguments)
-        body = self._add_body("sh_world_add_spring_body", definition)
+        body = self._add_body("sh_spring_body_create", definition)
         del arrays  # the definition pointed into them until the C library copied what it needs
         return body
 
     def remove_body(self, body: Body) -> None:
         """Destroy body; its id becomes stale (using the Body afterwards raises softhap.Error with
         status SH_ERR_INVALID_HANDLE)."""
-        handle = self._require_handle("sh_world_remove_body")
-        check(lib.sh_world_remove_body(handle, body_id_in(self, body, "body")), "sh_world_remove_body")
+        handle = self._require_handle("sh_body_destroy")
+        check(lib.sh_body_destroy(handle, body_id_in(self, body, "body")), "sh_body_destroy")
 
     # -- haptics ----------------------------------------------------------------------------
 

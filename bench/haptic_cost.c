@@ -1,0 +1,257 @@
+/* softhap_bench haptic: the haptic step's cost against buffer size, with the world frozen or
+ * stepped by a sim thread beside it, and the step's fixed cost (haptic.c describes the cases). */
+#include "haptic_common.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const int kCostSizes[] = {50, 100, 200, 500, 1000, 2000};
+static const int kConcurrentSizes[] = {50, 200, 500, 2000};
+static const double kCostDepth = 0.003;  /* m */
+static const double kCostCircle = 0.001; /* m, once a second */
+static const double kCostDamping = 5.0;  /* 1/s */
+static const int kPressTicks = 300, kWarmupTicks = 2000, kPacedTicks = 5000;
+/* Timed ticks: corotational (the headline), the other materials (for their kernels' cost). */
+static const int kTimedTicks = 20000, kOtherTimedTicks = 5000;
+enum { kBatch = 100, kBatches = 200, kClockReads = 2000 };
+enum { kSimCapacity = 4096 }; /* sim step times kept */
+
+/* ------------------------------------------------------------------------------------------ */
+/* The device's path                                                                            */
+
+typedef struct {
+    double touch[3];
+} cost_path;
+
+/* Pressed kCostDepth over kPressTicks, then a circle of kCostCircle once a second: the contact
+ * keeps moving, so every step solves a changing contact. */
+static void cost_pose(const void* ctx, long tick, double out[3]) {
+    const cost_path* c = (const cost_path*)ctx;
+    const double press = fmin(1.0, (tick + 1.0) / kPressTicks);
+    const double a = tick > kPressTicks ? 2.0 * kPi * (tick - kPressTicks) * kHapticDt : 0.0;
+    out[0] = c->touch[0] + kCostCircle * (cos(a) - 1.0);
+    out[1] = c->touch[1] + kCostCircle * sin(a);
+    out[2] = c->touch[2] - kCostDepth * press;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* The sim thread of the concurrent cases                                                       */
+
+typedef struct {
+    sh_world* world;
+    int cpu;  /* the CPU it keeps */
+    int rt;   /* the haptic thread is real-time: this one must not inherit that */
+    atomic_int stop;
+    int steps, capacity, failed;
+    double* ns;
+    pthread_t thread;
+} sim_runner;
+
+/* Steps the world by kSimDt at most once per kSimDt of wall time until told to stop; when
+ * behind it does not catch up (a host's sim thread drops frames). */
+static void* sim_main(void* arg) {
+    sim_runner* r = (sim_runner*)arg;
+    bench_pin_thread(r->cpu);
+    if (r->rt) make_ordinary();
+    double deadline = now_ns();
+    while (!atomic_load(&r->stop)) {
+        const double t0 = now_ns();
+        r->failed += world_step(r->world);
+        if (r->steps < r->capacity) r->ns[r->steps] = now_ns() - t0;
+        ++r->steps;
+        deadline += kSimDt * 1e9;
+        const double now = now_ns();
+        if (now < deadline)
+            sleep_until(deadline);
+        else
+            deadline = now;
+    }
+    return NULL;
+}
+
+/* Starts the sim thread on world. */
+static void sim_start(sim_runner* sim, sh_world* world, const haptic_options* options) {
+    memset(sim, 0, sizeof *sim);
+    sim->world = world;
+    sim->cpu = options->sim_cpu;
+    sim->rt = options->rt;
+    sim->capacity = kSimCapacity;
+    sim->ns = (double*)xmalloc(sizeof(double) * (size_t)sim->capacity);
+    atomic_store(&sim->stop, 0);
+    if (pthread_create(&sim->thread, NULL, sim_main, sim) != 0) {
+        fprintf(stderr, "softhap_bench: cannot start the sim thread\n");
+        exit(1);
+    }
+}
+
+/* Stops the sim thread and waits for it. */
+static void sim_stop(sim_runner* sim) {
+    atomic_store(&sim->stop, 1);
+    pthread_join(sim->thread, NULL);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* One buffer size                                                                              */
+
+/* How many ticks a cost case times: --steps N (a quarter of it paced beside the sim thread),
+ * else the case's default. */
+static int cost_ticks(const haptic_options* options, sh_material_model model, int with_sim) {
+    if (with_sim) return options->steps > 0 ? options->steps / 4 : kPacedTicks;
+    if (options->steps > 0) return options->steps;
+    return model == SH_MATERIAL_COROTATIONAL ? kTimedTicks : kOtherTimedTicks;
+}
+
+/* The sim thread's fields of a concurrent case's JSON line. */
+static void print_sim_fields(const sim_runner* sim, double wall, long fresh) {
+    const int kept = sim->steps < sim->capacity ? sim->steps : sim->capacity;
+    const stats w = summarize(sim->ns, kept);
+    printf(",\"sim_target_hz\":%g,\"sim_steps\":%d,\"sim_rate_hz\":%.2f,\"sim_step_median_ms\":%.3f,\"sim_step_max_ms\":%.3f,"
+           "\"sim_failed\":%d,\"fresh_buffers\":%ld",
+           1.0 / kSimDt, sim->steps, sim->steps / wall, w.median * 1e-6, w.max * 1e-6, sim->failed, fresh);
+}
+
+/* A cost case's JSON line (sorts the log's samples; sim NULL: frozen) and its summary on
+ * stderr. */
+static void print_cost(const char* name, const tissue* block, sh_material_model model, int capacity,
+                       tick_log* log, const sim_runner* sim, double wall, int rt) {
+    const stats sub = summarize(log->substeps, log->timed);
+    const stats t = summarize(log->ns, log->timed);
+    const int tets = log->last.buffer_tets;
+    printf("{\"study\":\"haptic_cost\",\"case\":\"%s\",\"material\":\"%s\",\"sim\":\"%s\",\"capacity_tets\":%d,"
+           "\"buffer_tets\":%d,\"buffer_nodes\":%d,\"mesh_tets\":%d,\"steps\":%d,",
+           name, material_name(model), sim ? "sim" : "frozen", capacity, tets, log->last.buffer_nodes,
+           block->tet_count, t.count);
+    print_times_us("", &t);
+    printf(",\"substeps_median\":%g,\"substeps_max\":%g,\"ns_per_tet\":%.2f,\"ns_per_tet_substep\":%.2f,"
+           "\"allocations\":%ld,\"contact_ticks\":%ld,\"faults\":%u,\"dt\":%g,\"depth_m\":%g,\"rt\":%d",
+           sub.median, sub.max, tets > 0 ? t.median / tets : 0.0,
+           tets > 0 && sub.median > 0 ? t.median / (tets * sub.median) : 0.0, log->allocations, log->contact,
+           log->faults, kHapticDt, kCostDepth, rt);
+    if (sim) print_sim_fields(sim, wall, log->fresh);
+    printf("}\n");
+    fflush(stdout);
+    fprintf(stderr, "%s: median %.2f us, p99.9 %.2f us, %d tets, %g sub-steps\n", name, t.median * 1e-3,
+            t.p999 * 1e-3, tets, sub.median);
+}
+
+/* One buffer size: the press and a warm-up untimed, then the timed ticks, back to back with
+ * the world frozen, or paced at 1 kHz beside the sim thread. */
+static void cost_case(const tissue* block, sh_material_model model, int capacity, int with_sim,
+                      const haptic_options* options) {
+    char name[128];
+    snprintf(name, sizeof name, "haptic/%s/%s/%d", with_sim ? "sim" : "frozen", material_name(model), capacity);
+    if (!name_matches(name, options->filter)) return;
+    cost_path path;
+    touch_point(block, path.touch);
+    scene s = scene_create(block, model, with_sim ? SH_INTEGRATOR_IMPLICIT_EULER : SH_INTEGRATOR_SYMPLECTIC_EULER,
+                           kCostDamping, path.touch);
+    const sh_haptic_def def = haptic_def_for(&s, 1.0, capacity, 0);
+    sh_haptic* haptic = NULL;
+    CHECK(sh_haptic_create(s.world, &def, &haptic));
+    if (with_sim) world_step(s.world); /* the implicit solver's set-up */
+
+    tick_log warm, log;
+    memset(&warm, 0, sizeof warm);
+    run_ticks(haptic, cost_pose, &path, 0, kPressTicks + kWarmupTicks, 0, &warm);
+    const int count = cost_ticks(options, model, with_sim);
+    tick_log_alloc(&log, count);
+    sim_runner sim;
+    memset(&sim, 0, sizeof sim);
+    if (with_sim) sim_start(&sim, s.world, options);
+    const double t0 = now_ns();
+    run_ticks(haptic, cost_pose, &path, kPressTicks + kWarmupTicks, count, with_sim, &log);
+    const double wall = (now_ns() - t0) * 1e-9;
+    if (with_sim) sim_stop(&sim);
+    print_cost(name, block, model, capacity, &log, with_sim ? &sim : NULL, wall, options->rt);
+    if (with_sim) free(sim.ns);
+    tick_log_free(&log);
+    CHECK(sh_haptic_destroy(haptic));
+    scene_destroy(&s);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* The fixed cost                                                                               */
+
+/* kBatches batches of kBatch steps at the pose p, each batch timed as a whole (no clock read
+ * per call): each batch's mean per call into batch[]; the allocations counted. */
+static long time_batches(sh_haptic* haptic, const double p[3], double batch[kBatches]) {
+    sh_haptic_output out;
+    alloc_count_on();
+    for (int b = 0; b < kBatches; ++b) {
+        const double t0 = now_ns();
+        for (int i = 0; i < kBatch; ++i) sh_haptic_step(haptic, p, kIdentity, kHapticDt, &out);
+        batch[b] = (now_ns() - t0) / kBatch;
+    }
+    return alloc_count_off();
+}
+
+/* The median time of one clock read (ns), which every per-call time includes. */
+static double clock_read_ns(void) {
+    double clock[kClockReads];
+    for (int i = 0; i < kClockReads; ++i) {
+        const double t0 = now_ns();
+        clock[i] = now_ns() - t0;
+    }
+    return summarize(clock, kClockReads).median;
+}
+
+/* The fixed cost: the tool 1 m above the block, so the buffer is empty and the step renders the
+ * untouched proxy plane; per-call times, then batches. */
+static void overhead_case(const tissue* block, const haptic_options* options) {
+    const char* name = "haptic/overhead";
+    if (!name_matches(name, options->filter)) return;
+    cost_path path;
+    touch_point(block, path.touch);
+    path.touch[2] += 1.0;
+    scene s = scene_create(block, SH_MATERIAL_COROTATIONAL, SH_INTEGRATOR_SYMPLECTIC_EULER, kCostDamping, path.touch);
+    const sh_haptic_def def = haptic_def_for(&s, 0.02, 2000, 0);
+    sh_haptic* haptic = NULL;
+    CHECK(sh_haptic_create(s.world, &def, &haptic));
+    tick_log warm, log;
+    memset(&warm, 0, sizeof warm);
+    run_ticks(haptic, cost_pose, &path, 0, kWarmupTicks, 0, &warm);
+    const int count = options->steps > 0 ? options->steps : kTimedTicks;
+    tick_log_alloc(&log, count);
+    run_ticks(haptic, cost_pose, &path, kWarmupTicks, count, 0, &log);
+    const stats t = summarize(log.ns, log.timed);
+    double batch[kBatches], p[3];
+    cost_pose(&path, kWarmupTicks, p);
+    const long batch_allocations = time_batches(haptic, p, batch);
+    const stats bt = summarize(batch, kBatches);
+    const double clock_ns = clock_read_ns();
+    printf("{\"study\":\"haptic_overhead\",\"case\":\"%s\",\"buffer_tets\":%d,\"contact_ticks\":%ld,\"steps\":%d,"
+           "\"median_ns\":%.1f,\"p99_ns\":%.1f,\"p999_ns\":%.1f,\"max_ns\":%.1f,\"mean_ns\":%.1f,"
+           "\"batch_median_ns\":%.1f,\"batch_min_ns\":%.1f,\"batch\":%d,\"batches\":%d,\"clock_ns\":%.1f,"
+           "\"allocations\":%ld,\"faults\":%u,\"rt\":%d}\n",
+           name, log.last.buffer_tets, log.contact, t.count, t.median, t.p99, t.p999, t.max, t.mean, bt.median,
+           batch[0], kBatch, kBatches, clock_ns, log.allocations + batch_allocations, log.faults, options->rt);
+    fflush(stdout);
+    fprintf(stderr, "%s: median %.0f ns per call (%.0f ns in batches of %d)\n", name, t.median, bt.median, kBatch);
+    tick_log_free(&log);
+    CHECK(sh_haptic_destroy(haptic));
+    scene_destroy(&s);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+
+/* The overhead, every material at every buffer size frozen, then corotational beside the sim
+ * thread. */
+int haptic_run_cost(const haptic_options* options) {
+    static const sh_material_model kModels[] = {SH_MATERIAL_COROTATIONAL, SH_MATERIAL_LINEAR, SH_MATERIAL_STVK,
+                                                 SH_MATERIAL_NEOHOOKEAN};
+    const int sizes = (int)(sizeof kCostSizes / sizeof kCostSizes[0]);
+    tissue block = make_block();
+    fprintf(stderr, "haptic: block %d tets, %d nodes (%d fixed); counting allocator installed\n", block.tet_count,
+            block.node_count, block.fixed_count);
+    overhead_case(&block, options);
+    for (size_t m = 0; m < sizeof kModels / sizeof kModels[0]; ++m)
+        for (int k = 0; k < sizes; ++k) cost_case(&block, kModels[m], kCostSizes[k], 0, options);
+    for (size_t k = 0; k < sizeof kConcurrentSizes / sizeof kConcurrentSizes[0]; ++k)
+        cost_case(&block, SH_MATERIAL_COROTATIONAL, kConcurrentSizes[k], 1, options);
+    tissue_free(&block);
+    return 0;
+}

@@ -85,7 +85,7 @@ void World::step_islands(double h, sh_step_report& r, vec<uint8_t>& skip) {
         bool keep_best = false;  // the island's last attempt is that of any member's
         for (int32_t m = 0; m < count; ++m) {
             Slot& slot = slots_[members[m]];
-            keep_best |= slot.keep_best;
+            keep_best |= scratch_.bodies[members[m]].keep_best;
             if (!slot.stepped->newton) slot.stepped->newton = sh::create<NewtonBodyState>();
             islands.stepped.push_back(slot.stepped);
             islands.doublings.push_back(slot.doubling);

@@ -17,6 +17,7 @@ struct BodyAttempt {
                               ///< sub-step
     BodyStepResult failure;   ///< why the body's last attempt failed
     bool failed = false;      ///< its last attempt in this step failed
+    bool keep_best = false;   ///< this attempt is its last: keep the best iterate
 };
 
 /// A world's step scratch, indexed like the world's body slots.

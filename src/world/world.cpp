@@ -174,7 +174,7 @@ void World::step_bodies(double h, sh_step_report& r, vec<uint8_t>& skip) {
             half_steps_stable = take_half_steps(*slot.stepped, *slot.doubling, h, gravity);
         }
         slot.body()->clear_inverted_elements();
-        const BodyStepResult result = step_body(*slot.stepped, h, gravity, slot.keep_best);
+        const BodyStepResult result = step_body(*slot.stepped, h, gravity, scratch_.bodies[index].keep_best);
         if (slot.doubling) {
             if (half_steps_stable && result.stable && r.error_estimate >= 0.0)
                 r.error_estimate = std::max(r.error_estimate, largest_half_step_difference(*slot.body(), *slot.doubling));
@@ -361,10 +361,11 @@ void World::run_attempts(double dt, sh_step_report& r) {
         if (slots_.is_live(index) && base > 1) save_step_start(index);
     }
     for (int32_t factor = 1;; factor *= 2) {
-        slots_.for_each([&](Slot& slot) {
-            const StepSettings& s = slot.stepped->settings;
-            slot.keep_best = sub_steps_on_failure(s) && !may_retry_in(s, 2 * factor);
-        });
+        for (size_t index = 0; index < slots_.size(); ++index) {
+            if (!slots_.is_live(index)) continue;
+            const StepSettings& s = slots_[index].stepped->settings;
+            scratch_.bodies[index].keep_best = sub_steps_on_failure(s) && !may_retry_in(s, 2 * factor);
+        }
         run_substeps(dt, base * factor, r);
         bool retry = false;
         for (size_t index = 0; index < slots_.size(); ++index) {

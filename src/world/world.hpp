@@ -109,9 +109,6 @@ private:
         Body* body() const { return stepped ? stepped->body : nullptr; }
         StepDoubling* doubling = nullptr;   ///< with error_estimate_ only
         BodyContacts* contacts = nullptr;   ///< built on the first step with contact
-        /// This attempt is its last: keep the best iterate. Attempt scratch, kept here because
-        /// step_islands (contact_islands.cpp) reads it from the slot.
-        bool keep_best = false;
     };
     /// Two bodies in contact with each other, with their contact law.
     struct BodyPair {

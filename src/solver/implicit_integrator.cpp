@@ -34,6 +34,12 @@ constexpr double kArmijo = 1e-4;
 // of magnitude, and the residual there is noise rather than a gradient to follow.
 constexpr double kStalledRoundoffFactor = 8.0;
 
+// Along an update whose predicted decrease of Phi is below Phi's round-off estimate, Phi cannot
+// judge it (a stiff body at rest: the update removes a residual of cancellation noise plus a
+// slow creep, and changes Phi by 1e-19 J): the update is kept if it halves the residual and Phi
+// rises by at most this many times the estimate, which is an order of magnitude.
+constexpr double kBlindRoundoffFactor = 16.0;
+
 // The runaway guard's bound: a step with no outside work may not raise the bodies' mechanical
 // energy by more than this times the magnitude of its terms at the start.
 constexpr double kEnergyGrowth = 1.0;
@@ -317,7 +323,8 @@ void NewtonStep::take_update(double scale) {
 }
 
 // Backtracks along delta from the iterate in previous_v (potential phi0 = phi_, slope
-// g^T delta < 0) until Phi falls by Armijo's rule (to round-off). A kept factorisation's
+// g^T delta < 0) until Phi falls by Armijo's rule (to round-off), or, where the fall Phi should
+// show is below its round-off, until the residual halves. A kept factorisation's
 // update must also be full length and cut the residual by kStaleContraction. Returns false,
 // back at the iterate, if no step length qualifies.
 bool NewtonStep::line_search(double slope, bool fresh) {
@@ -332,7 +339,11 @@ bool NewtonStep::line_search(double slope, bool fresh) {
     for (int halving = 0; halving <= (fresh ? kMaxHalvings : 0); ++halving, scale *= 0.5) {
         take_update(scale);
         const double roundoff = sum_roundoff(phi0.scale) + 4.0 * matrix_.kept.roundoff_floor * scale * length;
-        if (!phi_.finite() || phi_.value > phi0.value + kArmijo * scale * slope + roundoff) continue;
+        if (!phi_.finite()) continue;
+        if (fresh && -scale * slope <= roundoff && r_ <= kStaleContraction * r0 &&
+            phi_.value <= phi0.value + kBlindRoundoffFactor * roundoff)
+            return true;  // Phi is blind along this update: the residual judges it
+        if (phi_.value > phi0.value + kArmijo * scale * slope + roundoff) continue;
         if (fresh) return true;
         const double floor = matrix_.kept.roundoff_floor;
         if (r_ <= std::max(kStaleContraction * r0, floor) && r_max_ <= std::max(kStaleContraction * r0_max, floor)) return true;

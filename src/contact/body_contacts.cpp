@@ -48,7 +48,7 @@ BodyContacts::BodyContacts(const Body& body, bool implicit, ContactScratch& scra
         edge_length_[i] = norm3(e);
     }
     stamp_.assign(n, 0);
-    if (node_push_.size() < 3 * n) node_push_.resize(3 * n, 0.0);  // the pushes already there are 0
+    if (scratch_.node_push.size() < 3 * n) scratch_.node_push.resize(3 * n, 0.0);  // the pushes already there are 0
 }
 
 void BodyContacts::clear() {
@@ -124,14 +124,14 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
 }
 
 void BodyContacts::add_forces(const double* x, const double* v, double* f) const {
-    const ScopedTimer timer(evaluation_seconds_);
+    const ScopedTimer timer(scratch_.evaluation_seconds);
     // Explicit bodies feel their friction in end_explicit_step, not here: against another
     // body per contact, against a collider per node (node_friction_point), recorded at the
     // (sub)step's first evaluation.
     const bool explicit_friction = !implicit_step();
-    const bool record = recording_ && v;
-    if (record) friction_records_.clear();
-    recording_ = false;
+    const bool record = scratch_.recording && v;
+    if (record) scratch_.friction_records.clear();
+    scratch_.recording = false;
     const auto add = [&](const ContactPoint& p, bool normal_only) {
         for (int a = 0; a < p.count; ++a)
             for (int k = 0; k < 3; ++k)
@@ -140,11 +140,11 @@ void BodyContacts::add_forces(const double* x, const double* v, double* f) const
     const auto add_point = [&](const ContactCandidate& c, const ContactPoint& p) {
         const bool friction = explicit_friction && p.friction_normal > 0.0;
         add(p, friction);
-        if (friction && record) friction_records_.push_back(friction_record(p, *c.params, v));
+        if (friction && record) scratch_.friction_records.push_back(friction_record(p, *c.params, v));
     };
     const auto record_node = [&](const Collider& collider, int32_t node, const double* push) {
         if (collider.params.static_friction > 0.0 && norm3(push) > 0.0)
-            friction_records_.push_back(friction_record(node_friction_point(collider, node, push, x, v), collider.params, v));
+            scratch_.friction_records.push_back(friction_record(node_friction_point(collider, node, push, x, v), collider.params, v));
     };
     evaluate_with_node_pushes(x, v, explicit_friction && record, add_point, record_node);
     evaluate_friction(v, [&](const ContactCandidate& c, const ContactPoint& p) {

@@ -216,15 +216,7 @@ private:
     uint32_t pass_ = 0;
     vec<ContactCandidate> candidates_;
     vec<Group> groups_;
-    // The world's scratch (see ContactScratch), and its members under the names the
-    // evaluation files use. References: const evaluations write them without `mutable`.
-    ContactScratch& scratch_;
-    vec<double>& keys_ = scratch_.keys;                           ///< see ContactScratch
-    double& evaluation_seconds_ = scratch_.evaluation_seconds;    ///< see ContactScratch
-    vec<double>& node_push_ = scratch_.node_push;                 ///< see ContactScratch
-    vec<int32_t>& pushed_nodes_ = scratch_.pushed_nodes;          ///< see ContactScratch
-    vec<FrictionRecord>& friction_records_ = scratch_.friction_records;  ///< see ContactScratch
-    bool& recording_ = scratch_.recording;                        ///< see ContactScratch
+    ContactScratch& scratch_;  ///< the world's scratch, shared by its bodies' evaluations
     /// Implicit bodies with friction: per candidate, its geometry at the step's start and its
     /// friction over the step's Newton iterates (see friction_chord). State of the candidates
     /// for the whole (sub)step, not scratch: an island's Newton solve interleaves its bodies'

@@ -45,12 +45,12 @@ void BodyContacts::for_each_pair_candidate(const Body& other, const int32_t* own
 
 template <class Emit>
 void BodyContacts::drain_node_pushes(Emit&& emit) const {
-    for (const int32_t node : pushed_nodes_) {
-        double* push = &node_push_[3 * static_cast<size_t>(node)];
+    for (const int32_t node : scratch_.pushed_nodes) {
+        double* push = &scratch_.node_push[3 * static_cast<size_t>(node)];
         emit(node, static_cast<const double*>(push));
         push[0] = push[1] = push[2] = 0.0;
     }
-    pushed_nodes_.clear();
+    scratch_.pushed_nodes.clear();
 }
 
 template <class OnPoint, class OnNode>

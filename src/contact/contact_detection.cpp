@@ -167,17 +167,17 @@ bool BodyContacts::detect_pair(BodyContacts& a, BodyContacts& b, const sh_contac
 bool BodyContacts::keep_deepest(Group& group, int32_t capacity) {
     const int32_t count = group.end - group.begin;
     if (count <= capacity) return false;
-    keys_.resize(static_cast<size_t>(count));
+    scratch_.keys.resize(static_cast<size_t>(count));
     for (int32_t i = 0; i < count; ++i) {
         ContactPoint point;
         const ContactCandidate& c = candidates_[static_cast<size_t>(group.begin + i)];
-        keys_[static_cast<size_t>(i)] = touching(c, body_.x.data(), nullptr, point) ? point.depth : -1.0;
+        scratch_.keys[static_cast<size_t>(i)] = touching(c, body_.x.data(), nullptr, point) ? point.depth : -1.0;
     }
     // Order the group by depth, deepest first, and keep the first `capacity`.
     vec<int32_t> order(static_cast<size_t>(count));
     for (int32_t i = 0; i < count; ++i) order[static_cast<size_t>(i)] = i;
     std::stable_sort(order.begin(), order.end(),
-                     [&](int32_t p, int32_t q) { return keys_[static_cast<size_t>(p)] > keys_[static_cast<size_t>(q)]; });
+                     [&](int32_t p, int32_t q) { return scratch_.keys[static_cast<size_t>(p)] > scratch_.keys[static_cast<size_t>(q)]; });
     vec<ContactCandidate> kept;
     kept.reserve(static_cast<size_t>(capacity));
     for (int32_t i = 0; i < capacity; ++i) kept.push_back(candidates_[static_cast<size_t>(group.begin + order[static_cast<size_t>(i)])]);

@@ -86,25 +86,25 @@ double BodyContacts::dissipation(const double* v) const {
 
 void BodyContacts::add_node_push(const ContactPoint& p) const {
     for (int a = 0; a < p.count; ++a) {
-        double* push = &node_push_[3 * static_cast<size_t>(p.nodes[a])];
-        if (push[0] == 0.0 && push[1] == 0.0 && push[2] == 0.0) pushed_nodes_.push_back(p.nodes[a]);
+        double* push = &scratch_.node_push[3 * static_cast<size_t>(p.nodes[a])];
+        if (push[0] == 0.0 && push[1] == 0.0 && push[2] == 0.0) scratch_.pushed_nodes.push_back(p.nodes[a]);
         for (int k = 0; k < 3; ++k) push[k] += p.node_force[a][k];
     }
 }
 
 void BodyContacts::begin_explicit_step() const {
-    recording_ = true;
-    friction_records_.clear();
+    scratch_.recording = true;
+    scratch_.friction_records.clear();
 }
 
 void BodyContacts::end_explicit_step(double h, bool move_positions, double* x, double* v) const {
     // Friction taken implicitly on the velocities the step reached without it, contact by
     // contact (Gauss-Seidel over contacts sharing nodes), with the normal force and normal of
     // the step's start (see apply_implicit_friction).
-    recording_ = false;
-    for (const FrictionRecord& r : friction_records_)
+    scratch_.recording = false;
+    for (const FrictionRecord& r : scratch_.friction_records)
         apply_implicit_friction(r, body_.inverse_mass.data(), h, move_positions ? x : nullptr, v);
-    friction_records_.clear();
+    scratch_.friction_records.clear();
 }
 
 // Friction's tangent in an implicit step.

@@ -74,7 +74,7 @@ void add_point_tangent(const ContactPoint& p, const PointTangent& tangent, const
 
 void BodyContacts::add_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
                                const int32_t* free_index, SparseSystem& system) const {
-    const ScopedTimer timer(evaluation_seconds_);
+    const ScopedTimer timer(scratch_.evaluation_seconds);
     evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
         add_point_tangent(p, PointTangent(p, *c.params, stiffness_scale, damping_scale), free_index, system);
     });
@@ -101,7 +101,7 @@ void BodyContacts::add_coupling_tangent(const double* x, const double* v, double
     // A body-pair contact is one term over its node and the face behind it: this body's node
     // with gradient n and share 1, the other's face nodes with -w_k n and -w_k. Each body's
     // add_tangent has the blocks among its own nodes; these are the ones across.
-    const ScopedTimer timer(evaluation_seconds_);
+    const ScopedTimer timer(scratch_.evaluation_seconds);
     const auto add = [&](const ContactCandidate& c, const ContactPoint& p) {
         const PointTangent tangent(p, *c.params, stiffness_scale, damping_scale);
         for (int k = 0; k < 3; ++k) {

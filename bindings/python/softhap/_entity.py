@@ -27,11 +27,10 @@ class WorldEntity:
     def __init__(self, world: World, entity_id: int) -> None:
         """Wrap the id entity_id of world (use the World's add_* methods rather than this)."""
         self._world = world
-        self._id = int(entity_id)
-        self._cid = self._id_type(self._id)  # the id as the C functions take it
+        self._cid = self._id_type(int(entity_id))  # the id as the C functions take it
 
     def __repr__(self) -> str:
-        return "<softhap.%s id=%#x>" % (type(self).__name__, self._id)
+        return "<softhap.%s id=%#x>" % (type(self).__name__, self.id)
 
     @property
     def world(self) -> World:
@@ -41,7 +40,7 @@ class WorldEntity:
     @property
     def id(self) -> int:
         """The generation-checked id (an int; 0 is the null id)."""
-        return self._id
+        return cast(int, self._cid.value)
 
     @property
     def is_valid(self) -> bool:

@@ -53,9 +53,10 @@ class _Collider(WorldEntity):
     """What Tool and Obstacle share: an id in a World, the contact state read after a step and
     destroy().
 
-    A subclass sets _kind, _is_valid, _get_contact (the C function reading its state) and
-    _destroy (the C function removing it)."""
+    A subclass sets _kind, _is_valid, _id_type, _create and _destroy (the C functions making
+    and removing it) and _get_contact (the C function reading its state)."""
 
+    _create: str = ""
     _get_contact: str = ""
     _destroy: str = ""
 
@@ -119,6 +120,7 @@ class Tool(_Collider):
     _kind = "tool"
     _is_valid = "sh_tool_is_valid"
     _id_type = sh_tool_id
+    _create = "sh_tool_create"
     _get_contact = "sh_tool_get_contact"
     _destroy = "sh_tool_destroy"
 
@@ -193,6 +195,7 @@ class Obstacle(_Collider):
     _kind = "obstacle"
     _is_valid = "sh_obstacle_is_valid"
     _id_type = sh_obstacle_id
+    _create = "sh_obstacle_create"
     _get_contact = "sh_obstacle_get_contact"
     _destroy = "sh_obstacle_destroy"
 
@@ -243,7 +246,7 @@ class WorldContacts(OwnedHandle):
         """
         arguments = dict(locals())
         world = cast("World", self)
-        return Tool(world, self._create_collider("sh_tool_create", kind, arguments, position, orientation))
+        return Tool(world, self._create_collider(Tool, kind, arguments, position, orientation))
 
     def add_obstacle(
         self,
@@ -283,23 +286,22 @@ class WorldContacts(OwnedHandle):
                 "normal=)"
             )
         world = cast("World", self)
-        return Obstacle(
-            world, self._create_collider("sh_obstacle_create", kind, arguments, position, orientation)
-        )
+        return Obstacle(world, self._create_collider(Obstacle, kind, arguments, position, orientation))
 
     def _create_collider(
         self,
-        function: str,
+        entity: type[_Collider],
         kind: str,
         arguments: Mapping[str, Any],
         position: Optional[ArrayLike],
         orientation: Optional[ArrayLike],
     ) -> int:
-        """The id that C function (sh_tool_create or sh_obstacle_create) gives the collider of
-        shape kind, its keyword arguments and its pose."""
+        """The id that entity's create function (sh_tool_create or sh_obstacle_create) gives
+        the collider of shape kind, its keyword arguments and its pose."""
+        function = entity._create
         handle = self._require_handle(function)
         definition, arrays = _defs.collider_def(kind, arguments, position, orientation)
-        collider = (sh_tool_id if function == "sh_tool_create" else sh_obstacle_id)()
+        collider = entity._id_type()
         check(
             getattr(lib, function)(handle, ctypes.byref(definition), ctypes.byref(collider)),
             function,

@@ -247,17 +247,23 @@ static void test_force_is_clamped_rate_limited_and_ramped_in(void** state) {
         const double p[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top - 0.003 * fmin(1.0, (i + 1) / 50.0)};
         sh_haptic_output out;
         assert_ok(sh_haptic_step(haptic, p, kIdentity, dt, &out));
-        double change[3];
+        double change[3], wanted[3], previous_gap[3], gap[3];
+        /* Ramp-in: the gain after i + 1 ticks is (i + 1) dt / ramp_time. The output moves from
+         * the last one straight towards gain times the raw force (clamped to max_force), at most
+         * max_force_rate * dt per tick. */
+        const double gain = fmin(1.0, (i + 1) * dt / def.ramp_time);
+        const double wanted_scale = gain * fmin(1.0, def.max_force / fmax(gain * norm3(out.raw_force), 1e-300));
         for (int k = 0; k < 3; ++k) {
             assert_true(isfinite(out.force[k]) && isfinite(out.torque[k]));
+            wanted[k] = wanted_scale * out.raw_force[k];
+            previous_gap[k] = last[k] - wanted[k];
+            gap[k] = out.force[k] - wanted[k];
             change[k] = out.force[k] - last[k];
             last[k] = out.force[k];
         }
         assert_true(norm3(out.force) <= def.max_force * (1.0 + 1e-12));
         assert_true(norm3(change) <= def.max_force_rate * dt * (1.0 + 1e-12));
-        /* Ramp-in: the gain after i + 1 ticks is (i + 1) dt / ramp_time. */
-        const double gain = fmin(1.0, (i + 1) * dt / def.ramp_time);
-        assert_true(norm3(out.force) <= gain * norm3(out.raw_force) * (1.0 + 1e-12) + 1e-15);
+        assert_true(norm3(gap) <= fmax(0.0, norm3(previous_gap) - def.max_force_rate * dt) + 1e-12 * def.max_force);
         if (norm3(out.raw_force) > largest_raw) largest_raw = norm3(out.raw_force);
         seen |= out.warnings;
     }

@@ -19,32 +19,6 @@ std::string tet_name(const MeshData& data, size_t t) {
 // Faces of tet (0,1,2,3) oriented outward for a positively oriented tet.
 constexpr int kFaces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
 
-void build_surface(TetMesh& mesh) {
-    struct Face {
-        std::array<int32_t, 3> key;   // sorted node indices
-        std::array<int32_t, 3> nodes; // outward order
-    };
-    const int32_t tet_count = mesh.tet_count();
-    vec<Face> faces;
-    faces.reserve(static_cast<size_t>(tet_count) * 4);
-    for (int32_t t = 0; t < tet_count; ++t) {
-        const int32_t* tet = &mesh.tets[4 * static_cast<size_t>(t)];
-        for (const auto& f : kFaces) {
-            Face face{{tet[f[0]], tet[f[1]], tet[f[2]]}, {tet[f[0]], tet[f[1]], tet[f[2]]}};
-            std::sort(face.key.begin(), face.key.end());
-            faces.push_back(face);
-        }
-    }
-    std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.key < b.key; });
-    for (size_t i = 0; i < faces.size();) {
-        size_t j = i + 1;
-        while (j < faces.size() && faces[j].key == faces[i].key) ++j;
-        if (j - i == 1)
-            mesh.surface_triangles.insert(mesh.surface_triangles.end(), faces[i].nodes.begin(), faces[i].nodes.end());
-        i = j;
-    }
-}
-
 void build_edges(TetMesh& mesh) {
     const int32_t tet_count = mesh.tet_count();
     vec<std::array<int32_t, 2>> edges;
@@ -62,6 +36,43 @@ void build_edges(TetMesh& mesh) {
 }
 
 }  // namespace
+
+vec<int32_t> boundary_triangles(const int32_t* tets, size_t tet_count) {
+    struct Face {
+        std::array<int32_t, 3> key;   // sorted node indices
+        std::array<int32_t, 3> nodes; // outward order
+    };
+    vec<Face> faces;
+    faces.reserve(tet_count * 4);
+    for (size_t t = 0; t < tet_count; ++t) {
+        const int32_t* tet = &tets[4 * t];
+        for (const auto& f : kFaces) {
+            Face face{{tet[f[0]], tet[f[1]], tet[f[2]]}, {tet[f[0]], tet[f[1]], tet[f[2]]}};
+            std::sort(face.key.begin(), face.key.end());
+            faces.push_back(face);
+        }
+    }
+    std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.key < b.key; });
+    vec<int32_t> boundary;
+    for (size_t i = 0; i < faces.size();) {
+        size_t j = i + 1;
+        while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+        if (j - i == 1) boundary.insert(boundary.end(), faces[i].nodes.begin(), faces[i].nodes.end());
+        i = j;
+    }
+    return boundary;
+}
+
+double tet_quality(const double* a, const double* b, const double* c, const double* d) {
+    const double* p[4] = {a, b, c, d};
+    double sum_squares = 0.0;
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+            for (int k = 0; k < 3; ++k) sum_squares += (p[i][k] - p[j][k]) * (p[i][k] - p[j][k]);
+    const double rms = std::sqrt(sum_squares / 6.0);
+    // A regular tet of edge l has volume l^3 / (6 sqrt 2).
+    return rms > 0.0 ? 6.0 * std::sqrt(2.0) * signed_tet_volume(a, b, c, d) / (rms * rms * rms) : 0.0;
+}
 
 double signed_tet_volume(const double* a, const double* b, const double* c, const double* d) {
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
@@ -144,7 +155,7 @@ TetMesh build_tet_mesh(MeshData data, const std::string& origin) {
     }
     mesh.nodes = std::move(data.nodes);
     mesh.tets = std::move(data.tets);
-    build_surface(mesh);
+    mesh.surface_triangles = boundary_triangles(mesh.tets.data(), mesh.tets.size() / 4);
     build_edges(mesh);
     return mesh;
 }

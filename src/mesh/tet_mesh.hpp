@@ -40,6 +40,14 @@ struct TetMesh {
 /// zero-volume tets; flips inverted tets and counts them.
 TetMesh build_tet_mesh(MeshData data, const std::string& origin);
 
+/// The faces of tets[0..tet_count) (4 node indices each, positively oriented) that belong to
+/// one tet only, 3 node indices each, outward (counter-clockwise seen from outside).
+vec<int32_t> boundary_triangles(const int32_t* tets, size_t tet_count);
+
+/// Shape quality of the tet (a, b, c, d): 6 sqrt(2) V / l_rms^3, 1 for a regular tet, falling
+/// to 0 as it flattens, negative when inverted (l_rms: root mean square of its six edges).
+double tet_quality(const double* a, const double* b, const double* c, const double* d);
+
 /// Signed volume of the tet (a, b, c, d): positive when (b-a, c-a, d-a) is right-handed.
 double signed_tet_volume(const double* a, const double* b, const double* c, const double* d);
 

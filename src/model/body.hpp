@@ -13,6 +13,22 @@ namespace sh {
 class ExternalField;
 class SparseSystem;
 
+/// Where a node appended by a topology change comes from: the point (1 - t) a + t b of the
+/// edge from node a to node b, in the rest and in the current shape. A copy of node a is
+/// {a, a, 0}.
+struct NodeOrigin {
+    int32_t a = 0, b = 0;  ///< the edge's end nodes (equal for a copy)
+    double t = 0.0;        ///< where on the edge, in [0, 1]
+};
+
+/// A body's node arrays grown by appended nodes, built aside (Body::grow_nodes) so that a
+/// failed allocation leaves the body as it was; Body::adopt_nodes swaps them in.
+struct GrownNodes {
+    vec<double> x, v, rest, target, external_force, node_damping, mass, inverse_mass;
+    vec<uint8_t> kinematic;
+    vec<int32_t> parent;
+};
+
 /// A deformable body. Orphan nodes have zero mass and are never integrated.
 class Body {
 public:
@@ -97,6 +113,20 @@ public:
 
     int32_t node_count() const { return static_cast<int32_t>(mass.size()); }
 
+    /// The node arrays with the nodes of origins[0..count) appended, each interpolated along its
+    /// edge (positions, velocities, targets, damping): a node is held (fixed or prescribed) if
+    /// both ends are, carries no external force, and its parent is the nearer end (or the one
+    /// copied). mass is sized and zero: the body's elements give it. Throws std::bad_alloc.
+    GrownNodes grow_nodes(const NodeOrigin* origins, size_t count) const;
+
+    /// Swaps grown's arrays in (allocation-free) and recomputes inverse_mass.
+    void adopt_nodes(GrownNodes& grown) noexcept;
+
+    /// The node each node was made from by a cut (-1 for nodes the body was created with).
+    int32_t parent_of(int32_t node) const {
+        return static_cast<size_t>(node) < node_parent.size() ? node_parent[static_cast<size_t>(node)] : -1;
+    }
+
     double damping_mass = 0.0;   ///< Rayleigh alpha: viscous damping of every node (1/s)
     vec<double> x, v;            ///< 3 per node (m, m/s)
     vec<double> rest;            ///< the rest shape, 3 per node (m)
@@ -107,6 +137,11 @@ public:
     vec<double> external_force;  ///< 3 per node (N), held
     vec<double> node_damping;    ///< per-node viscous coefficient (1/s); empty if unused
     vec<int32_t> surface_triangles;  ///< 3 per boundary triangle, outward; empty for springs
+    vec<int32_t> node_parent;    ///< per node: the node it was made from, -1 for the body's own
+                                 ///< nodes; empty until the first topology change
+    /// Bumped by every topology change (elements, springs or nodes added or removed): whatever
+    /// holds per-node or per-element data of the body rebuilds it when this moves.
+    uint64_t topology_version = 0;
     /// Bumped whenever M, D or K change other than through x (a material or node-damping
     /// change): a factorisation kept by the implicit integrator is valid only for the version it
     /// was built at.

@@ -63,63 +63,110 @@ vec<uint32_t> locality_order(const vec<int32_t>& tets, const vec<double>& p) {
 }  // namespace
 
 FemBody::FemBody(const TetMesh& mesh, const sh_material& material, double damping_mass, double damping_stiffness)
-    : Body(mesh.nodes, damping_mass), tets_(mesh.tets), damping_stiffness_(damping_stiffness) {
+    : Body(mesh.nodes, damping_mass), damping_stiffness_(damping_stiffness) {
     surface_triangles = mesh.surface_triangles;
-    const size_t tet_count = tets_.size() / 4;
-    inverse_rest_.resize(9 * tet_count);
-    volume_.resize(tet_count);
-    for (size_t t = 0; t < tet_count; ++t) {
-        const int32_t* tet = &tets_[4 * t];
-        Eigen::Matrix3d dm;
-        for (int a = 0; a < 3; ++a)
-            for (int i = 0; i < 3; ++i) dm(i, a) = x[3 * tet[a + 1] + i] - x[3 * tet[0] + i];
-        volume_[t] = dm.determinant() / 6.0;
-        const Eigen::Matrix3d bm = dm.inverse();
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) inverse_rest_[9 * t + 3 * i + j] = bm(i, j);
-    }
-    rebuild(vec<sh_material>(tet_count, material));
+    const size_t tet_count = mesh.tets.size() / 4;
+    ElementSet set;
+    set.tets = mesh.tets;
+    set.materials.assign(tet_count, material);
+    set.inverse_rest.resize(9 * tet_count);
+    set.volume.resize(tet_count);
+    set.omega2.assign(tet_count, -1.0);
+    for (size_t t = 0; t < tet_count; ++t) shape_from_rest(rest, &set.tets[4 * t], &set.inverse_rest[9 * t], set.volume[t]);
+    adopt(set, nullptr);
+}
+
+void FemBody::shape_from_rest(const vec<double>& rest_positions, const int32_t* tet, double* bm_out, double& volume) {
+    Eigen::Matrix3d dm;
+    for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < 3; ++i) dm(i, a) = rest_positions[3 * tet[a + 1] + i] - rest_positions[3 * tet[0] + i];
+    volume = dm.determinant() / 6.0;
+    const Eigen::Matrix3d bm = dm.inverse();
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) bm_out[3 * i + j] = bm(i, j);
 }
 
 void FemBody::set_material(const int32_t* elements, int32_t count, const sh_material& material) {
     for (int32_t k = 0; k < count; ++k)
         require(elements[k] >= 0 && elements[k] < element_count(), SH_ERR_INVALID_ARGUMENT,
                 format("elements[%d] = %d is not an element index in [0, %d)", k, elements[k], element_count()));
-    vec<sh_material> materials = materials_;
-    for (int32_t k = 0; k < count; ++k) materials[static_cast<size_t>(elements[k])] = material;
-    rebuild(std::move(materials));
+    ElementSet set;
+    set.tets = tets_, set.inverse_rest = inverse_rest_, set.volume = volume_, set.materials = materials_;
+    set.omega2 = element_omega2_;
+    for (int32_t k = 0; k < count; ++k) {
+        set.materials[static_cast<size_t>(elements[k])] = material;
+        set.omega2[static_cast<size_t>(elements[k])] = -1.0;
+    }
+    adopt(set, nullptr);
 }
 
-void FemBody::rebuild(vec<sh_material> materials) {
-    // Everything is built aside and swapped in at the end: a failed allocation changes nothing.
-    const size_t tet_count = volume_.size();
-    vec<double> new_mass(mass.size(), 0.0);
-    for (size_t t = 0; t < tet_count; ++t)
-        for (int a = 0; a < 4; ++a) new_mass[static_cast<size_t>(tets_[4 * t + a])] += materials[t].density * volume_[t] / 4.0;
+void FemBody::retopologize(const NodeOrigin* origins, size_t origin_count, vec<int32_t> tets, const vec<int32_t>& source) {
+    GrownNodes grown = grow_nodes(origins, origin_count);
+    const size_t tet_count = tets.size() / 4;
+    ElementSet set;
+    set.tets = std::move(tets);
+    set.inverse_rest.resize(9 * tet_count);
+    set.volume.resize(tet_count);
+    set.materials.resize(tet_count);
+    set.omega2.resize(tet_count);
+    for (size_t t = 0; t < tet_count; ++t) {
+        const bool piece = source[t] < 0;
+        const size_t from = static_cast<size_t>(piece ? -1 - source[t] : source[t]);
+        set.materials[t] = materials_[from];
+        if (piece) {
+            shape_from_rest(grown.rest, &set.tets[4 * t], &set.inverse_rest[9 * t], set.volume[t]);
+            set.omega2[t] = -1.0;
+        } else {
+            std::copy(&inverse_rest_[9 * from], &inverse_rest_[9 * from] + 9, &set.inverse_rest[9 * t]);
+            set.volume[t] = volume_[from];
+            set.omega2[t] = element_omega2_[from];
+        }
+    }
+    adopt(set, &grown);
+}
 
+vec<double> FemBody::lumped_mass(const ElementSet& set, size_t node_count) {
+    vec<double> m(node_count, 0.0);
+    for (size_t t = 0; t < set.volume.size(); ++t)
+        for (int a = 0; a < 4; ++a) m[static_cast<size_t>(set.tets[4 * t + a])] += set.materials[t].density * set.volume[t] / 4.0;
+    return m;
+}
+
+void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
+    // Everything is built aside and swapped in at the end: a failed allocation changes nothing.
+    const size_t tet_count = set.volume.size();
+    vec<double> new_mass = lumped_mass(set, grown ? grown->mass.size() : mass.size());
     vec<TetBlock> new_blocks[SH_MATERIAL_COUNT];
-    const vec<uint32_t> order = locality_order(tets_, x);
+    const vec<uint32_t> order = locality_order(set.tets, grown ? grown->x : x);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         vec<uint32_t> members;
         for (const uint32_t t : order)
-            if (materials[t].model == model) members.push_back(t);
+            if (set.materials[t].model == model) members.push_back(t);
         vec<TetBlock>& blocks = new_blocks[model];
         blocks.assign(block_count(members.size()), TetBlock{});
         spread_over_lanes(members.data(), members.size(), [&](uint32_t t, bool used, size_t k, int l) {
-            fill_lane(t, materials[t], &tets_[4 * static_cast<size_t>(t)], used, blocks[k], l);
+            fill_lane(set, t, used, blocks[k], l);
         });
     }
+    vec<int32_t> surface = grown ? boundary_triangles(set.tets.data(), tet_count) : vec<int32_t>();
 
-    vec<double> omega2(tet_count);
     double largest = 0.0;
     for (size_t t = 0; t < tet_count; ++t) {
-        omega2[t] = element_max_frequency_squared(t, materials[t]);
-        largest = std::max(largest, omega2[t]);
+        if (set.omega2[t] < 0.0) set.omega2[t] = element_max_frequency_squared(&set.inverse_rest[9 * t], set.volume[t], set.materials[t]);
+        largest = std::max(largest, set.omega2[t]);
+    }
+    // Commit: nothing below allocates.
+    if (grown) {
+        adopt_nodes(*grown);
+        surface_triangles.swap(surface);
+        ++topology_version;
     }
     stable_step_ = stable_step_at(largest);
-    element_omega2_.swap(omega2);
-
-    materials_.swap(materials);
+    tets_.swap(set.tets);
+    inverse_rest_.swap(set.inverse_rest);
+    volume_.swap(set.volume);
+    element_omega2_.swap(set.omega2);
+    materials_.swap(set.materials);
     mass.swap(new_mass);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) blocks_[model].swap(new_blocks[model]);
     ++matrix_version;
@@ -127,22 +174,30 @@ void FemBody::rebuild(vec<sh_material> materials) {
 }
 
 void FemBody::fill_lane(size_t t, const sh_material& m, const int32_t nodes[4], bool used, TetBlock& b, int lane) const {
+    fill_lane_from(&inverse_rest_[9 * t], volume_[t], m, nodes, used, b, lane);
+}
+
+void FemBody::fill_lane(const ElementSet& set, size_t t, bool used, TetBlock& b, int lane) {
+    fill_lane_from(&set.inverse_rest[9 * t], set.volume[t], set.materials[t], &set.tets[4 * t], used, b, lane);
+}
+
+void FemBody::fill_lane_from(const double* bm, double v0, const sh_material& m, const int32_t nodes[4], bool used,
+                             TetBlock& b, int lane) {
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) b.Bm.m[i][j][lane] = inverse_rest_[9 * t + 3 * i + j];
-    const double weight = used ? -volume_[t] : 0.0;
+        for (int j = 0; j < 3; ++j) b.Bm.m[i][j][lane] = bm[3 * i + j];
+    const double weight = used ? -v0 : 0.0;
     b.lambda_w[lane] = weight * lame_lambda(m);
     b.mu_w[lane] = weight * lame_mu(m);
     for (int a = 0; a < 4; ++a) b.node[a][lane] = nodes[a];
 }
 
-double FemBody::element_max_frequency_squared(size_t t, const sh_material& material) const {
+double FemBody::element_max_frequency_squared(const double* bm, double v0, const sh_material& material) {
     // Largest eigenvalue of M_e^-1 K_e with the rest (small-strain) stiffness and the element's
     // share of the lumped mass: an upper bound of the assembled system's (Irons-Treharne).
-    const double* bm = &inverse_rest_[9 * t];
     Eigen::Vector3d g[4];
     for (int a = 0; a < 3; ++a) g[a + 1] = Eigen::Vector3d(bm[3 * a], bm[3 * a + 1], bm[3 * a + 2]);
     g[0] = -(g[1] + g[2] + g[3]);
-    const double lambda = lame_lambda(material), mu = lame_mu(material), v0 = volume_[t];
+    const double lambda = lame_lambda(material), mu = lame_mu(material);
     Eigen::Matrix<double, 12, 12> k;
     for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b)

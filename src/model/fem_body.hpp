@@ -17,6 +17,30 @@ public:
     /// Sets the material of the listed elements; recomputes masses, blocks and the stable step.
     void set_material(const int32_t* elements, int32_t count, const sh_material& material);
 
+    /// Replaces the elements after a cut: appends the nodes of origins[0..origin_count) (see
+    /// Body::grow_nodes), then takes tets (4 per tet, over the grown numbering, positively
+    /// oriented) where source[t] names the tet each comes from: source[t] = s >= 0 keeps tet s's
+    /// rest shape and material (its nodes may be copies of s's), source[t] = -1 - s is a piece
+    /// of tet s (s's material, its rest shape from its nodes' rest positions). Recomputes
+    /// masses, blocks, the surface and the stable step, and bumps topology_version; a failed
+    /// allocation changes nothing.
+    void retopologize(const NodeOrigin* origins, size_t origin_count, vec<int32_t> tets, const vec<int32_t>& source);
+
+    /// Rest volume of tet t (m^3).
+    double rest_volume(size_t t) const { return volume_[t]; }
+
+    /// Squared largest frequency of tet t alone at rest (1/s^2): stable_step is 2/omega over the
+    /// largest of them.
+    double element_frequency_squared(size_t t) const { return element_omega2_[t]; }
+
+    /// Squared largest frequency (1/s^2) that a tet of rest inverse shape bm (9, row-major),
+    /// rest volume v0 and material would have.
+    static double element_max_frequency_squared(const double* bm, double v0, const sh_material& material);
+
+    /// Inverse rest shape Bm (9, row-major) and rest volume of tet (4 node indices) at
+    /// rest_positions.
+    static void shape_from_rest(const vec<double>& rest_positions, const int32_t* tet, double* bm, double& volume);
+
     void add_internal_forces(const double* x, const double* v, double* f) const override;
     double elastic_energy(const double* x) const override;
     double stable_step(const double* x) const override;
@@ -44,9 +68,24 @@ public:
     void fill_lane(size_t t, const sh_material& m, const int32_t nodes[4], bool used, TetBlock& b, int lane) const;
 
 private:
-    /// Adopts materials (one per tet): masses, blocks and the stable step, all or nothing.
-    void rebuild(vec<sh_material> materials);
-    double element_max_frequency_squared(size_t element, const sh_material& material) const;
+    /// A body's elements as built aside before they are adopted.
+    struct ElementSet {
+        vec<int32_t> tets;          ///< 4 per tet
+        vec<double> inverse_rest;   ///< 9 per tet
+        vec<double> volume;         ///< per tet
+        vec<sh_material> materials; ///< per tet
+        vec<double> omega2;         ///< per tet; negative: to be computed
+    };
+    /// Adopts set (and grown's nodes, for a topology change, then also the new surface):
+    /// masses, blocks and the stable step, all or nothing.
+    void adopt(ElementSet& set, GrownNodes* grown);
+    /// Lumped masses of set over node_count nodes.
+    static vec<double> lumped_mass(const ElementSet& set, size_t node_count);
+    /// fill_lane for tet t of set.
+    static void fill_lane(const ElementSet& set, size_t t, bool used, TetBlock& b, int lane);
+    /// Writes one lane from a tet's Bm, rest volume, material and nodes.
+    static void fill_lane_from(const double* bm, double v0, const sh_material& m, const int32_t nodes[4], bool used,
+                               TetBlock& b, int lane);
     /// 2/omega with the stiffness damping, for omega^2 = omega2 (1/s^2).
     double stable_step_at(double omega2) const;
 

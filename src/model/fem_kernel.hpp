@@ -6,7 +6,7 @@
 // Node data (x, v, f) is 3 doubles per node. With AVX-512 a node's xyz is read, and its force
 // added, with one masked 256-bit load (and store) per node and lane, the kLanes rows being
 // transposed in registers (edges are formed on the rows, before the transpose). Zen 4 does not forward a masked store to a later load of the same
-// node, so tets of one block that share a node would stall on each other: FemBody::rebuild
+// node, so tets of one block that share a node would stall on each other: FemBody::adopt
 // puts tets far apart along its locality curve into the lanes of a block, and the next
 // block's updates of the same nodes come after the stores have retired. Elsewhere the lanes
 // are filled and drained one double at a time.

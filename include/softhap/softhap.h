@@ -536,6 +536,11 @@ typedef struct sh_body_info {
     int32_t fixed_node_count; /**< nodes fixed or prescribed */
     double total_mass;      /**< sum of nodal masses (kg) */
     double dt_critical;     /**< critical explicit step of its integrator (s); INFINITY if none */
+    int32_t surface_triangle_count; /**< FEM: boundary triangles of the current topology (0 for
+                                         mass-spring bodies) */
+    int32_t reserved;       /**< 0 */
+    uint64_t topology_version; /**< 0 at creation; increases at every topology change (a cut,
+                                    springs breaking): re-read tets, surface and node count */
 } sh_body_info;
 
 /** Destroy a body (FEM or mass-spring); its id becomes stale, and its contacts with other
@@ -608,6 +613,68 @@ SH_API sh_status sh_body_get_elastic_energy(const sh_world* world, sh_body_id bo
 /** Write the body's current shape as ASCII .vtu (FEM: tets; springs: lines) with point data
  *  "velocity". Thread: sim. Alloc: may. */
 SH_API sh_status sh_body_write_vtu(const sh_world* world, sh_body_id body, const char* path);
+
+/** @} */
+
+/** @defgroup sh_api_cut Cutting and topology
+ *  Cuts separate material, never delete it: the tets on the two sides of a cut surface stop
+ *  sharing nodes. Nodes on the cut are copied (each copy appended, with its parent's index),
+ *  tets the surface crosses are split so that the new surface follows it, and parts left joined
+ *  only through a node are separated too. Node indices never change; a cut body stays one body
+ *  (cut through, it has several connected pieces). Thread: sim for everything here.
+ *  @{ */
+
+/** What one cut did. */
+typedef struct sh_cut_report {
+    int32_t faces_separated; /**< tet faces that became surface (counted once per pair of
+                                  faces that parted) */
+    int32_t nodes_added;     /**< nodes appended: points made on cut edges and node copies */
+    int32_t tets_added;      /**< tets after the cut minus tets before */
+    int32_t nodes_moved;     /**< existing nodes moved onto the cut surface (0: nodes near the
+                                  surface are cut through where they are) */
+    double min_quality;      /**< lowest shape quality 6 sqrt(2) V / l_rms^3 of the tets the
+                                  cut made (1 regular, 0 flat); 1 if it made none */
+    double seconds;          /**< wall time of the cut, topology update included (s) */
+    int32_t springs_cut;     /**< mass-spring bodies: springs the surface crossed, removed */
+    int32_t reserved;        /**< 0 */
+} sh_cut_report;
+
+/** Cut body along a surface: triangle_count triangles, 9 doubles each (three corners, world
+ *  frame, m), in the body's current configuration; the triangles need not be welded or
+ *  consistently oriented. The material the surface passes through separates; where its
+ *  border lies inside the body, the body stays joined (a later cut extends it). FEM bodies
+ *  split the tets it crosses (a cut point within a quarter of an edge of a node goes through
+ *  the node instead); mass-spring bodies lose the springs it crosses. Masses, rest shapes,
+ *  the surface, contact, implicit solver data and haptic buffers follow; topology_version
+ *  increases if anything was cut. out_report may be NULL. Non-finite coordinates, a
+ *  zero-area triangle or triangle_count < 1 are SH_ERR_INVALID_ARGUMENT naming the triangle;
+ *  a failed allocation is SH_ERR_OUT_OF_MEMORY; either leaves the body as it was.
+ *  Alloc: may. */
+SH_API sh_status sh_body_cut(sh_world* world, sh_body_id body, const double* triangles,
+                             int32_t triangle_count, sh_cut_report* out_report);
+
+/** Copy the FEM body's tets (element_count x 4 node indices, positively oriented) into
+ *  out_tets, which has room for capacity tets. SH_ERR_UNSUPPORTED for a mass-spring body.
+ *  Alloc: none. */
+SH_API sh_status sh_body_get_tets(const sh_world* world, sh_body_id body, int32_t* out_tets,
+                                  int32_t capacity);
+
+/** Copy the body's springs (element_count x 2 node indices) into out_springs, which has room
+ *  for capacity springs. SH_ERR_UNSUPPORTED for an FEM body. Alloc: none. */
+SH_API sh_status sh_body_get_springs(const sh_world* world, sh_body_id body, int32_t* out_springs,
+                                     int32_t capacity);
+
+/** Copy the FEM body's boundary triangles (surface_triangle_count x 3 node indices, counter-
+ *  clockwise seen from outside) into out_triangles, room for capacity triangles.
+ *  SH_ERR_UNSUPPORTED for a mass-spring body. Alloc: none. */
+SH_API sh_status sh_body_get_surface_triangles(const sh_world* world, sh_body_id body,
+                                               int32_t* out_triangles, int32_t capacity);
+
+/** Copy each node's parent (node_count values: the node it was made from by a cut, -1 for the
+ *  body's own nodes) into out_parents, room for capacity nodes. A copy's parent is the node
+ *  copied; a node made on a cut edge has the edge's nearer end. Alloc: none. */
+SH_API sh_status sh_body_get_node_parents(const sh_world* world, sh_body_id body,
+                                          int32_t* out_parents, int32_t capacity);
 
 /** @} */
 

@@ -42,6 +42,24 @@ SpringBody::SpringBody(vec<double> nodes, vec<int32_t> springs, const sh_spring_
     update_inverse_mass();
 }
 
+int32_t SpringBody::remove_springs(const vec<uint8_t>& broken) {
+    vec<int32_t> springs;
+    vec<double> rest_length;
+    for (size_t s_i = 0; s_i < rest_length_.size(); ++s_i) {
+        if (broken[s_i]) continue;
+        springs.push_back(springs_[2 * s_i]);
+        springs.push_back(springs_[2 * s_i + 1]);
+        rest_length.push_back(rest_length_[s_i]);
+    }
+    const int32_t removed = static_cast<int32_t>(rest_length_.size() - rest_length.size());
+    if (removed == 0) return 0;
+    springs_.swap(springs);
+    rest_length_.swap(rest_length);
+    ++topology_version;
+    ++matrix_version;
+    return removed;
+}
+
 void SpringBody::add_internal_forces(const double* xs, const double* vs, double* f) const {
     const double c = vs ? law_.damping() : 0.0;
     for (size_t s = 0; s < rest_length_.size(); ++s) {

@@ -26,6 +26,11 @@ public:
     int32_t element_count() const override { return static_cast<int32_t>(rest_length_.size()); }
     bool is_fem() const override { return false; }
 
+    /// Removes the springs whose entry in broken (one per spring) is nonzero, keeping the
+    /// others' order; bumps topology_version and matrix_version if any went. A failed
+    /// allocation changes nothing. Returns how many went.
+    int32_t remove_springs(const vec<uint8_t>& broken);
+
 private:
     vec<int32_t> springs_;      ///< 2 per spring
     vec<double> rest_length_;   ///< l0 per spring (m)

@@ -107,6 +107,28 @@ void World::remove_body(Id id) {
                  pairs_.end());
 }
 
+TopologyScratch::~TopologyScratch() { sh::destroy(doubling); }
+
+void World::prepare_topology_change(Id id, int32_t node_count, TopologyScratch& out) {
+    body(id);  // validates
+    out.workspace.resize(node_count);
+    if (error_estimate_) out.doubling = sh::create<StepDoubling>(3 * static_cast<size_t>(node_count));
+    scratch_.reserve_body(slots_.size(), id_index(id), 6 * static_cast<size_t>(node_count));
+}
+
+void World::topology_changed(Id id, TopologyScratch& prepared) noexcept {
+    Slot& slot = slots_[id_index(id)];
+    std::swap(slot.stepped->workspace, prepared.workspace);
+    std::swap(slot.doubling, prepared.doubling);
+    sh::destroy(slot.contacts);  // rebuilt over the new surface on the next step with contact
+    slot.contacts = nullptr;
+    sh::destroy(slot.stepped->newton);  // its pattern and symbolic analysis follow the elements
+    slot.stepped->newton = nullptr;
+    sh::destroy(islands_);  // joint systems are rebuilt on the next step with body contact
+    islands_ = nullptr;
+    for (StepHook* hook : hooks_) hook->topology_changed(*this, id);
+}
+
 Id World::add_collider(const sh_collider_def& def, bool is_tool) {
     Collider* collider = sh::create<Collider>(def, is_tool);
     try {

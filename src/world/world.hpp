@@ -22,6 +22,17 @@ struct Collider;
 struct NewtonBodyState;
 struct StepDoubling;
 
+/// What a world needs for a body whose topology is about to change, allocated beforehand
+/// (World::prepare_topology_change) so that the change itself cannot fail.
+struct TopologyScratch {
+    IntegratorWorkspace workspace;     ///< the body's integrator scratch at its new size
+    StepDoubling* doubling = nullptr;  ///< its step-doubling scratch, with error estimates only
+    TopologyScratch() = default;
+    ~TopologyScratch();
+    TopologyScratch(const TopologyScratch&) = delete;             ///< owns doubling
+    TopologyScratch& operator=(const TopologyScratch&) = delete;  ///< owns doubling
+};
+
 /// The simulation world of the C API's sh_world. Bodies, tools and obstacles are named by
 /// generation-checked Ids (core/id_pool.hpp), the values the C API's id types carry.
 class World {
@@ -79,6 +90,15 @@ public:
     /// Moves every body to static equilibrium (see sh_world_solve_static); on failure every
     /// body is restored and the error rethrown.
     void solve_static(const sh_static_def& def, sh_static_report* report);
+
+    /// Allocates into out what body id needs from the world once it has node_count nodes, before
+    /// its topology changes. Throws SH_ERR_INVALID_HANDLE or std::bad_alloc, changing nothing.
+    void prepare_topology_change(Id id, int32_t node_count, TopologyScratch& out);
+
+    /// Body id's topology changed (its nodes, elements or surface): adopts prepared (from
+    /// prepare_topology_change at its new node count), drops what the world keeps per node or
+    /// element of it (contact state, Newton solver data, joint systems) and tells the hooks.
+    void topology_changed(Id id, TopologyScratch& prepared) noexcept;
 
     /// Registers a step hook (a haptic context takes its device pose before each step and
     /// refreshes its buffer after). The hook is told (detach) if the world goes first.

@@ -1280,6 +1280,136 @@ static void test_write_vtu_to_unwritable_path(void** state) {
     assert_ok(sh_world_destroy(world));
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* Cutting and topology queries: the API surface (what a cut does is test_cut's)                */
+
+/* Asserts the body is still its uncut self: topology version 0, node and tet counts as given. */
+static void assert_uncut(const sh_world* world, sh_body_id body, int32_t nodes, int32_t tets) {
+    sh_body_info info;
+    assert_ok(sh_body_get_info(world, body, &info));
+    assert_int_equal(info.topology_version, 0);
+    assert_int_equal(info.node_count, nodes);
+    assert_int_equal(info.element_count, tets);
+}
+
+static void test_cut_rejects_bad_arguments(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_mesh* mesh = sh_test_box(0.02, 0.02, 0.02, 1, 1, 1);
+    const sh_mesh_info mesh_info = sh_test_mesh_info(mesh);
+    const sh_body_id body = add_fem(world, mesh);
+    const sh_body_id stale = add_fem(world, mesh);
+    assert_ok(sh_body_destroy(world, stale));
+    /* Two triangles spanning the plane x = 7 mm, well past the 2 cm box on every side. */
+    const double blade[18] = {0.007, -1, -1, 0.007, 1, -1, 0.007, 1, 1,
+                              0.007, -1, -1, 0.007, 1, 1,  0.007, -1, 1};
+    double nan_blade[18], flat_blade[18];
+    memcpy(nan_blade, blade, sizeof blade);
+    nan_blade[9 + 4] = NAN; /* triangle 1, corner 1, y */
+    memcpy(flat_blade, blade, sizeof blade);
+    memcpy(flat_blade + 6, flat_blade + 3, 3 * sizeof(double)); /* triangle 0: two equal corners */
+    sh_cut_report report, untouched;
+    memset(&untouched, 0x5a, sizeof untouched);
+    report = untouched;
+
+    assert_error(sh_body_cut(world, body, NULL, 2, &report), SH_ERR_INVALID_ARGUMENT, "triangles");
+    assert_error(sh_body_cut(world, body, NULL, 2, NULL), SH_ERR_INVALID_ARGUMENT, "triangles");
+    assert_error(sh_body_cut(world, body, blade, 0, &report), SH_ERR_INVALID_ARGUMENT, "triangle_count");
+    assert_error(sh_body_cut(world, body, blade, -3, NULL), SH_ERR_INVALID_ARGUMENT, "triangle_count");
+    assert_error(sh_body_cut(world, body, blade, INT32_MIN, &report), SH_ERR_INVALID_ARGUMENT, "triangle_count");
+    assert_error(sh_body_cut(world, body, nan_blade, 2, &report), SH_ERR_INVALID_ARGUMENT, "triangles[1]");
+    assert_error(sh_body_cut(world, body, flat_blade, 2, &report), SH_ERR_INVALID_ARGUMENT, "triangles[0]");
+    assert_error(sh_body_cut(NULL, body, blade, 2, &report), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_cut(world, stale, blade, 2, &report), SH_ERR_INVALID_HANDLE, "body");
+    assert_error(sh_body_cut(world, (sh_body_id)SH_NULL_ID, blade, 2, &report), SH_ERR_INVALID_HANDLE, "body");
+    /* A stale id is reported before the other arguments are looked at. */
+    assert_error(sh_body_cut(world, stale, NULL, 0, &report), SH_ERR_INVALID_HANDLE, "body");
+    /* A failed cut writes no report and changes nothing. */
+    assert_memory_equal(&report, &untouched, sizeof report);
+    assert_uncut(world, body, mesh_info.node_count, mesh_info.tet_count);
+
+    /* The same blade, valid: out_report may be NULL, and the body is cut. */
+    assert_ok(sh_body_cut(world, body, blade, 2, NULL));
+    assert_no_error_message();
+    sh_body_info info;
+    assert_ok(sh_body_get_info(world, body, &info));
+    assert_true(info.topology_version > 0);
+    assert_true(info.node_count > mesh_info.node_count);
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_destroy(world));
+}
+
+typedef sh_status (*topology_getter)(const sh_world*, sh_body_id, int32_t*, int32_t);
+
+/* Asserts get refuses NULL and the capacities -1, 0 and items - 1 (SH_ERR_INVALID_ARGUMENT
+ * naming the capacity, nothing written), and copies items x per values into room for more,
+ * writing nothing past them; leaves the copy in out. */
+static void check_topology_getter(topology_getter get, const char* name, const sh_world* world, sh_body_id body,
+                                  int32_t items, int per, int32_t* out, size_t out_count) {
+    int32_t* sentinel = malloc(out_count * sizeof(int32_t));
+    assert_non_null(sentinel);
+    for (size_t i = 0; i < out_count; ++i) sentinel[i] = -777;
+    assert_true((size_t)(items + 1) * (size_t)per <= out_count);
+    assert_error(get(world, body, NULL, items), SH_ERR_INVALID_ARGUMENT, name);
+    const int32_t too_small[] = {-1, 0, items - 1};
+    for (size_t k = 0; k < sizeof too_small / sizeof too_small[0]; ++k) {
+        memcpy(out, sentinel, out_count * sizeof(int32_t));
+        assert_error(get(world, body, out, too_small[k]), SH_ERR_INVALID_ARGUMENT, "capacity");
+        assert_memory_equal(out, sentinel, out_count * sizeof(int32_t));
+    }
+    memcpy(out, sentinel, out_count * sizeof(int32_t));
+    assert_ok(get(world, body, out, items + 1)); /* larger than needed is fine */
+    assert_memory_equal(out + (size_t)items * (size_t)per, sentinel,
+                        (out_count - (size_t)items * (size_t)per) * sizeof(int32_t));
+    free(sentinel);
+}
+
+static void test_topology_getters_check_capacity_and_kind(void** state) {
+    const moved_box* s = *state;
+    sh_test_mesh_arrays mesh = sh_test_mesh_arrays_of(s->mesh);
+    const sh_mesh_info mesh_info = sh_test_mesh_info(s->mesh);
+    enum { ROOM = 256 };
+    int32_t out[ROOM];
+
+    sh_body_info info;
+    assert_ok(sh_body_get_info(s->world, s->body, &info));
+    assert_int_equal(info.surface_triangle_count, mesh_info.surface_triangle_count);
+    assert_int_equal(info.topology_version, 0);
+    assert_int_equal(info.reserved, 0);
+    check_topology_getter(sh_body_get_tets, "out_tets", s->world, s->body, info.element_count, 4, out, ROOM);
+    assert_memory_equal(out, mesh.tets, sizeof(int32_t) * 4 * (size_t)mesh_info.tet_count);
+    check_topology_getter(sh_body_get_surface_triangles, "out_triangles", s->world, s->body,
+                          info.surface_triangle_count, 3, out, ROOM);
+    assert_memory_equal(out, mesh.triangles, sizeof(int32_t) * 3 * (size_t)mesh_info.surface_triangle_count);
+    check_topology_getter(sh_body_get_node_parents, "out_parents", s->world, s->body, info.node_count, 1, out, ROOM);
+    for (int32_t i = 0; i < info.node_count; ++i) assert_int_equal(out[i], -1);
+
+    sh_body_info spring_info;
+    assert_ok(sh_body_get_info(s->world, s->spring, &spring_info));
+    assert_int_equal(spring_info.surface_triangle_count, 0);
+    assert_int_equal(spring_info.topology_version, 0);
+    check_topology_getter(sh_body_get_springs, "out_springs", s->world, s->spring, spring_info.element_count, 2, out, ROOM);
+    assert_int_equal(out[0], 0);
+    assert_int_equal(out[1], 1);
+    check_topology_getter(sh_body_get_node_parents, "out_parents", s->world, s->spring, 2, 1, out, ROOM);
+    assert_int_equal(out[0], -1);
+    assert_int_equal(out[1], -1);
+
+    /* The wrong kind of body, whatever the capacity: the message names the kind. */
+    assert_error(sh_body_get_tets(s->world, s->spring, out, ROOM / 4), SH_ERR_UNSUPPORTED, "mass-spring");
+    assert_error(sh_body_get_surface_triangles(s->world, s->spring, out, ROOM / 3), SH_ERR_UNSUPPORTED, "mass-spring");
+    assert_error(sh_body_get_springs(s->world, s->body, out, ROOM / 2), SH_ERR_UNSUPPORTED, "FEM");
+    assert_error(sh_body_get_tets(s->world, s->spring, NULL, 0), SH_ERR_UNSUPPORTED, "sh_body_get_tets");
+
+    /* Handles and ids. */
+    assert_error(sh_body_get_tets(NULL, s->body, out, ROOM / 4), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_get_springs(NULL, s->spring, out, ROOM / 2), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_get_surface_triangles(NULL, s->body, out, ROOM / 3), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_get_node_parents(NULL, s->body, out, ROOM), SH_ERR_INVALID_HANDLE, "world");
+    assert_error(sh_body_get_node_parents(s->world, (sh_body_id)SH_NULL_ID, out, ROOM), SH_ERR_INVALID_HANDLE, "body");
+    sh_test_mesh_arrays_free(&mesh);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_version_matches_header),
@@ -1310,6 +1440,9 @@ int main(void) {
         cmocka_unit_test(test_failed_calls_leave_state_intact),
         cmocka_unit_test(test_mesh_create_misuse),
         cmocka_unit_test(test_write_vtu_to_unwritable_path),
+        cmocka_unit_test(test_cut_rejects_bad_arguments),
+        cmocka_unit_test_setup_teardown(test_topology_getters_check_capacity_and_kind, setup_moved_box_and_spring,
+                                        teardown_moved_box),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -72,6 +72,8 @@ SH_API sh_status sh_body_get_info(const sh_world* world, sh_body_id body, sh_bod
             info.total_mass += b.mass[static_cast<size_t>(i)];
         }
         info.dt_critical = critical_step(b, capi::world_of(world).step_settings(body.value).integrator);
+        info.surface_triangle_count = static_cast<int32_t>(b.surface_triangles.size() / 3);
+        info.topology_version = b.topology_version;
         *out_info = info;
     });
 }

@@ -120,10 +120,10 @@ struct Separation {
                contains(cut.cut_nodes, original(f[2]));
     }
 
-    // Cut faces along an edge that would join more than two surface faces are glued back; true
-    // if any was. (Every face with a node on the cut lies between tets at the cut, so the
-    // surface faces there are those named once among them.)
-    bool glue_pinched_edges() {
+    // The surface faces among the tets at the cut that have a node on the cut, by renumbered
+    // nodes. (Every face with a node on the cut lies between tets at the cut, so the surface
+    // faces there are those named once among them.)
+    vec<Face> surface_at_cut() const {
         vec<Face> faces;
         for (size_t k = 0; k < cut.at_cut.size(); ++k)
             for (int f = 0; f < 4; ++f) {
@@ -131,29 +131,74 @@ struct Separation {
                 if (touches_cut(face)) faces.push_back(face);
             }
         std::sort(faces.begin(), faces.end());
-        vec<std::array<int32_t, 2>> edges;  // surface edges there, by renumbered nodes
+        vec<Face> surface;
         for (size_t i = 0; i < faces.size(); ++i) {
             const bool shared = (i + 1 < faces.size() && faces[i + 1] == faces[i]) || (i > 0 && faces[i - 1] == faces[i]);
-            if (shared) continue;
-            const Face& f = faces[i];
-            edges.push_back({f[0], f[1]}), edges.push_back({f[0], f[2]}), edges.push_back({f[1], f[2]});
+            if (!shared) surface.push_back(faces[i]);
         }
+        return surface;
+    }
+
+    // Surface edges (renumbered) on more than two surface faces, as edges of original nodes.
+    vec<std::array<int32_t, 2>> pinched_edges(const vec<Face>& surface) const {
+        vec<std::array<int32_t, 2>> edges, pinched;
+        for (const Face& f : surface) edges.push_back({f[0], f[1]}), edges.push_back({f[0], f[2]}), edges.push_back({f[1], f[2]});
         std::sort(edges.begin(), edges.end());
-        vec<std::array<int32_t, 2>> pinched;
         for (size_t i = 0; i + 2 < edges.size(); ++i)
             if (edges[i] == edges[i + 2]) {
                 std::array<int32_t, 2> e{original(edges[i][0]), original(edges[i][1])};
                 std::sort(e.begin(), e.end());
                 pinched.push_back(e);
             }
-        if (pinched.empty()) return false;
-        const auto on_pinched = [&](const Face& f) {
-            for (const auto& e : pinched)
+        return pinched;
+    }
+
+    // Surface nodes (renumbered) on the cut whose surface faces form more than one fan, as
+    // original nodes.
+    vec<int32_t> pinched_nodes(const vec<Face>& surface) const {
+        vec<std::pair<int32_t, std::array<int32_t, 2>>> links;  // (node, the opposite edge of a face on it)
+        for (const Face& f : surface)
+            for (int k = 0; k < 3; ++k) links.push_back({f[k], {f[(k + 1) % 3], f[(k + 2) % 3]}});
+        std::sort(links.begin(), links.end());
+        vec<int32_t> pinched, ends, parent;
+        for (size_t begin = 0; begin < links.size();) {
+            size_t end = begin + 1;
+            while (end < links.size() && links[end].first == links[begin].first) ++end;
+            ends.clear();
+            for (size_t i = begin; i < end; ++i) ends.push_back(links[i].second[0]), ends.push_back(links[i].second[1]);
+            std::sort(ends.begin(), ends.end());
+            ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+            parent.resize(ends.size());
+            std::iota(parent.begin(), parent.end(), 0);
+            const auto slot = [&](int32_t n) { return static_cast<int32_t>(std::lower_bound(ends.begin(), ends.end(), n) - ends.begin()); };
+            for (size_t i = begin; i < end; ++i)
+                parent[static_cast<size_t>(root(parent, slot(links[i].second[0])))] = root(parent, slot(links[i].second[1]));
+            int32_t fans = 0;
+            for (size_t i = 0; i < ends.size(); ++i) fans += root(parent, static_cast<int32_t>(i)) == static_cast<int32_t>(i) ? 1 : 0;
+            if (fans > 1 && contains(cut.cut_nodes, original(links[begin].first))) pinched.push_back(original(links[begin].first));
+            begin = end;
+        }
+        return pinched;
+    }
+
+    // Cut faces along an edge that would join more than two surface faces, or at a node whose
+    // surface would be two fans touching at a point, are glued back; true if any was.
+    bool glue_pinches() {
+        const vec<Face> surface = surface_at_cut();
+        const vec<std::array<int32_t, 2>> edges = pinched_edges(surface);
+        vec<int32_t> nodes = pinched_nodes(surface);
+        if (edges.empty() && nodes.empty()) return false;
+        std::sort(nodes.begin(), nodes.end());
+        const size_t before = cut_faces.size();
+        const auto pinched = [&](const Face& f) {
+            for (const int32_t n : f)
+                if (std::binary_search(nodes.begin(), nodes.end(), n)) return true;
+            for (const auto& e : edges)
                 if (std::count(f.begin(), f.end(), e[0]) && std::count(f.begin(), f.end(), e[1])) return true;
             return false;
         };
-        cut_faces.erase(std::remove_if(cut_faces.begin(), cut_faces.end(), on_pinched), cut_faces.end());
-        return true;
+        cut_faces.erase(std::remove_if(cut_faces.begin(), cut_faces.end(), pinched), cut_faces.end());
+        return cut_faces.size() < before;  // a pinch no cut face made stays as it came
     }
 
     // Cut faces whose two tets no longer name the same three nodes.
@@ -180,7 +225,7 @@ int32_t separate(TetCut& cut, int32_t node_count) {
     s.build_star();
     s.find_cut_faces();
     do s.split_stars();
-    while (s.glue_pinched_edges());
+    while (s.glue_pinches());
     const int32_t parted = s.parted_faces();
     for (size_t k = 0; k < cut.at_cut.size(); ++k)
         std::copy(&s.renumbered[4 * k], &s.renumbered[4 * k] + 4, &cut.tets[4 * static_cast<size_t>(cut.at_cut[k])]);

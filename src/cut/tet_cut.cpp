@@ -11,8 +11,8 @@
 namespace sh {
 namespace {
 
-// Pieces below this quality, or with a critical step below kStepRatio times the body's, are
-// avoided by cutting through a node instead.
+// Pieces below this quality, or with a critical step below kStepRatio times the uncut body's,
+// are avoided by cutting through a node instead.
 constexpr double kMinQuality = 0.05;
 constexpr double kStepRatio = 0.3;
 
@@ -86,9 +86,7 @@ size_t TetCut::node_slot(int32_t node) const {
 }
 
 void TetCut::settle(const FemBody& body) {
-    double largest_omega2 = 0.0;
-    for (int32_t t = 0; t < body.element_count(); ++t)
-        largest_omega2 = std::max(largest_omega2, body.element_frequency_squared(static_cast<size_t>(t)));
+    const double largest_omega2 = body.reference_frequency_squared();
     // Each round either settles or moves one more crossing onto a node: it ends.
     for (;;) {
         mark_cut_edges();

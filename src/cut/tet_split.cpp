@@ -45,7 +45,13 @@ Polygon cut_polygon(const TetCrossing& crossing) {
             const int e = edge_of(a, b);
             if (crossing.cut[e] && count < 3) ends[count++] = 4 + e;
         }
-        if (count == 2) segment[segments][0] = ends[0], segment[segments][1] = ends[1], ++segments;
+        if (count != 2) continue;
+        // Two faces through an edge on the surface give that edge twice.
+        bool known = false;
+        for (int k = 0; k < segments; ++k)
+            known = known || (std::min(segment[k][0], segment[k][1]) == std::min(ends[0], ends[1]) &&
+                              std::max(segment[k][0], segment[k][1]) == std::max(ends[0], ends[1]));
+        if (!known) segment[segments][0] = ends[0], segment[segments][1] = ends[1], ++segments;
     }
     Polygon polygon;
     if (segments < 3) return polygon;

@@ -162,6 +162,7 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
         ++topology_version;
     }
     stable_step_ = stable_step_at(largest);
+    if (!grown) reference_omega2_ = largest;
     tets_.swap(set.tets);
     inverse_rest_.swap(set.inverse_rest);
     volume_.swap(set.volume);

@@ -33,6 +33,11 @@ public:
     /// largest of them.
     double element_frequency_squared(size_t t) const { return element_omega2_[t]; }
 
+    /// The largest element_frequency_squared when the body's materials were last set (at
+    /// creation or by set_material): cuts keep every piece's frequency within a bound of it, so
+    /// that the critical step never falls far below the uncut body's however often it is cut.
+    double reference_frequency_squared() const { return reference_omega2_; }
+
     /// Squared largest frequency (1/s^2) that a tet of rest inverse shape bm (9, row-major),
     /// rest volume v0 and material would have.
     static double element_max_frequency_squared(const double* bm, double v0, const sh_material& material);
@@ -96,6 +101,7 @@ private:
     vec<TetBlock> blocks_[SH_MATERIAL_COUNT];  ///< per sh_material_model
     double damping_stiffness_;
     double stable_step_ = 0.0;   ///< 2/omega_max at rest, with stiffness damping
+    double reference_omega2_ = 0.0;  ///< see reference_frequency_squared
     vec<double> element_omega2_; ///< per tet: its largest squared frequency (Irons-Treharne)
     mutable int32_t inverted_elements_ = 0;  ///< most elements with det F <= 0 at one evaluation
 };

@@ -78,7 +78,8 @@ def test_sizes_computed_by_hand():
     assert ctypes.sizeof(_lib.sh_fem_body_def) == 128  # 80 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_spring_params) == 72
     assert ctypes.sizeof(_lib.sh_spring_body_def) == 208  # 160 + sh_implicit_settings
-    assert ctypes.sizeof(_lib.sh_body_info) == 32
+    assert ctypes.sizeof(_lib.sh_body_info) == 48  # 4 int32, 2 doubles, 2 int32, uint64
+    assert ctypes.sizeof(_lib.sh_cut_report) == 40  # 4 int32, 2 doubles, 2 int32
     assert ctypes.sizeof(_lib.sh_implicit_settings) == 48  # i32 x2, 2 doubles, i32, pad 4, double, i32, pad 4
     assert ctypes.sizeof(_lib.sh_static_def) == 32
     assert ctypes.sizeof(_lib.sh_static_report) == 16 + 8 + 64 * 8 + 8

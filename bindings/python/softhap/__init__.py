@@ -23,7 +23,7 @@ from ._errors import Error, status_name
 from ._lib import SH_VERSION, FeatureKind, HapticFault, Status, WarningKind, version_string
 from ._loaded import lib as _c_library
 from ._loaded import status_string
-from ._record import BodyInfo, MeshInfo, StaticReport, StepReport
+from ._record import BodyInfo, CutReport, MeshInfo, StaticReport, StepReport
 from .contact import ContactState, Obstacle, Tool
 from .haptic import Haptic, HapticResult
 from .mesh import Mesh
@@ -53,6 +53,7 @@ __all__ = [
     "Body",
     "BodyInfo",
     "ContactState",
+    "CutReport",
     "Error",
     "FeatureKind",
     "Haptic",

@@ -308,6 +308,24 @@ class sh_body_info(Structure):
         ("fixed_node_count", c_int32),
         ("total_mass", c_double),
         ("dt_critical", c_double),
+        ("surface_triangle_count", c_int32),
+        ("reserved", c_int32),
+        ("topology_version", c_uint64),
+    ]
+
+
+class sh_cut_report(Structure):
+    """Mirror of struct sh_cut_report."""
+
+    _fields_ = [
+        ("faces_separated", c_int32),
+        ("nodes_added", c_int32),
+        ("tets_added", c_int32),
+        ("nodes_moved", c_int32),
+        ("min_quality", c_double),
+        ("seconds", c_double),
+        ("springs_cut", c_int32),
+        ("reserved", c_int32),
     ]
 
 
@@ -445,6 +463,7 @@ STRUCTS = {
     "sh_spring_params": sh_spring_params,
     "sh_spring_body_def": sh_spring_body_def,
     "sh_body_info": sh_body_info,
+    "sh_cut_report": sh_cut_report,
     "sh_implicit_settings": sh_implicit_settings,
     "sh_static_def": sh_static_def,
     "sh_static_report": sh_static_report,
@@ -517,6 +536,12 @@ PROTOTYPES = {
     "sh_body_get_elastic_forces": (_status, [_handle, sh_body_id, _pd, c_int32]),
     "sh_body_get_elastic_energy": (_status, [_handle, sh_body_id, _pd]),
     "sh_body_write_vtu": (_status, [_handle, sh_body_id, c_char_p]),
+    # cutting and topology
+    "sh_body_cut": (_status, [_handle, sh_body_id, _pd, c_int32, POINTER(sh_cut_report)]),
+    "sh_body_get_tets": (_status, [_handle, sh_body_id, _pi, c_int32]),
+    "sh_body_get_springs": (_status, [_handle, sh_body_id, _pi, c_int32]),
+    "sh_body_get_surface_triangles": (_status, [_handle, sh_body_id, _pi, c_int32]),
+    "sh_body_get_node_parents": (_status, [_handle, sh_body_id, _pi, c_int32]),
     # tools, obstacles and contact
     "sh_contact_params_default": (None, [POINTER(sh_contact_params)]),
     "sh_collider_def_default": (None, [POINTER(sh_collider_def)]),

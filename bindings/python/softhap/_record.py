@@ -51,7 +51,18 @@ class MeshInfo(Record):
 
 class BodyInfo(Record):
     """Facts about a body (sh_body_info): node_count, element_count (tets or springs), is_fem
-    (bool), fixed_node_count, total_mass (kg) and dt_critical (s; inf if none)."""
+    (bool), fixed_node_count, total_mass (kg), dt_critical (s; inf if none),
+    surface_triangle_count (FEM boundary triangles; 0 for mass-spring bodies), reserved (0) and
+    topology_version (0 at creation; increases at every topology change, such as a cut)."""
+
+
+class CutReport(Record):
+    """What one Body.cut did (sh_cut_report): faces_separated (tet faces that became surface,
+    once per pair that parted), nodes_added (points made on cut edges and node copies),
+    tets_added (tets after minus tets before), nodes_moved (existing nodes moved onto the cut
+    surface), min_quality (lowest shape quality 6 sqrt(2) V / l_rms^3 of the tets the cut made:
+    1 regular, 0 flat; 1 if it made none), seconds (wall time of the cut, s), springs_cut
+    (mass-spring bodies: springs the surface crossed, removed) and reserved (0)."""
 
 
 class StepReport(Record):

@@ -1,4 +1,5 @@
-"""softhap.Body: a body of a World (an sh_body_id), its node data, boundary conditions and loads."""
+"""softhap.Body: a body of a World (an sh_body_id), its node data, topology and cuts, boundary
+conditions and loads."""
 
 from __future__ import annotations
 
@@ -11,9 +12,24 @@ from numpy.typing import ArrayLike
 
 from . import _arrays, _defs
 from ._entity import WorldEntity
-from ._lib import sh_body_id, sh_body_info
+from ._errors import Error
+from ._lib import Status, sh_body_id, sh_body_info, sh_cut_report
 from ._loaded import check, lib
-from ._record import BodyInfo, record_of
+from ._record import BodyInfo, CutReport, record_of
+
+
+def cut_triangles(value: ArrayLike) -> np.ndarray:
+    """value (k triangles, as a (k, 3, 3) or (k, 9) array-like of floats) as a C-contiguous
+    (k, 9) float64 array, three corners per row; any other shape is a ValueError."""
+    try:
+        array = np.ascontiguousarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError("triangles must be an array of numbers: %s" % exc) from None
+    if array.ndim == 3 and array.shape[1:] == (3, 3) or array.ndim == 2 and array.shape[1] == 9:
+        return np.ascontiguousarray(array.reshape(array.shape[0], 9))
+    raise ValueError(
+        "triangles must have shape (k, 3, 3) or (k, 9), got %s" % (tuple(array.shape),)
+    )
 
 
 def body_id_in(world: object, body: Body, name: str) -> sh_body_id:
@@ -44,7 +60,8 @@ class Body(WorldEntity):
     @property
     def info(self) -> BodyInfo:
         """Facts about the body as a BodyInfo (dict with attribute access): node_count,
-        element_count, is_fem, fixed_node_count, total_mass (kg), dt_critical (s)."""
+        element_count, is_fem, fixed_node_count, total_mass (kg), dt_critical (s),
+        surface_triangle_count, reserved and topology_version."""
         handle = self._world_handle("sh_body_get_info")
         raw = sh_body_info()
         check(lib.sh_body_get_info(handle, self._cid, ctypes.byref(raw)), "sh_body_get_info")
@@ -52,8 +69,26 @@ class Body(WorldEntity):
 
     @property
     def node_count(self) -> int:
-        """Number of nodes (including orphans)."""
+        """Number of nodes (including orphans); a cut appends nodes, so this can grow."""
         return self.info["node_count"]
+
+    @property
+    def tet_count(self) -> int:
+        """Number of tets of an FEM body (its element count), after any cuts. A mass-spring
+        body raises softhap.Error (SH_ERR_UNSUPPORTED), as Body.tets does."""
+        info = self.info
+        if not info["is_fem"]:
+            raise Error(
+                Status.SH_ERR_UNSUPPORTED,
+                "tet_count needs an FEM body; this is a mass-spring body (see info.element_count)",
+            )
+        return info["element_count"]
+
+    @property
+    def topology_version(self) -> int:
+        """0 at creation; increases at every topology change (a cut). When it moves, arrays
+        read before (tets, springs, surface_triangles, node_parents, positions) are stale."""
+        return int(self.info["topology_version"])
 
     @property
     def critical_dt(self) -> float:
@@ -121,6 +156,77 @@ class Body(WorldEntity):
             "sh_body_get_elastic_energy",
         )
         return energy.value
+
+    # -- topology and cutting ---------------------------------------------------------------
+
+    def _int_table(self, function_name: str, rows: int, columns: int) -> np.ndarray:
+        handle = self._world_handle(function_name)
+        out = np.empty((rows, columns) if columns else (rows,), dtype=np.int32)
+        check(
+            getattr(lib, function_name)(handle, self._cid, _arrays.int32_ptr(out), rows),
+            function_name,
+        )
+        return out
+
+    @property
+    def tets(self) -> np.ndarray:
+        """A copy of the FEM body's tets in the current topology, an (m, 4) int32 array of node
+        indices (positively oriented). A mass-spring body raises softhap.Error
+        (SH_ERR_UNSUPPORTED)."""
+        info = self.info  # sizes are read at every call: a cut changes them
+        rows = info["element_count"] if info["is_fem"] else 0  # a spring body: C refuses it
+        return self._int_table("sh_body_get_tets", rows, 4)
+
+    @property
+    def springs(self) -> np.ndarray:
+        """A copy of the mass-spring body's springs, an (s, 2) int32 array of node indices. An
+        FEM body raises softhap.Error (SH_ERR_UNSUPPORTED)."""
+        info = self.info
+        rows = 0 if info["is_fem"] else info["element_count"]  # an FEM body: C refuses it
+        return self._int_table("sh_body_get_springs", rows, 2)
+
+    @property
+    def surface_triangles(self) -> np.ndarray:
+        """A copy of the FEM body's boundary triangles in the current topology (cut faces
+        included), a (k, 3) int32 array, counter-clockwise seen from outside. A mass-spring body
+        raises softhap.Error (SH_ERR_UNSUPPORTED)."""
+        rows = self.info["surface_triangle_count"]
+        return self._int_table("sh_body_get_surface_triangles", rows, 3)
+
+    @property
+    def node_parents(self) -> np.ndarray:
+        """A copy of each node's parent, an (n,) int32 array: the node a cut made it from (a
+        copy's parent is the node copied; a node made on a cut edge has the edge's nearer end),
+        -1 for the body's own nodes."""
+        return self._int_table("sh_body_get_node_parents", self.node_count, 0)
+
+    def cut(self, triangles: ArrayLike) -> CutReport:
+        """Cut the body along a triangulated surface (sh_body_cut) and return a CutReport.
+
+        triangles is a (k, 3, 3) or (k, 9) array-like of floats: k >= 1 triangles, three
+        corners each, world frame (m), in the body's current configuration; they need not be
+        welded or consistently oriented. The material the surface passes through separates
+        (FEM bodies split the tets it crosses, mass-spring bodies lose the springs it crosses);
+        where the surface's border lies inside the body, it stays joined. topology_version
+        increases if anything was cut; node indices never change, new nodes are appended.
+
+        A wrong shape raises ValueError; non-finite coordinates, a zero-area triangle or k = 0
+        raise softhap.Error (SH_ERR_INVALID_ARGUMENT), and the body is left as it was.
+        """
+        handle = self._world_handle("sh_body_cut")
+        array = cut_triangles(triangles)
+        raw = sh_cut_report()
+        check(
+            lib.sh_body_cut(
+                handle,
+                self._cid,
+                _arrays.double_ptr(array),
+                _arrays.count(array.shape[0], "triangle count"),
+                ctypes.byref(raw),
+            ),
+            "sh_body_cut",
+        )
+        return record_of(CutReport, raw)
 
     # -- boundary conditions and loads ------------------------------------------------------
 

@@ -309,6 +309,8 @@ typedef struct sh_step_report {
     double collision_seconds;    /**< time in collision detection and contact forces (s) */
     int32_t contact_substeps;    /**< sub-steps taken so that no tool moves more than half
                                       its inner radius per sub-step (1 = none) */
+    int32_t cut_faces;           /**< faces that cutting tools separated in this step */
+    double topology_seconds;     /**< time in cuts and topology updates in this step (s) */
 } sh_step_report;
 
 /** Advance every body by dt seconds with its own integrator. A body whose step is rejected
@@ -652,6 +654,34 @@ typedef struct sh_cut_report {
  *  Alloc: may. */
 SH_API sh_status sh_body_cut(sh_world* world, sh_body_id body, const double* triangles,
                              int32_t triangle_count, sh_cut_report* out_report);
+
+/** When a cutting tool breaks the material its blade reaches. */
+typedef enum sh_cut_criterion {
+    SH_CUT_GEOMETRIC = 0,  /**< the blade separates whatever its edge sweeps through */
+    SH_CUT_CRITERION_COUNT = 1 /**< number of criteria, not a criterion */
+} sh_cut_criterion;
+
+/** How a tool cuts. */
+typedef struct sh_cut_def {
+    uint32_t internal_init;      /**< set by sh_cut_def_default; do not touch */
+    sh_cut_criterion criterion;  /**< default SH_CUT_GEOMETRIC */
+    double edge[2][3];           /**< the blade's cutting edge: two points in the tool's local
+                                      frame (m), distinct; default (0, 0, -5 mm) to (0, 0, 5 mm) */
+    double sharpness;            /**< blade sharpness kappa (dimensionless, > 0; 1 = a scalpel),
+                                      for criteria that weigh it; default 1 */
+} sh_cut_def;
+
+/** Fill a cut def with defaults. Thread: any. Alloc: none. */
+SH_API void sh_cut_def_default(sh_cut_def* def);
+
+/** Make tool a cutting tool with def, or an ordinary one again with NULL. At every
+ *  sh_world_step, before the bodies move, the surface the blade edge sweeps from the tool's
+ *  last pose to its new pose cuts every body it passes through (as sh_body_cut would), so a
+ *  blade that has entered the material separates it as it advances, and a cut continues from
+ *  where the last step's ended. The tool's shape still touches the material through contact.
+ *  A def not from sh_cut_def_default, coincident edge points or non-finite values are
+ *  SH_ERR_INVALID_ARGUMENT. Thread: sim. Alloc: may. */
+SH_API sh_status sh_tool_set_cutting(sh_world* world, sh_tool_id tool, const sh_cut_def* def);
 
 /** Copy the FEM body's tets (element_count x 4 node indices, positively oriented) into
  *  out_tets, which has room for capacity tets. SH_ERR_UNSUPPORTED for a mass-spring body.

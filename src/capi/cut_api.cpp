@@ -3,6 +3,7 @@
 #include "capi/guard.hpp"
 #include "capi/world_handle.hpp"
 #include "cut/body_cut.hpp"
+#include "cut/tool_cutting.hpp"
 #include "model/body.hpp"
 
 #include <algorithm>
@@ -89,3 +90,21 @@ SH_API sh_status sh_body_get_node_parents(const sh_world* world, sh_body_id body
 }
 
 }  // extern "C"
+
+SH_API void sh_cut_def_default(sh_cut_def* def) {
+    if (!def) return;
+    *def = sh_cut_def{};
+    def->internal_init = capi::kDefInitialised;
+    def->criterion = SH_CUT_GEOMETRIC;
+    def->edge[0][2] = -0.005;
+    def->edge[1][2] = 0.005;
+    def->sharpness = 1.0;
+}
+
+SH_API sh_status sh_tool_set_cutting(sh_world* world, sh_tool_id tool, const sh_cut_def* def) {
+    return capi::guard([&] {
+        World& w = capi::world_of(world);
+        if (def) capi::require_initialised(def, "def");
+        set_tool_cutting(w, tool.value, def);
+    });
+}

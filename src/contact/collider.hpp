@@ -30,6 +30,8 @@ struct Collider {
     bool velocity_given = false;  ///< the host gave the next step's velocity
     double given_velocity[3] = {}, given_angular[3] = {};
     sh_contact_state state{};  ///< reaction and measures after the last step
+    bool cuts = false;         ///< a cutting tool (sh_tool_set_cutting)
+    sh_cut_def cutting{};      ///< how it cuts, when cuts
 
     /// Velocity (m/s) of the collider's material point at world point q.
     void point_velocity(const double q[3], double out[3]) const {

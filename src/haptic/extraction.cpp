@@ -84,7 +84,7 @@ void deepest_contact(const Collider& tool, NearestSurface& near) {
 }  // namespace
 
 void HapticContext::ensure_adjacency(const FemBody& body, Id id) {
-    if (adjacency_body_ == id && adjacency_tets_ == body.element_count()) return;
+    if (adjacency_body_ == id && adjacency_version_ == body.topology_version) return;
     const size_t n = static_cast<size_t>(body.node_count()), tets = static_cast<size_t>(body.element_count());
     const int32_t* nodes = body.element_nodes();
     node_tet_begin_.assign(n + 1, 0);
@@ -96,7 +96,7 @@ void HapticContext::ensure_adjacency(const FemBody& body, Id id) {
     local_of_.assign(n, -1);
     in_buffer_.assign(tets, 0);
     adjacency_body_ = id;
-    adjacency_tets_ = body.element_count();
+    adjacency_version_ = body.topology_version;
 }
 
 void HapticContext::select_tets(const FemBody& body, const double center[3], int32_t seed_triangle, Buffer& out) {

@@ -144,6 +144,17 @@ void HapticContext::after_step(World& world, double dt) {
     buffer_index_.publish();
 }
 
+void HapticContext::topology_changed(World& world, Id id) noexcept {
+    if (id != extracted_body_) return;
+    x_before_body_ = 0;
+    try {
+        extract(world, 0.0, buffers_[buffer_index_.back()]);
+        buffer_index_.publish();
+    } catch (...) {
+        // Out of memory on the sim side: the device keeps the last buffer until the next step.
+    }
+}
+
 void HapticContext::read_warnings(uint64_t out[SH_WARN_COUNT]) const {
     for (int k = 0; k < SH_WARN_COUNT; ++k) out[k] = warnings_[k].load(std::memory_order_relaxed);
 }

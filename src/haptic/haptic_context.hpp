@@ -47,6 +47,9 @@ public:
 
     /// Cuts a new buffer from the full model after a step of dt (s) and publishes it.
     void after_step(World& world, double dt) override;
+    /// A cut of the buffer's body: drops what follows its old topology and cuts a new buffer
+    /// at once, so that the device feels the cut before the next full step.
+    void topology_changed(World& world, Id id) noexcept override;
 
     /// The world is gone: from now on the haptic step reports SH_HAPTIC_FAULT_NO_TOOL.
     void detach() override;
@@ -131,7 +134,7 @@ private:
     // sim side (may allocate)
     Id extracted_body_ = kNullId;  ///< the body of the last extraction
     Id adjacency_body_ = kNullId;
-    int32_t adjacency_tets_ = -1;
+    uint64_t adjacency_version_ = 0;  ///< the body's topology_version the adjacency is for
     vec<int32_t> node_tet_begin_, node_tet_;  ///< per body node: its tets (CSR)
     vec<double> x_before_;                     ///< the buffer body's x before the step
     Id x_before_body_ = kNullId;

@@ -4,6 +4,8 @@
 
 #include "core/id_pool.hpp"
 
+#include <softhap/softhap.h>
+
 namespace sh {
 
 class World;
@@ -15,6 +17,13 @@ public:
 
     /// Before a step or a static solve, on the sim thread (e.g. take the newest device pose).
     virtual void before_step(World& world) = 0;
+
+    /// In a step, after every hook's before_step and before anything moves: changes to the
+    /// scene that the step's motion must see (cutting), counted in report.
+    virtual void before_motion(World& world, sh_step_report& report) {
+        (void)world;
+        (void)report;
+    }
 
     /// After a step of dt (s), or after a static solve with dt = 0 (no motion to follow).
     virtual void after_step(World& world, double dt) = 0;

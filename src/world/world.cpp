@@ -27,6 +27,7 @@ World::World(const sh_world_def& def) : error_estimate_(def.error_estimate != 0)
 
 World::~World() {
     for (StepHook* hook : hooks_) hook->detach();
+    for (auto& owned : owned_hooks_) sh::destroy(owned.second);
     slots_.for_each([&](Slot& slot) { destroy_slot(slot); });
     colliders_.for_each([](Collider* c) { sh::destroy(c); });
     sh::destroy(islands_);
@@ -181,6 +182,19 @@ const BodyContacts* World::contacts_of(Id id) const {
 
 void World::add_hook(StepHook* hook) { hooks_.push_back(hook); }
 
+void World::own_hook(StepHook* hook, const void* key) {
+    owned_hooks_.reserve(owned_hooks_.size() + 1);
+    hooks_.reserve(hooks_.size() + 1);
+    owned_hooks_.push_back({key, hook});
+    hooks_.push_back(hook);
+}
+
+StepHook* World::owned_hook(const void* key) const {
+    for (const auto& owned : owned_hooks_)
+        if (owned.first == key) return owned.second;
+    return nullptr;
+}
+
 void World::remove_hook(StepHook* hook) { hooks_.erase(std::remove(hooks_.begin(), hooks_.end(), hook), hooks_.end()); }
 
 void World::step_bodies(double h, sh_step_report& r, vec<uint8_t>& skip) {
@@ -299,6 +313,7 @@ void World::step(double dt, sh_step_report* report) {
     r.error_estimate = error_estimate_ ? 0.0 : -1.0;
     r.dt_critical = INFINITY;
     for (StepHook* hook : hooks_) hook->before_step(*this);
+    for (StepHook* hook : hooks_) hook->before_motion(*this, r);
     r.contact_substeps = begin_colliders(dt);
     try {
         run_attempts(dt, r);

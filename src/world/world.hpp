@@ -12,6 +12,7 @@
 #include <softhap/softhap.h>
 
 #include <cstdint>
+#include <utility>
 
 namespace sh {
 
@@ -107,6 +108,13 @@ public:
     /// Unregisters a step hook.
     void remove_hook(StepHook* hook);
 
+    /// Registers hook (made with sh::create) and owns it: it is destroyed with the world. key
+    /// names it for owned_hook (one hook per key).
+    void own_hook(StepHook* hook, const void* key);
+
+    /// The hook owned under key, or null.
+    StepHook* owned_hook(const void* key) const;
+
     /// The contact state of body id after the last step, or null if it has none yet.
     const BodyContacts* contacts_of(Id id) const;
 
@@ -115,6 +123,13 @@ public:
     void for_each_body(Visit&& visit) const {
         for (size_t index = 0; index < slots_.size(); ++index)
             if (slots_[index].body()) visit(slots_.id_at(index), *slots_[index].body());
+    }
+
+    /// Calls visit(id, collider) for every live tool and obstacle (needs collider.hpp).
+    template <class Visit>
+    void for_each_collider(Visit&& visit) const {
+        for (size_t index = 0; index < colliders_.size(); ++index)
+            if (colliders_.is_live(index)) visit(colliders_.id_at(index), *colliders_[index]);
     }
 
     double gravity[3];                       ///< m/s^2, on every body
@@ -184,6 +199,7 @@ private:
     vec<BodyPair> pairs_;                ///< body pairs with contact enabled
     ContactIslands* islands_ = nullptr;  ///< built on the first step with body pairs
     vec<StepHook*> hooks_;               ///< told before and after each step
+    vec<std::pair<const void*, StepHook*>> owned_hooks_;  ///< hooks the world owns, by key
     bool error_estimate_ = false;        ///< bodies take half steps for sh_step_report's estimate
     /// The id of live body slot index.
     Id id_of(size_t index) const { return slots_.id_at(index); }

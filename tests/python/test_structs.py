@@ -71,8 +71,9 @@ def test_field_offsets_match_c(c_layout, name):
 def test_sizes_computed_by_hand():
     # Independent of any compiler: the x86-64/aarch64 SysV layout worked out from the header.
     assert ctypes.sizeof(_lib.sh_world_def) == 40  # u32, pad 4, 3 doubles, i32, pad 4
-    assert ctypes.sizeof(_lib.sh_step_report) == 136  # ... 88, i32, pad 4, 2 doubles, i32, pad 4,
-    # double, i32, pad 4
+    assert ctypes.sizeof(_lib.sh_step_report) == 144  # ... 88, i32, pad 4, 2 doubles, i32, pad 4,
+    # double, i32, i32, double
+    assert ctypes.sizeof(_lib.sh_cut_def) == 64  # u32, i32, 6 doubles, double
     assert ctypes.sizeof(_lib.sh_mesh_info) == 88  # 7 int32, pad 4, 7 doubles
     assert ctypes.sizeof(_lib.sh_material) == 32
     assert ctypes.sizeof(_lib.sh_fem_body_def) == 128  # 80 + sh_implicit_settings
@@ -107,6 +108,7 @@ def _python_constants():
         ("SH_SPRING_", _lib.SPRING_LAWS),
         ("SH_LINEAR_SOLVER_", _lib.LINEAR_SOLVERS),
         ("SH_SHAPE_", _lib.SHAPE_KINDS),
+        ("SH_CUT_", _lib.CUT_CRITERIA),
     ]:
         constants.update({prefix + name.upper(): value for name, value in table.items()})
     return constants

@@ -143,6 +143,11 @@ SHAPE_KINDS = {
 }
 SH_SHAPE_COUNT = len(SHAPE_KINDS)
 
+CUT_CRITERIA = {
+    "geometric": 0,
+}
+SH_CUT_CRITERION_COUNT = len(CUT_CRITERIA)
+
 # ------------------------------------------------------------------------------------------------
 # Structs. Enums are C ints; opaque handles are void pointers. The ids are distinct one-field
 # structs, as in C, so that ctypes refuses one kind of id where another is expected.
@@ -216,6 +221,8 @@ class sh_step_report(Structure):
         ("contact_count", c_int32),
         ("collision_seconds", c_double),
         ("contact_substeps", c_int32),
+        ("cut_faces", c_int32),
+        ("topology_seconds", c_double),
     ]
 
 
@@ -326,6 +333,17 @@ class sh_cut_report(Structure):
         ("seconds", c_double),
         ("springs_cut", c_int32),
         ("reserved", c_int32),
+    ]
+
+
+class sh_cut_def(Structure):
+    """Mirror of struct sh_cut_def."""
+
+    _fields_ = [
+        ("internal_init", c_uint32),
+        ("criterion", c_int32),
+        ("edge", (c_double * 3) * 2),
+        ("sharpness", c_double),
     ]
 
 
@@ -551,6 +569,8 @@ PROTOTYPES = {
     "sh_tool_set_pose": (_status, [_handle, sh_tool_id, _pd, _pd]),
     "sh_tool_get_pose": (_status, [_handle, sh_tool_id, _pd, _pd]),
     "sh_tool_set_velocity": (_status, [_handle, sh_tool_id, _pd, _pd]),
+    "sh_cut_def_default": (None, [POINTER(sh_cut_def)]),
+    "sh_tool_set_cutting": (_status, [_handle, sh_tool_id, POINTER(sh_cut_def)]),
     "sh_tool_get_contact": (_status, [_handle, sh_tool_id, POINTER(sh_contact_state)]),
     "sh_tool_get_wrench": (_status, [_handle, sh_tool_id, _pd, _pd]),
     "sh_haptic_def_default": (None, [POINTER(sh_haptic_def)]),

@@ -19,11 +19,11 @@ from typing import TYPE_CHECKING, Any, Mapping, Optional, Tuple, cast
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _arrays, _defs
+from . import _arrays, _defs, _lib
 from ._defs import default
 from ._entity import WorldEntity
 from ._handle import OwnedHandle
-from ._lib import sh_contact_state, sh_obstacle_id, sh_tool_id
+from ._lib import sh_contact_state, sh_cut_def, sh_obstacle_id, sh_tool_id
 from ._loaded import check, lib
 from ._record import Record, record_of
 from .body import Body, body_id_in
@@ -167,6 +167,36 @@ class Tool(_Collider):
             ),
             "sh_tool_set_velocity",
         )
+
+    def set_cutting(
+        self,
+        edge: Optional[ArrayLike] = ((0.0, 0.0, -0.005), (0.0, 0.0, 0.005)),
+        criterion: str = "geometric",
+        sharpness: float = 1.0,
+    ) -> None:
+        """Make the tool a cutting tool, or an ordinary one again with ``set_cutting(None)``.
+
+        edge is the blade's cutting edge, two points in the tool's local frame (m). At every
+        World.step the surface the edge sweeps from the tool's last pose to its new pose cuts
+        every body it passes through (see Body.cut); the report's cut_faces and
+        topology_seconds count it. criterion: "geometric" (the material the edge sweeps
+        separates). sharpness: the blade's kappa (> 0)."""
+        handle = self._world_handle("sh_tool_set_cutting")
+        if edge is None:
+            check(lib.sh_tool_set_cutting(handle, self._cid, None), "sh_tool_set_cutting")
+            return
+        criteria = _lib.CUT_CRITERIA
+        if criterion not in criteria:
+            raise ValueError("criterion must be one of %s, got %r" % (sorted(criteria), criterion))
+        points = _arrays.float_array(edge, "edge", (2, 3))
+        raw = sh_cut_def()
+        lib.sh_cut_def_default(ctypes.byref(raw))
+        raw.criterion = criteria[criterion]
+        for e in range(2):
+            for k in range(3):
+                raw.edge[e][k] = float(points[e, k])
+        raw.sharpness = float(sharpness)
+        check(lib.sh_tool_set_cutting(handle, self._cid, ctypes.byref(raw)), "sh_tool_set_cutting")
 
     def wrench(self) -> Tuple[np.ndarray, np.ndarray]:
         """(force, torque): the reaction on the tool after the last step, two (3,) arrays

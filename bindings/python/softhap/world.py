@@ -98,7 +98,8 @@ class World(WorldContacts):
         potential_energy, warnings (set of names), warning_bits, unstable_body_count, ...;
         with tools or obstacles: contact_count (contact points at the step's end state),
         collision_seconds and contact_substeps (sub-steps taken so that no tool moves more
-        than half its inner radius at once; 1 = none)).
+        than half its inner radius at once; 1 = none); with cutting: cut_faces (faces cutting
+        tools separated) and topology_seconds).
 
         If a body's step failed (rejected or rolled back: SH_ERR_UNSTABLE; an implicit body's
         SH_ERR_SOLVER or SH_ERR_NOT_CONVERGED) that body is as before and the other bodies still

@@ -1,0 +1,126 @@
+#include "cut/tool_cutting.hpp"
+
+#include "contact/collider.hpp"
+#include "core/clock.hpp"
+#include "core/error.hpp"
+#include "core/vec3.hpp"
+#include "cut/body_cut.hpp"
+#include "world/world.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace sh {
+namespace {
+
+/// Names the world's cutting hook.
+const char kCuttingKey = 0;
+
+/// The two triangles the blade edge sweeps from the tool's start pose to its target pose (18
+/// doubles); false if they have no area (the blade did not move across its own edge).
+bool swept_blade(const Collider& tool, double triangles[18]) {
+    double a0[3], b0[3], a1[3], b1[3];
+    tool.start.to_world(tool.cutting.edge[0], a0);
+    tool.start.to_world(tool.cutting.edge[1], b0);
+    tool.target.to_world(tool.cutting.edge[0], a1);
+    tool.target.to_world(tool.cutting.edge[1], b1);
+    const double* corners[6] = {a0, b0, b1, a0, b1, a1};
+    for (int c = 0; c < 6; ++c)
+        for (int k = 0; k < 3; ++k) triangles[3 * c + k] = corners[c][k];
+    // Each triangle's area against the blade's length: a sweep shorter than a millionth of the
+    // blade is no motion.
+    double e[3], d0[3], d1[3], n0[3], n1[3];
+    sub3(b0, a0, e);
+    sub3(b1, a0, d0);
+    sub3(a1, a0, d1);
+    cross3(e, d0, n0);
+    cross3(d0, d1, n1);
+    const double scale = 1e-6 * dot3(e, e);
+    return norm3(n0) > scale && norm3(n1) > scale;
+}
+
+/// Most triangles of a blade's swept surface kept: a blade advancing by at least 1/256 of an
+/// element per step still crosses whole elements with what is kept.
+constexpr size_t kKeptTriangles = 512;
+
+/// Cuts every body along each cutting tool's swept blade before the step's motion. A blade
+/// that advances by less than an element per step crosses each tet bit by bit: the surface it
+/// swept over its last steps is kept and cut with whole, so that a tet separates once the
+/// blade has passed through it.
+class ToolCutting final : public StepHook {
+public:
+    void before_step(World&) override {}
+    void after_step(World&, double) override {}
+    void detach() override {}
+
+    void before_motion(World& world, sh_step_report& report) override {
+        const double start = now_seconds();
+        forget_gone_tools(world);
+        world.for_each_collider([&](Id id, const Collider& tool) {
+            double triangles[18];
+            if (!tool.is_tool || !tool.cuts || !swept_blade(tool, triangles)) return;
+            vec<double>& swept = swept_of(id);
+            swept.insert(swept.end(), triangles, triangles + 18);
+            if (swept.size() > 9 * kKeptTriangles) swept.erase(swept.begin(), swept.end() - 9 * kKeptTriangles);
+            world.for_each_body([&](Id body, const Body&) {
+                sh_cut_report cut{};
+                cut_body(world, body, swept.data(), static_cast<int32_t>(swept.size() / 9), cut);
+                report.cut_faces += cut.faces_separated;
+            });
+        });
+        report.topology_seconds += now_seconds() - start;
+    }
+
+    /// Forgets what tool id's blade swept (it stopped cutting).
+    void forget(Id id) { swept_of(id).clear(); }
+
+private:
+    vec<double>& swept_of(Id id) {
+        for (auto& entry : swept_)
+            if (entry.first == id) return entry.second;
+        swept_.push_back({id, vec<double>()});
+        return swept_.back().second;
+    }
+
+    void forget_gone_tools(const World& world) {
+        swept_.erase(std::remove_if(swept_.begin(), swept_.end(),
+                                    [&](const auto& entry) { return !world.is_valid_collider(entry.first, true); }),
+                     swept_.end());
+    }
+
+    vec<std::pair<Id, vec<double>>> swept_;  ///< per cutting tool: its blade's recent sweep, 9 per triangle
+};
+
+void validate(const sh_cut_def& def) {
+    SH_REQUIRE(def.criterion >= 0 && def.criterion < SH_CUT_CRITERION_COUNT, SH_ERR_INVALID_ARGUMENT,
+               "def->criterion = %d is not an sh_cut_criterion", static_cast<int>(def.criterion));
+    for (int e = 0; e < 2; ++e)
+        SH_REQUIRE(finite3(def.edge[e]), SH_ERR_INVALID_ARGUMENT, "def->edge[%d] is not finite", e);
+    double d[3];
+    sub3(def.edge[1], def.edge[0], d);
+    SH_REQUIRE(norm3(d) > 0.0, SH_ERR_INVALID_ARGUMENT, "def->edge[0] and def->edge[1] coincide: a blade needs a length");
+    SH_REQUIRE(std::isfinite(def.sharpness) && def.sharpness > 0.0, SH_ERR_INVALID_ARGUMENT,
+               "def->sharpness = %g, must be finite and > 0", def.sharpness);
+}
+
+}  // namespace
+
+void set_tool_cutting(World& world, Id id, const sh_cut_def* def) {
+    Collider& tool = world.collider(id, true);
+    if (def) validate(*def);
+    if (def && !world.owned_hook(&kCuttingKey)) {
+        ToolCutting* hook = sh::create<ToolCutting>();
+        try {
+            world.own_hook(hook, &kCuttingKey);
+        } catch (...) {
+            sh::destroy(hook);
+            throw;
+        }
+    }
+    tool.cuts = def != nullptr;
+    if (def) tool.cutting = *def;
+    if (StepHook* hook = world.owned_hook(&kCuttingKey)) static_cast<ToolCutting*>(hook)->forget(id);
+}
+
+}  // namespace sh

@@ -12,8 +12,8 @@
 namespace sh {
 namespace {
 
-void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, sh_cut_report& report) {
-    TetCut cut(body, surface);
+void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report) {
+    TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data());
     const int32_t node_count = body.node_count(), tet_count = body.element_count();
     report.faces_separated = separate(cut, node_count);
     report.min_quality = cut.min_quality;
@@ -26,7 +26,8 @@ void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, sh_c
     report.tets_added = body.element_count() - tet_count;
 }
 
-void cut_springs(World& world, Id id, SpringBody& body, const CutSurface& surface, sh_cut_report& report) {
+void cut_springs(World& world, Id id, SpringBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report) {
+    const double* frame = at_rest ? body.rest.data() : body.x.data();
     const int32_t count = body.element_count();
     vec<uint8_t> broken(static_cast<size_t>(count), 0);
     bool any = false;
@@ -34,7 +35,7 @@ void cut_springs(World& world, Id id, SpringBody& body, const CutSurface& surfac
         const int32_t* ends = body.element_nodes() + 2 * static_cast<size_t>(s);
         double t = 0.0;
         int32_t triangle = -1;
-        broken[static_cast<size_t>(s)] = surface.first_hit(at(body.x.data(), ends[0]), at(body.x.data(), ends[1]), t, triangle);
+        broken[static_cast<size_t>(s)] = surface.first_hit(at(frame, ends[0]), at(frame, ends[1]), t, triangle);
         any = any || broken[static_cast<size_t>(s)];
     }
     if (!any) return;
@@ -44,19 +45,28 @@ void cut_springs(World& world, Id id, SpringBody& body, const CutSurface& surfac
     world.topology_changed(id, prepared);
 }
 
-}  // namespace
-
-void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {
+/// Cuts body id along triangles given against its current (at_rest false) or rest positions.
+void cut_in_frame(World& world, Id id, const double* triangles, int32_t count, bool at_rest, sh_cut_report& report) {
     const double start = now_seconds();
     Body& body = world.body(id);
     const CutSurface surface(triangles, count);
     report = sh_cut_report{};
     report.min_quality = 1.0;
     if (body.is_fem())
-        cut_fem(world, id, static_cast<FemBody&>(body), surface, report);
+        cut_fem(world, id, static_cast<FemBody&>(body), surface, at_rest, report);
     else
-        cut_springs(world, id, static_cast<SpringBody&>(body), surface, report);
+        cut_springs(world, id, static_cast<SpringBody&>(body), surface, at_rest, report);
     report.seconds = now_seconds() - start;
+}
+
+}  // namespace
+
+void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {
+    cut_in_frame(world, id, triangles, count, false, report);
+}
+
+void cut_body_at_rest(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {
+    cut_in_frame(world, id, triangles, count, true, report);
 }
 
 }  // namespace sh

@@ -17,4 +17,8 @@ class World;
 /// failure leaves the body as it was.
 void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report);
 
+/// cut_body with triangles given in body id's rest shape (the material frame) instead of its
+/// current configuration: a surface recorded there stays with the material as it moves.
+void cut_body_at_rest(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report);
+
 }  // namespace sh

@@ -21,7 +21,7 @@ const int32_t* corners(const FemBody& body, int32_t t) { return body.element_nod
 
 }  // namespace
 
-TetCut::TetCut(const FemBody& body, const CutSurface& surface) {
+TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* frame) : frame_(frame) {
     find_candidates(body, surface);
     find_edges(body, surface);
     settle(body);
@@ -34,7 +34,7 @@ TetCut::TetCut(const FemBody& body, const CutSurface& surface) {
 }
 
 void TetCut::find_candidates(const FemBody& body, const CutSurface& surface) {
-    const double* x = body.x.data();
+    const double* x = frame_;
     for (int32_t t = 0; t < body.element_count(); ++t) {
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int a = 0; a < 4; ++a)
@@ -74,7 +74,7 @@ void TetCut::find_edges(const FemBody& body, const CutSurface& surface) {
             tet_edge_[6 * c + e] = static_cast<int32_t>(std::lower_bound(edges_.begin(), edges_.end(), key, by_nodes) - edges_.begin());
         }
     for (Edge& edge : edges_) {
-        if (!surface.first_hit(at(body.x.data(), edge.lo), at(body.x.data(), edge.hi), edge.t, edge.triangle)) continue;
+        if (!surface.first_hit(at(frame_, edge.lo), at(frame_, edge.hi), edge.t, edge.triangle)) continue;
         // A crossing near a node goes through the node.
         if (edge.t < kSnap) on_[node_slot(edge.lo)] = 1;
         if (edge.t > 1.0 - kSnap) on_[node_slot(edge.hi)] = 1;
@@ -224,10 +224,10 @@ int8_t TetCut::side_of_group(const FemBody& body, const CutSurface& surface, int
         const int a = kTetEdge[e][0], b = kTetEdge[e][1];
         const int mine = group[a] == g ? a : (group[b] == g ? b : -1);
         if (mine < 0) continue;
-        const double* corner = at(body.x.data(), corner_[4 * static_cast<size_t>(c) + mine]);
+        const double* corner = at(frame_, corner_[4 * static_cast<size_t>(c) + mine]);
         double offset[3];
         for (int k = 0; k < 3; ++k)
-            offset[k] = corner[k] - ((1.0 - ed.t) * at(body.x.data(), ed.lo)[k] + ed.t * at(body.x.data(), ed.hi)[k]);
+            offset[k] = corner[k] - ((1.0 - ed.t) * at(frame_, ed.lo)[k] + ed.t * at(frame_, ed.hi)[k]);
         return dot3(offset, surface.normal(ed.triangle)) >= 0.0 ? 1 : -1;
     }
     return 0;
@@ -241,7 +241,7 @@ int8_t TetCut::side_of_tet(const FemBody& body, const CutSurface& surface, int32
         const size_t slot = node_slot(node);
         if (slot < nodes_.size() && nodes_[slot] == node && on_[slot]) continue;
         int32_t triangle = -1;
-        const double d = surface.signed_distance(at(body.x.data(), node), triangle);
+        const double d = surface.signed_distance(at(frame_, node), triangle);
         if (std::fabs(d) > std::fabs(farthest)) farthest = d;
     }
     return farthest > 0.0 ? 1 : (farthest < 0.0 ? -1 : 0);

@@ -22,9 +22,10 @@ public:
     /// so that no piece is thinner than about kSnap of its tet.
     static constexpr double kSnap = 0.25;
 
-    /// Finds where surface crosses body's tets (in the current configuration) and splits the
+    /// Finds where surface crosses body's tets with the nodes at frame (3 per node: the current
+    /// positions, or the rest shape for a surface given in the material frame) and splits the
     /// crossed tets; see the members for what it leaves.
-    TetCut(const FemBody& body, const CutSurface& surface);
+    TetCut(const FemBody& body, const CutSurface& surface, const double* frame);
 
     /// New nodes (appended after the body's), each on a crossed edge.
     vec<NodeOrigin> origins;
@@ -79,6 +80,7 @@ private:
     /// Rest position of point (0..3 corners, 4 + e the cut point of edge e) of candidate c.
     void point_rest(const FemBody& body, int32_t c, int point, double out[3]) const;
 
+    const double* frame_;       ///< node positions the surface is given against
     vec<int32_t> candidates_;   ///< body tets whose box meets the surface's
     vec<int32_t> corner_;       ///< 4 per candidate: its nodes
     vec<std::pair<int32_t, int8_t>> piece_side_;  ///< tets at the cut with their side

@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "core/vec3.hpp"
 #include "cut/body_cut.hpp"
+#include "cut/material_frame.hpp"
 #include "world/world.hpp"
 
 #include <algorithm>
@@ -40,14 +41,15 @@ bool swept_blade(const Collider& tool, double triangles[18]) {
     return norm3(n0) > scale && norm3(n1) > scale;
 }
 
-/// Most triangles of a blade's swept surface kept: a blade advancing by at least 1/256 of an
-/// element per step still crosses whole elements with what is kept.
+/// Most triangles of a blade's swept surface kept per body: a blade advancing by at least
+/// 1/256 of an element per step still crosses whole elements with what is kept.
 constexpr size_t kKeptTriangles = 512;
 
 /// Cuts every body along each cutting tool's swept blade before the step's motion. A blade
-/// that advances by less than an element per step crosses each tet bit by bit: the surface it
-/// swept over its last steps is kept and cut with whole, so that a tet separates once the
-/// blade has passed through it.
+/// that advances by less than an element per step crosses each tet bit by bit, so what it
+/// swept is kept and cut with whole; it is kept in each body's rest shape (the material
+/// frame), where it stays with the material as the body moves, so that cutting again along
+/// where the blade has been finds the same faces and shaves nothing off them.
 class ToolCutting final : public StepHook {
 public:
     void before_step(World&) override {}
@@ -56,16 +58,20 @@ public:
 
     void before_motion(World& world, sh_step_report& report) override {
         const double start = now_seconds();
-        forget_gone_tools(world);
+        forget_gone(world);
         world.for_each_collider([&](Id id, const Collider& tool) {
             double triangles[18];
             if (!tool.is_tool || !tool.cuts || !swept_blade(tool, triangles)) return;
-            vec<double>& swept = swept_of(id);
-            swept.insert(swept.end(), triangles, triangles + 18);
-            if (swept.size() > 9 * kKeptTriangles) swept.erase(swept.begin(), swept.end() - 9 * kKeptTriangles);
-            world.for_each_body([&](Id body, const Body&) {
+            world.for_each_body([&](Id body_id, const Body& body) {
+                vec<double>& swept = swept_of(id, body_id);
+                for (int c = 0; c < 6; ++c) {
+                    double rest[3];
+                    to_rest(body, &triangles[3 * c], rest);
+                    swept.insert(swept.end(), rest, rest + 3);
+                }
+                if (swept.size() > 9 * kKeptTriangles) swept.erase(swept.begin(), swept.end() - 9 * kKeptTriangles);
                 sh_cut_report cut{};
-                cut_body(world, body, swept.data(), static_cast<int32_t>(swept.size() / 9), cut);
+                cut_body_at_rest(world, body_id, swept.data(), static_cast<int32_t>(swept.size() / 9), cut);
                 report.cut_faces += cut.faces_separated;
             });
         });
@@ -73,23 +79,31 @@ public:
     }
 
     /// Forgets what tool id's blade swept (it stopped cutting).
-    void forget(Id id) { swept_of(id).clear(); }
-
-private:
-    vec<double>& swept_of(Id id) {
-        for (auto& entry : swept_)
-            if (entry.first == id) return entry.second;
-        swept_.push_back({id, vec<double>()});
-        return swept_.back().second;
+    void forget(Id tool) {
+        swept_.erase(std::remove_if(swept_.begin(), swept_.end(), [&](const Sweep& s) { return s.tool == tool; }), swept_.end());
     }
 
-    void forget_gone_tools(const World& world) {
+private:
+    /// What one tool's blade swept through one body, in the body's rest shape.
+    struct Sweep {
+        Id tool, body;
+        vec<double> triangles;  ///< 9 per triangle
+    };
+
+    vec<double>& swept_of(Id tool, Id body) {
+        for (Sweep& s : swept_)
+            if (s.tool == tool && s.body == body) return s.triangles;
+        swept_.push_back({tool, body, vec<double>()});
+        return swept_.back().triangles;
+    }
+
+    void forget_gone(const World& world) {
         swept_.erase(std::remove_if(swept_.begin(), swept_.end(),
-                                    [&](const auto& entry) { return !world.is_valid_collider(entry.first, true); }),
+                                    [&](const Sweep& s) { return !world.is_valid_collider(s.tool, true) || !world.is_valid(s.body); }),
                      swept_.end());
     }
 
-    vec<std::pair<Id, vec<double>>> swept_;  ///< per cutting tool: its blade's recent sweep, 9 per triangle
+    vec<Sweep> swept_;
 };
 
 void validate(const sh_cut_def& def) {

@@ -87,13 +87,14 @@ size_t TetCut::node_slot(int32_t node) const {
 
 void TetCut::settle(const FemBody& body) {
     const double largest_omega2 = body.reference_frequency_squared();
-    // Each round either settles or moves one more crossing onto a node: it ends.
+    // Each round moves at least one more crossing onto a node, or settles: it ends. A round
+    // snaps every offending tet at once, so that a long cut settles in a few rounds.
     for (;;) {
         mark_cut_edges();
-        int32_t bad = first_unsplittable();
-        if (bad < 0) bad = first_bad_split(body, largest_omega2);
-        if (bad < 0) return;
-        snap_nearest_end(bad);
+        vec<int32_t> offending = unsplittable();
+        if (offending.empty()) offending = bad_splits(body, largest_omega2);
+        if (offending.empty()) return;
+        for (const int32_t c : offending) snap_nearest_end(c);
     }
 }
 
@@ -101,14 +102,38 @@ void TetCut::mark_cut_edges() {
     for (Edge& edge : edges_) edge.cut = edge.triangle >= 0 && !on(edge.lo) && !on(edge.hi);
 }
 
-int32_t TetCut::first_unsplittable() const {
+vec<int32_t> TetCut::unsplittable() const {
     // A tet the cut crosses without separating its corners holds the cut's border: the cut
     // there goes through a node instead (the tet then stays whole and touches the cut).
+    vec<int32_t> found;
     for (size_t c = 0; c < candidates_.size(); ++c) {
         int group[4];
-        if (group_corners(crossing_of(static_cast<int32_t>(c)), group) == -1) return static_cast<int32_t>(c);
+        if (group_corners(crossing_of(static_cast<int32_t>(c)), group) == -1) found.push_back(static_cast<int32_t>(c));
     }
-    return -1;
+    return found;
+}
+
+vec<int32_t> TetCut::bad_splits(const FemBody& body, double largest_omega2) const {
+    vec<int32_t> found;
+    for (size_t c = 0; c < candidates_.size(); ++c) {
+        double quality = 1.0;
+        if (!pieces_ok(body, static_cast<int32_t>(c), largest_omega2, quality)) found.push_back(static_cast<int32_t>(c));
+    }
+    return found;
+}
+
+void TetCut::snap_nearest_end(int32_t c) {
+    // The crossing nearest to a node of the tet moves onto that node (another tet of this
+    // round may have snapped it already).
+    int best = -1;
+    double nearest = INFINITY;
+    for (int e = 0; e < 6; ++e) {
+        const Edge& ed = edge(c, e);
+        if (ed.cut && !on(ed.lo) && !on(ed.hi) && std::min(ed.t, 1.0 - ed.t) < nearest) nearest = std::min(ed.t, 1.0 - ed.t), best = e;
+    }
+    if (best < 0) return;
+    const Edge& ed = edge(c, best);
+    on_[node_slot(ed.t < 0.5 ? ed.lo : ed.hi)] = 1;
 }
 
 TetCrossing TetCut::crossing_of(int32_t c) const {
@@ -116,26 +141,6 @@ TetCrossing TetCut::crossing_of(int32_t c) const {
     for (int e = 0; e < 6; ++e) crossing.cut[e] = edge(c, e).cut;
     for (int a = 0; a < 4; ++a) crossing.on[a] = on(corner_[4 * static_cast<size_t>(c) + a]);
     return crossing;
-}
-
-int32_t TetCut::first_bad_split(const FemBody& body, double largest_omega2) {
-    for (size_t c = 0; c < candidates_.size(); ++c) {
-        double quality = 1.0;
-        if (!pieces_ok(body, static_cast<int32_t>(c), largest_omega2, quality)) return static_cast<int32_t>(c);
-    }
-    return -1;
-}
-
-void TetCut::snap_nearest_end(int32_t c) {
-    // The crossing nearest to a node of the tet moves onto that node.
-    int best = -1;
-    double nearest = INFINITY;
-    for (int e = 0; e < 6; ++e) {
-        const Edge& ed = edge(c, e);
-        if (ed.cut && std::min(ed.t, 1.0 - ed.t) < nearest) nearest = std::min(ed.t, 1.0 - ed.t), best = e;
-    }
-    const Edge& ed = edge(c, best);
-    on_[node_slot(ed.t < 0.5 ? ed.lo : ed.hi)] = 1;
 }
 
 int TetCut::split_candidate(const FemBody& body, int32_t c, bool final_numbers, int pieces[kMaxPieces][4],

@@ -57,8 +57,8 @@ private:
     void find_edges(const FemBody& body, const CutSurface& surface);
     void settle(const FemBody& body);
     void mark_cut_edges();
-    int32_t first_unsplittable() const;
-    int32_t first_bad_split(const FemBody& body, double largest_omega2);
+    vec<int32_t> unsplittable() const;
+    vec<int32_t> bad_splits(const FemBody& body, double largest_omega2) const;
     void snap_nearest_end(int32_t candidate);
     bool pieces_ok(const FemBody& body, int32_t candidate, double largest_omega2, double& quality) const;
     int split_candidate(const FemBody& body, int32_t candidate, bool final_numbers, int pieces[kMaxPieces][4],

@@ -645,8 +645,10 @@ typedef struct sh_cut_report {
  *  frame, m), in the body's current configuration; the triangles need not be welded or
  *  consistently oriented. The material the surface passes through separates; where its
  *  border lies inside the body, the body stays joined (a later cut extends it). FEM bodies
- *  split the tets it crosses (a cut point within a quarter of an edge of a node goes through
- *  the node instead); mass-spring bodies lose the springs it crosses. Masses, rest shapes,
+ *  split every edge it crosses at the crossing (a crossing within a quarter of an edge of a
+ *  node, or one that would make a piece of quality below 0.05 or stiffer than 0.3 of the uncut
+ *  body's critical step allows, goes through a node instead); mass-spring bodies lose the
+ *  springs it crosses. Masses, rest shapes,
  *  the surface, contact, implicit solver data and haptic buffers follow; topology_version
  *  increases if anything was cut. out_report may be NULL. Non-finite coordinates, a
  *  zero-area triangle or triangle_count < 1 are SH_ERR_INVALID_ARGUMENT naming the triangle;

@@ -13,7 +13,9 @@ namespace sh {
 namespace {
 
 void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report) {
-    TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data());
+    // A surface in the material frame is a tool's growing sweep, cut with again at every step:
+    // the quality guard's choices depend on the pieces already there and would not repeat.
+    TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data(), !at_rest);
     const int32_t node_count = body.node_count(), tet_count = body.element_count();
     report.faces_separated = separate(cut, node_count);
     report.min_quality = cut.min_quality;

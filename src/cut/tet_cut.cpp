@@ -16,20 +16,26 @@ namespace {
 constexpr double kMinQuality = 0.05;
 constexpr double kStepRatio = 0.3;
 
+// The tet's edges: edge e joins corners kTetEdge[e][0] and kTetEdge[e][1].
+constexpr int kTetEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
 // The corners of tet t of body.
 const int32_t* corners(const FemBody& body, int32_t t) { return body.element_nodes() + 4 * static_cast<size_t>(t); }
 
 }  // namespace
 
-TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* frame) : frame_(frame) {
+TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality)
+    : frame_(frame) {
     find_candidates(body, surface);
     find_edges(body, surface);
-    settle(body);
+    snap_earlier_cut_nodes(body, surface);
+    mark_cut_edges();
+    if (guard_quality) settle(body);
     number_new_nodes(body.node_count());
     tets.assign(body.element_nodes(), body.element_nodes() + 4 * static_cast<size_t>(body.element_count()));
     source.resize(static_cast<size_t>(body.element_count()));
     for (size_t t = 0; t < source.size(); ++t) source[t] = static_cast<int32_t>(t);
-    for (size_t c = 0; c < candidates_.size(); ++c) add_pieces(body, surface, static_cast<int32_t>(c));
+    add_pieces(body, bisect(true));
     collect_cut(body, surface);
 }
 
@@ -81,6 +87,22 @@ void TetCut::find_edges(const FemBody& body, const CutSurface& surface) {
     }
 }
 
+void TetCut::snap_earlier_cut_nodes(const FemBody& body, const CutSurface& surface) {
+    // Nodes an earlier cut made lie on its surface, so a later cut that passes within a
+    // quarter edge of them (extending the earlier one from its border) goes through them.
+    vec<double> shortest(nodes_.size(), INFINITY);
+    for (const Edge& ed : edges_) {
+        double d[3];
+        sub3(at(frame_, ed.hi), at(frame_, ed.lo), d);
+        for (const int32_t node : {ed.lo, ed.hi}) shortest[node_slot(node)] = std::min(shortest[node_slot(node)], norm3(d));
+    }
+    for (size_t i = 0; i < nodes_.size(); ++i) {
+        if (on_[i] || body.parent_of(nodes_[i]) < 0) continue;
+        int32_t triangle = -1;
+        if (std::fabs(surface.signed_distance(at(frame_, nodes_[i]), triangle)) < kSnap * shortest[i]) on_[i] = 1;
+    }
+}
+
 size_t TetCut::node_slot(int32_t node) const {
     return static_cast<size_t>(std::lower_bound(nodes_.begin(), nodes_.end(), node) - nodes_.begin());
 }
@@ -88,11 +110,10 @@ size_t TetCut::node_slot(int32_t node) const {
 void TetCut::settle(const FemBody& body) {
     const double largest_omega2 = body.reference_frequency_squared();
     // Each round moves at least one more crossing onto a node, or settles: it ends. A round
-    // snaps every offending tet at once, so that a long cut settles in a few rounds.
+    // snaps the worst crossing of every offending tet at once, so that it settles in a few.
     for (;;) {
         mark_cut_edges();
-        vec<int32_t> offending = unsplittable();
-        if (offending.empty()) offending = bad_splits(body, largest_omega2);
+        const vec<int32_t> offending = bad_pieces(body, largest_omega2);
         if (offending.empty()) return;
         for (const int32_t c : offending) snap_nearest_end(c);
     }
@@ -100,26 +121,6 @@ void TetCut::settle(const FemBody& body) {
 
 void TetCut::mark_cut_edges() {
     for (Edge& edge : edges_) edge.cut = edge.triangle >= 0 && !on(edge.lo) && !on(edge.hi);
-}
-
-vec<int32_t> TetCut::unsplittable() const {
-    // A tet the cut crosses without separating its corners holds the cut's border: the cut
-    // there goes through a node instead (the tet then stays whole and touches the cut).
-    vec<int32_t> found;
-    for (size_t c = 0; c < candidates_.size(); ++c) {
-        int group[4];
-        if (group_corners(crossing_of(static_cast<int32_t>(c)), group) == -1) found.push_back(static_cast<int32_t>(c));
-    }
-    return found;
-}
-
-vec<int32_t> TetCut::bad_splits(const FemBody& body, double largest_omega2) const {
-    vec<int32_t> found;
-    for (size_t c = 0; c < candidates_.size(); ++c) {
-        double quality = 1.0;
-        if (!pieces_ok(body, static_cast<int32_t>(c), largest_omega2, quality)) found.push_back(static_cast<int32_t>(c));
-    }
-    return found;
 }
 
 void TetCut::snap_nearest_end(int32_t c) {
@@ -136,54 +137,78 @@ void TetCut::snap_nearest_end(int32_t c) {
     on_[node_slot(ed.t < 0.5 ? ed.lo : ed.hi)] = 1;
 }
 
-TetCrossing TetCut::crossing_of(int32_t c) const {
-    TetCrossing crossing;
-    for (int e = 0; e < 6; ++e) crossing.cut[e] = edge(c, e).cut;
-    for (int a = 0; a < 4; ++a) crossing.on[a] = on(corner_[4 * static_cast<size_t>(c) + a]);
-    return crossing;
-}
-
-int TetCut::split_candidate(const FemBody& body, int32_t c, bool final_numbers, int pieces[kMaxPieces][4],
-                            int piece_group[kMaxPieces], int group[4]) const {
-    const TetCrossing crossing = crossing_of(c);
-    if (group_corners(crossing, group) != 2) return 0;
-    int32_t global[10];
-    for (int a = 0; a < 4; ++a) global[a] = corner_[4 * static_cast<size_t>(c) + a];
-    for (int e = 0; e < 6; ++e) {
-        // Before numbering, an edge's slot stands in for its node: both grow in the same order.
-        const size_t slot = static_cast<size_t>(tet_edge_[6 * static_cast<size_t>(c) + e]);
-        global[4 + e] = final_numbers ? edges_[slot].node : body.node_count() + static_cast<int32_t>(slot);
+vec<TetCut::Piece> TetCut::bisect(bool final_numbers) const {
+    // Every crossed edge is split at its crossing in every tet that has it, one edge after the
+    // other in one global order: each split halves the tets around one edge, so the mesh stays
+    // conforming, and once every crossed edge is split no edge crosses the surface (each has an
+    // end on it or both on one side), so the surface inside the tets is made of their faces.
+    // Pieces of different candidates never share a split, so each candidate is split alone,
+    // with its own crossed edges in the global order.
+    vec<Piece> pieces(candidates_.size());
+    for (size_t c = 0; c < candidates_.size(); ++c) {
+        std::copy(&corner_[4 * c], &corner_[4 * c] + 4, pieces[c].node);
+        pieces[c].candidate = static_cast<int32_t>(c);
+        int32_t slots[6], crossed = 0;
+        for (int e = 0; e < 6; ++e)
+            if (edge(static_cast<int32_t>(c), e).cut) slots[crossed++] = tet_edge_[6 * c + static_cast<size_t>(e)];
+        std::sort(slots, slots + crossed);
+        vec<size_t> mine(1, c);  // this candidate's pieces
+        for (int k = 0; k < crossed; ++k) {
+            const Edge& ed = edges_[static_cast<size_t>(slots[k])];
+            const int32_t middle = final_numbers ? ed.node : kProvisional + slots[k];
+            const size_t count = mine.size();
+            for (size_t m = 0; m < count; ++m) {
+                Piece& piece = pieces[mine[m]];
+                int lo = -1, hi = -1;
+                for (int a = 0; a < 4; ++a) {
+                    if (piece.node[a] == ed.lo) lo = a;
+                    if (piece.node[a] == ed.hi) hi = a;
+                }
+                if (lo < 0 || hi < 0) continue;
+                Piece other = piece;
+                piece.node[hi] = middle;  // the half at lo
+                other.node[lo] = middle;  // the half at hi
+                mine.push_back(pieces.size());
+                pieces.push_back(other);
+            }
+        }
     }
-    return split_tet(crossing, group, global, pieces, piece_group);
+    return pieces;
 }
 
-void TetCut::point_rest(const FemBody& body, int32_t c, int point, double out[3]) const {
-    if (point < 4) {
-        for (int k = 0; k < 3; ++k) out[k] = at(body.rest.data(), corner_[4 * static_cast<size_t>(c) + point])[k];
+void TetCut::node_position(const FemBody& body, int32_t node, const double* positions, double out[3]) const {
+    if (node < body.node_count()) {
+        for (int k = 0; k < 3; ++k) out[k] = at(positions, node)[k];
         return;
     }
-    const Edge& ed = edge(c, point - 4);
-    for (int k = 0; k < 3; ++k) out[k] = (1.0 - ed.t) * at(body.rest.data(), ed.lo)[k] + ed.t * at(body.rest.data(), ed.hi)[k];
+    const Edge& ed = node >= kProvisional ? edges_[static_cast<size_t>(node - kProvisional)]
+                                          : *std::find_if(edges_.begin(), edges_.end(), [&](const Edge& e) { return e.node == node; });
+    for (int k = 0; k < 3; ++k) out[k] = (1.0 - ed.t) * at(positions, ed.lo)[k] + ed.t * at(positions, ed.hi)[k];
 }
 
-bool TetCut::pieces_ok(const FemBody& body, int32_t c, double largest_omega2, double& quality) const {
-    int pieces[kMaxPieces][4], piece_group[kMaxPieces], group[4];
-    const int count = split_candidate(body, c, false, pieces, piece_group, group);
-    const sh_material& material = body.material(static_cast<size_t>(candidates_[static_cast<size_t>(c)]));
-    for (int p = 0; p < count; ++p) {
+vec<int32_t> TetCut::bad_pieces(const FemBody& body, double largest_omega2) const {
+    const vec<Piece> pieces = bisect(false);
+    // Only split candidates count: a whole tet keeps whatever quality the mesh gave it.
+    vec<uint8_t> split(candidates_.size(), 0);
+    for (size_t p = candidates_.size(); p < pieces.size(); ++p) split[static_cast<size_t>(pieces[p].candidate)] = 1;
+    vec<int32_t> found;
+    for (const Piece& piece : pieces) {
+        if (!split[static_cast<size_t>(piece.candidate)] || (!found.empty() && found.back() == piece.candidate)) continue;
         double r[4][3];
-        for (int a = 0; a < 4; ++a) point_rest(body, c, pieces[p][a], r[a]);
-        const double q = std::fabs(tet_quality(r[0], r[1], r[2], r[3]));
-        quality = std::min(quality, q);
-        if (q < kMinQuality) return false;
-        vec<double> rest_points(r[0], r[0] + 12);
-        const int32_t local[4] = {0, 1, 2, 3};
-        double bm[9], v0 = 0.0;
-        FemBody::shape_from_rest(rest_points, local, bm, v0);
-        const double omega2 = FemBody::element_max_frequency_squared(bm, std::fabs(v0), material);
-        if (omega2 * kStepRatio * kStepRatio > largest_omega2) return false;
+        for (int a = 0; a < 4; ++a) node_position(body, piece.node[a], body.rest.data(), r[a]);
+        const double q = tet_quality(r[0], r[1], r[2], r[3]);
+        bool bad = q < kMinQuality;
+        if (!bad) {
+            vec<double> rest_points(r[0], r[0] + 12);
+            const int32_t local[4] = {0, 1, 2, 3};
+            double bm[9], v0 = 0.0;
+            FemBody::shape_from_rest(rest_points, local, bm, v0);
+            const sh_material& material = body.material(static_cast<size_t>(candidates_[static_cast<size_t>(piece.candidate)]));
+            bad = FemBody::element_max_frequency_squared(bm, v0, material) * kStepRatio * kStepRatio > largest_omega2;
+        }
+        if (bad && std::find(found.begin(), found.end(), piece.candidate) == found.end()) found.push_back(piece.candidate);
     }
-    return true;
+    return found;
 }
 
 void TetCut::number_new_nodes(int32_t node_count) {
@@ -194,55 +219,38 @@ void TetCut::number_new_nodes(int32_t node_count) {
     }
 }
 
-void TetCut::add_pieces(const FemBody& body, const CutSurface& surface, int32_t c) {
-    int pieces[kMaxPieces][4], piece_group[kMaxPieces], group[4];
-    const int count = split_candidate(body, c, true, pieces, piece_group, group);
-    if (count == 0) return;
-    ++split_count;
-    const int32_t original = candidates_[static_cast<size_t>(c)];
-    const int8_t sides[2] = {side_of_group(body, surface, c, group, 0), side_of_group(body, surface, c, group, 1)};
-    for (int p = 0; p < count; ++p) {
-        int32_t nodes[4];
-        double r[4][3];
-        for (int a = 0; a < 4; ++a) {
-            point_rest(body, c, pieces[p][a], r[a]);
-            nodes[a] = pieces[p][a] < 4 ? corner_[4 * static_cast<size_t>(c) + pieces[p][a]] : edge(c, pieces[p][a] - 4).node;
-        }
-        if (signed_tet_volume(r[0], r[1], r[2], r[3]) < 0.0) std::swap(nodes[2], nodes[3]), std::swap(r[2], r[3]);
-        min_quality = std::min(min_quality, tet_quality(r[0], r[1], r[2], r[3]));
-        const size_t slot = p == 0 ? static_cast<size_t>(original) : source.size();
-        if (p > 0) {
+void TetCut::add_pieces(const FemBody& body, const vec<Piece>& pieces) {
+    // A candidate's first piece takes its place, the others are appended.
+    vec<uint8_t> placed(candidates_.size(), 0);
+    vec<uint8_t> split(candidates_.size(), 0);
+    for (size_t p = candidates_.size(); p < pieces.size(); ++p) split[static_cast<size_t>(pieces[p].candidate)] = 1;
+    for (const Piece& piece : pieces) {
+        const size_t c = static_cast<size_t>(piece.candidate);
+        if (!split[c]) continue;
+        const int32_t original = candidates_[c];
+        const size_t slot = placed[c] ? source.size() : static_cast<size_t>(original);
+        if (placed[c]) {
             tets.resize(tets.size() + 4);
             source.push_back(0);
         }
-        std::copy(nodes, nodes + 4, &tets[4 * slot]);
+        placed[c] = 1;
+        std::copy(piece.node, piece.node + 4, &tets[4 * slot]);
         source[slot] = -1 - original;
-        piece_side_.push_back({static_cast<int32_t>(slot), sides[piece_group[p]]});
+        double r[4][3];
+        for (int a = 0; a < 4; ++a) node_position(body, piece.node[a], body.rest.data(), r[a]);
+        min_quality = std::min(min_quality, tet_quality(r[0], r[1], r[2], r[3]));
+        piece_side_.push_back({static_cast<int32_t>(slot), 0});
     }
+    for (size_t c = 0; c < candidates_.size(); ++c) split_count += split[c];
 }
 
-int8_t TetCut::side_of_group(const FemBody& body, const CutSurface& surface, int32_t c, const int group[4], int g) const {
-    // Across a cut edge from a corner of group g: the side of the crossed triangle it is on.
-    for (int e = 0; e < 6; ++e) {
-        const Edge& ed = edge(c, e);
-        if (!ed.cut) continue;
-        const int a = kTetEdge[e][0], b = kTetEdge[e][1];
-        const int mine = group[a] == g ? a : (group[b] == g ? b : -1);
-        if (mine < 0) continue;
-        const double* corner = at(frame_, corner_[4 * static_cast<size_t>(c) + mine]);
-        double offset[3];
-        for (int k = 0; k < 3; ++k)
-            offset[k] = corner[k] - ((1.0 - ed.t) * at(frame_, ed.lo)[k] + ed.t * at(frame_, ed.hi)[k]);
-        return dot3(offset, surface.normal(ed.triangle)) >= 0.0 ? 1 : -1;
-    }
-    return 0;
-}
-
-int8_t TetCut::side_of_tet(const FemBody& body, const CutSurface& surface, int32_t t) const {
-    // The corner farthest from the surface decides.
+int8_t TetCut::side_of_tet(const FemBody& body, const CutSurface& surface, const int32_t* tet) const {
+    // The corner off the surface farthest from it decides; corners on the surface (nodes the
+    // cut goes through, nodes made on crossed edges) have no side.
     double farthest = 0.0;
     for (int a = 0; a < 4; ++a) {
-        const int32_t node = corners(body, t)[a];
+        const int32_t node = tet[a];
+        if (node >= body.node_count()) continue;
         const size_t slot = node_slot(node);
         if (slot < nodes_.size() && nodes_[slot] == node && on_[slot]) continue;
         int32_t triangle = -1;
@@ -256,8 +264,8 @@ void TetCut::collect_cut(const FemBody& body, const CutSurface& surface) {
     for (size_t i = 0; i < nodes_.size(); ++i)
         if (on_[i]) cut_nodes.push_back(nodes_[i]);
     for (size_t k = 0; k < origins.size(); ++k) cut_nodes.push_back(body.node_count() + static_cast<int32_t>(k));
-    // Whole tets with a node the cut goes through, then the pieces.
-    std::sort(piece_side_.begin(), piece_side_.end());
+    for (auto& entry : piece_side_) entry.second = side_of_tet(body, surface, &tets[4 * static_cast<size_t>(entry.first)]);
+    // Whole tets with a node the cut goes through.
     for (int32_t t = 0; t < body.element_count(); ++t) {
         if (source[static_cast<size_t>(t)] < 0) continue;
         bool touches = false;
@@ -266,7 +274,7 @@ void TetCut::collect_cut(const FemBody& body, const CutSurface& surface) {
             const size_t slot = node_slot(node);
             touches = slot < nodes_.size() && nodes_[slot] == node && on_[slot];
         }
-        if (touches) piece_side_.push_back({t, side_of_tet(body, surface, t)});
+        if (touches) piece_side_.push_back({t, side_of_tet(body, surface, corners(body, t))});
     }
     std::sort(piece_side_.begin(), piece_side_.end());
     for (const auto& entry : piece_side_) {

@@ -3,7 +3,6 @@
 #pragma once
 
 #include "core/memory.hpp"
-#include "cut/tet_split.hpp"
 #include "model/body.hpp"
 
 #include <cstdint>
@@ -14,18 +13,23 @@ namespace sh {
 class CutSurface;
 class FemBody;
 
-/// The cut of one FEM body by one surface, before the material separates: the new nodes on
-/// crossed edges and the new element list with a side label for every tet at the cut.
+/// The cut of one FEM body by one surface, before the material separates: every edge the
+/// surface crosses is split at the crossing (a crossing near a node goes through the node),
+/// which leaves the surface inside the body made of tet faces; the new nodes and element list,
+/// with a side label for every tet at the cut.
 class TetCut {
 public:
-    /// A cut point within kSnap of an edge's length from a node goes through the node instead,
+    /// A crossing within kSnap of an edge's length from a node goes through the node instead,
     /// so that no piece is thinner than about kSnap of its tet.
     static constexpr double kSnap = 0.25;
 
     /// Finds where surface crosses body's tets with the nodes at frame (3 per node: the current
     /// positions, or the rest shape for a surface given in the material frame) and splits the
-    /// crossed tets; see the members for what it leaves.
-    TetCut(const FemBody& body, const CutSurface& surface, const double* frame);
+    /// crossed tets; see the members for what it leaves. With guard_quality, crossings that
+    /// would make a piece below the quality bound, or too stiff for 0.3 of the uncut body's
+    /// critical step, go through a node instead. (Without it, cutting again along the same
+    /// surface finds the same crossings: a sweep that is cut with again as it grows.)
+    TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality);
 
     /// New nodes (appended after the body's), each on a crossed edge.
     vec<NodeOrigin> origins;
@@ -53,32 +57,37 @@ private:
         bool cut = false;     ///< crossed strictly between its nodes (not through a node)
         int32_t node = -1;    ///< the new node on it, once numbered
     };
+    /// A tet made by splitting a candidate along its crossed edges.
+    struct Piece {
+        int32_t node[4];      ///< positively oriented
+        int32_t candidate;    ///< the candidate it is part of
+    };
+    /// Stands in for the node of crossed edge e (kProvisional + e) before nodes are numbered.
+    static constexpr int32_t kProvisional = 1 << 30;
+
     void find_candidates(const FemBody& body, const CutSurface& surface);
     void find_edges(const FemBody& body, const CutSurface& surface);
+    void snap_earlier_cut_nodes(const FemBody& body, const CutSurface& surface);
     void settle(const FemBody& body);
     void mark_cut_edges();
-    vec<int32_t> unsplittable() const;
-    vec<int32_t> bad_splits(const FemBody& body, double largest_omega2) const;
     void snap_nearest_end(int32_t candidate);
-    bool pieces_ok(const FemBody& body, int32_t candidate, double largest_omega2, double& quality) const;
-    int split_candidate(const FemBody& body, int32_t candidate, bool final_numbers, int pieces[kMaxPieces][4],
-                        int piece_group[kMaxPieces], int group[4]) const;
+    /// The candidates split along every crossed edge: each candidate's own entry first (as its
+    /// first piece), then the other pieces; new nodes numbered for real or provisionally.
+    vec<Piece> bisect(bool final_numbers) const;
+    /// Candidates with a piece below the quality bound or too stiff for the critical step.
+    vec<int32_t> bad_pieces(const FemBody& body, double largest_omega2) const;
+    /// Where node (a body node or a new one, numbered either way) is at positions.
+    void node_position(const FemBody& body, int32_t node, const double* positions, double out[3]) const;
     void number_new_nodes(int32_t node_count);
-    void add_pieces(const FemBody& body, const CutSurface& surface, int32_t candidate);
+    void add_pieces(const FemBody& body, const vec<Piece>& pieces);
+    int8_t side_of_tet(const FemBody& body, const CutSurface& surface, const int32_t* tet) const;
     void collect_cut(const FemBody& body, const CutSurface& surface);
-    void build_elements(const FemBody& body, const CutSurface& surface);
-    int8_t side_of_group(const FemBody& body, const CutSurface& surface, int32_t candidate, const int group[4], int g) const;
-    int8_t side_of_tet(const FemBody& body, const CutSurface& surface, int32_t tet) const;
-    TetCrossing crossing_of(int32_t candidate) const;
     /// The entry of nodes_ for node (a node of a candidate).
     size_t node_slot(int32_t node) const;
     bool on(int32_t node) const { return on_[node_slot(node)] != 0; }
     /// The edge slot of candidate tet c's edge e.
     Edge& edge(int32_t c, int e) { return edges_[static_cast<size_t>(tet_edge_[6 * static_cast<size_t>(c) + e])]; }
     const Edge& edge(int32_t c, int e) const { return edges_[static_cast<size_t>(tet_edge_[6 * static_cast<size_t>(c) + e])]; }
-
-    /// Rest position of point (0..3 corners, 4 + e the cut point of edge e) of candidate c.
-    void point_rest(const FemBody& body, int32_t c, int point, double out[3]) const;
 
     const double* frame_;       ///< node positions the surface is given against
     vec<int32_t> candidates_;   ///< body tets whose box meets the surface's

@@ -351,13 +351,6 @@ def test_crossing_cuts_give_pieces_each_a_sphere(world):
     assert_conserves(body, BAR_VOLUME, DENSITY * BAR_VOLUME)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="library bug: the third (lengthwise) cut also parts faces of the node plane "
-    "z = 7 cm next to the earlier cut z = 7.5 cm, cutting off a loose 0.25 cm^3 chip "
-    "(x < 5 mm, 7 < z < 7.5 cm): 7 pieces",
-)
 def test_crossing_cuts_give_six_pieces(world):
     """Two planes across the bar and one along it, crossing both, cut it into 3 x 2 = 6
     pieces."""
@@ -416,13 +409,6 @@ def test_progressive_cut_extends_a_partial_cut(world, second):
     assert_conserves(body, BAR_VOLUME, DENSITY * BAR_VOLUME)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="library bug: a cut whose surface inside the body lies only in tets that also hold "
-    "its border (here x >= 1.05 cm after a partial cut x <= 1.05 cm, in 1 cm cubes) separates "
-    "nothing (report all zeros): the later cut does not extend the earlier one",
-)
 def test_progressive_cut_extends_a_partial_cut_ending_inside_a_cube(world):
     """As above with the first cut's border inside a cube column (x = 1.05 cm) and the second
     covering exactly the rest: the two cuts together cover the section, so two pieces."""
@@ -450,12 +436,6 @@ def test_blade_advancing_in_small_increments_cuts_through(world):
     assert piece_count(body) == 2  # the strips together cover the section
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="library bug: a partial cut whose border lies 4 mm (0.4 of an element) inside the "
-    "far face (x <= 1.6 cm of 2 cm) is snapped to that face and cuts the bar through",
-)
 def test_partial_cut_with_its_border_inside_a_cube_leaves_one_piece(world):
     """A cut covering x <= 1.6 cm of the 2 cm section leaves the bar joined (the header: where
     its border lies inside the body, the body stays joined)."""
@@ -464,13 +444,6 @@ def test_partial_cut_with_its_border_inside_a_cube_leaves_one_piece(world):
     assert piece_count(body) == 1
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="library bug: after a partial cut x <= 1.6 cm of z = 5.5 cm (which already parted "
-    "the bar along a surface through nodes off the plane), cutting the whole plane z = 5.5 cm "
-    "makes a third, loose piece (0.5 cm^3) between the two surfaces",
-)
 def test_partial_then_whole_plane_gives_two_pieces(world):
     """A partial cut of the plane z = 5.5 cm and then the whole plane: one plane cuts a bar in
     two pieces, not three."""

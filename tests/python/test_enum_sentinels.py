@@ -47,6 +47,7 @@ MIRRORS = {
     "sh_material_model": ("SH_MATERIAL_", _lib.MATERIAL_MODELS),
     "sh_spring_law": ("SH_SPRING_", _lib.SPRING_LAWS),
     "sh_shape_kind": ("SH_SHAPE_", _lib.SHAPE_KINDS),
+    "sh_cut_criterion": ("SH_CUT_", _lib.CUT_CRITERIA),
 }
 
 

@@ -39,7 +39,8 @@ def test_empty_world_steps_and_reports():
             "potential_energy", "warnings", "warning_bits", "unstable_body_count",
             "newton_iterations", "linear_iterations", "newton_residual", "factorize_seconds",
             "solve_seconds", "factorizations", "error_estimate", "error_estimate_seconds",
-            "contact_count", "collision_seconds", "contact_substeps",
+            "contact_count", "collision_seconds", "contact_substeps", "cut_faces",
+            "topology_seconds",
         }
         with pytest.raises(AttributeError):
             report.no_such_field

@@ -1,0 +1,69 @@
+"""Haptic rendering across a cut: the device feels the tissue until it is cut, and the drop
+when it is."""
+
+import numpy as np
+
+import softhap
+from test_contact import box_mesh
+
+
+def ring_cut(center, radius, z0, z1, sides=16):
+    """Triangles of a closed vertical cylinder (a cookie cutter) around center, from z0 to z1."""
+    triangles = []
+    angles = np.linspace(0.0, 2.0 * np.pi, sides + 1)
+    for a0, a1 in zip(angles[:-1], angles[1:]):
+        p0 = (center[0] + radius * np.cos(a0), center[1] + radius * np.sin(a0))
+        p1 = (center[0] + radius * np.cos(a1), center[1] + radius * np.sin(a1))
+        quad = [(p0[0], p0[1], z0), (p1[0], p1[1], z0), (p1[0], p1[1], z1), (p0[0], p0[1], z1)]
+        triangles += [[quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]]
+    return np.array(triangles)
+
+
+def press_then_maybe_cut(cut):
+    """Held rendered force, then the rendered forces of the 60 ticks after the cut (or after
+    nothing, for cut False)."""
+    # A 6 x 6 x 1 cm slab held at its rim, pressed 2 mm at its centre by a 5 mm sphere through
+    # a haptic context (1 kHz ticks, full model at 60 Hz). Then a cylinder of radius 1.2 cm
+    # around the tool is cut through the slab: the plug under the tool is free, and nothing
+    # holds the tool back but the plug's inertia. The rendered force must fall below 10 % of
+    # its held value within one full-model period plus a few ticks (the issue's contract).
+    world = softhap.World(gravity=(0.0, 0.0, 0.0))
+    body = world.add_fem_body(box_mesh((0.06, 0.06, 0.01), (12, 12, 2)), young=2e4, poisson=0.3,
+                              damping_mass=5.0)
+    x = body.positions
+    rim = np.where((x[:, 0] < 1e-9) | (x[:, 0] > 0.06 - 1e-9) | (x[:, 1] < 1e-9) | (x[:, 1] > 0.06 - 1e-9))[0]
+    body.fix_nodes(rim)
+    top = 0.01 + 0.005
+    tool = world.add_tool("sphere", radius=0.005, stiffness=2e3, exponent=1.5, position=(0.03, 0.03, top))
+    haptic = world.add_haptic(tool, radius=0.02, dt=1e-3, max_force_rate=1e4, ramp_time=0.01)
+    pressed = (0.03, 0.03, top - 0.002)
+    tick, period = 1e-3, 1.0 / 60.0
+    forces = []
+    for k in range(600):  # 0.6 s pressed and held: settles (mass damping)
+        if k % 17 == 0:
+            tool.set_pose(pressed)
+            world.step(period)
+        forces.append(np.linalg.norm(haptic.step(pressed).force))
+    held = np.mean(forces[-50:])
+    if cut:
+        body.cut(ring_cut((0.03, 0.03), 0.012, -0.01, 0.02))
+    after = []
+    for k in range(60):
+        if k % 17 == 0:
+            tool.set_pose(pressed)
+            world.step(period)
+        after.append(np.linalg.norm(haptic.step(pressed).force))
+    return held, after
+
+
+def test_rendered_force_drops_when_the_pressed_plug_is_cut_free():
+    held, after = press_then_maybe_cut(True)
+    assert held > 1e-3  # the slab resists: there is a force to lose
+    within = int((1.0 / 60.0) / 1e-3) + 5  # one full-model period plus a few ticks
+    assert min(after[:within]) < 0.1 * held, (held, after[:within])
+
+
+def test_rendered_force_holds_without_the_cut():
+    # The control: the same press without the cut keeps its force over those ticks.
+    held, after = press_then_maybe_cut(False)
+    assert min(after[:22]) > 0.8 * held, (held, after[:22])

@@ -52,21 +52,23 @@ SH_API sh_status sh_body_cut(sh_world* world, sh_body_id body, const double* tri
     });
 }
 
-SH_API sh_status sh_body_get_tets(const sh_world* world, sh_body_id body, int32_t* out_tets, int32_t capacity) {
+/// The element getters of one body kind: checks the kind, then copies its connectivity.
+static sh_status get_elements(const sh_world* world, sh_body_id body, bool fem, int32_t* out, int32_t capacity,
+                              const char* function, const char* name, const char* items) {
     return capi::guard([&] {
         const Body& b = body_of(world, body);
-        require_kind(b, true, "sh_body_get_tets");
-        copy_elements(b, out_tets, capacity, "out_tets", "tets");
+        require_kind(b, fem, function);
+        copy_elements(b, out, capacity, name, items);
     });
+}
+
+SH_API sh_status sh_body_get_tets(const sh_world* world, sh_body_id body, int32_t* out_tets, int32_t capacity) {
+    return get_elements(world, body, true, out_tets, capacity, "sh_body_get_tets", "out_tets", "tets");
 }
 
 SH_API sh_status sh_body_get_springs(const sh_world* world, sh_body_id body, int32_t* out_springs,
                                      int32_t capacity) {
-    return capi::guard([&] {
-        const Body& b = body_of(world, body);
-        require_kind(b, false, "sh_body_get_springs");
-        copy_elements(b, out_springs, capacity, "out_springs", "springs");
-    });
+    return get_elements(world, body, false, out_springs, capacity, "sh_body_get_springs", "out_springs", "springs");
 }
 
 SH_API sh_status sh_body_get_surface_triangles(const sh_world* world, sh_body_id body, int32_t* out_triangles,

@@ -497,6 +497,67 @@ static void test_set_material_out_of_memory_changes_nothing(void** state) {
     assert_int_equal(failures, 0);
 }
 
+/* A cut that runs out of memory anywhere (the cut surface, the split, the separation, the
+ * body's new arrays, the world's resized step scratch) returns SH_ERR_OUT_OF_MEMORY and leaves
+ * the body exactly as it was: same topology, same positions. The body then still steps, and
+ * the cut that finally gets its memory cuts the bar in two (more nodes, a new version). */
+static void test_cut_out_of_memory_changes_nothing(void** state) {
+    (void)state;
+    reset_counts();
+    sh_world_def wd;
+    sh_world_def_default(&wd);
+    wd.error_estimate = 1;
+    sh_world* world = NULL;
+    assert_ok(sh_world_create(&wd, &world));
+    sh_mesh* mesh = sh_test_box(0.04, 0.01, 0.01, 4, 1, 1);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+    sh_body_id body;
+    assert_ok(sh_fem_body_create(world, &def, &body));
+    assert_ok(sh_mesh_destroy(mesh));
+    assert_ok(sh_world_step(world, 1e-3, NULL)); /* the body's solver state exists */
+    sh_body_info before, now;
+    assert_ok(sh_body_get_info(world, body, &before));
+    assert_true(before.node_count <= 64);
+    double x[3 * 64], x_now[3 * 64];
+    assert_ok(sh_body_get_positions(world, body, x, 64));
+    /* the plane x = 2.3 cm, crossing the bar's middle cells */
+    const double plane[18] = {0.023, -1, -1, 0.023, 1, -1, 0.023, 1, 1, 0.023, -1, -1, 0.023, 1, 1, 0.023, -1, 1};
+    int failures = 0;
+    long n = 0;
+    for (; n < 100000; ++n) {
+        reset_counts();
+        g.fail_after = n;
+        sh_cut_report report;
+        const sh_status status = sh_body_cut(world, body, plane, 2, &report);
+        const size_t failed = g.failed;
+        g.fail_after = -1;
+        if (failed == 0) {
+            assert_ok(status);
+            break;
+        }
+        assert_status(status, SH_ERR_OUT_OF_MEMORY);
+        assert_ok(sh_body_get_info(world, body, &now));
+        assert_ok(sh_body_get_positions(world, body, x_now, 64));
+        if (now.node_count != before.node_count || now.element_count != before.element_count ||
+            now.topology_version != before.topology_version ||
+            memcmp(x_now, x, sizeof(double) * 3 * (size_t)before.node_count) != 0) {
+            print_error("sh_body_cut failing after %ld allocations returned SH_ERR_OUT_OF_MEMORY but changed the body\n", n);
+            ++failures;
+        }
+        assert_ok(sh_world_step(world, 1e-3, NULL));
+        assert_ok(sh_body_get_positions(world, body, x, 64));
+    }
+    assert_true(n > 5); /* the cut does allocate: the failures above were tried */
+    assert_ok(sh_body_get_info(world, body, &now));
+    assert_true(now.node_count > before.node_count && now.topology_version > before.topology_version);
+    assert_ok(sh_world_step(world, 1e-3, NULL));
+    destroy_world_checking_leaks(world);
+    assert_int_equal(failures, 0);
+}
+
 /* The first implicit step builds the body's solver state (and, with the error estimate, the
  * half steps' own): running out of memory anywhere in it leaves positions, velocities and the
  * prescribed motion as they were, so the step then succeeds and the prescribed node still
@@ -709,6 +770,7 @@ int main(void) {
         cmocka_unit_test(test_remove_body_allocates_nothing),
         cmocka_unit_test(test_set_material_out_of_memory_changes_nothing),
         cmocka_unit_test(test_implicit_step_out_of_memory_changes_nothing),
+        cmocka_unit_test(test_cut_out_of_memory_changes_nothing),
         cmocka_unit_test(test_failing_allocator), /* last: a leak would stay behind */
     };
     return cmocka_run_group_tests(tests, setup_install, NULL);

@@ -4,7 +4,7 @@ PYTHON ?= python3
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-c test-python test-reduced demo palpation haptic-loop tsan asan fuzz bench report report-deps haptic-report press-report clean
+.PHONY: all deps build test test-c test-python test-reduced demo cutting palpation haptic-loop tsan asan fuzz bench report report-deps haptic-report press-report clean
 
 all: build
 
@@ -36,6 +36,13 @@ demo: build
 	$(BUILD)/examples/liver_sag
 	@mkdir -p frames
 	$(BUILD)/examples/haptic_loop > frames/haptic_loop.csv
+	$(BUILD)/examples/cutting > frames/cutting.csv
+
+# A scalpel draws a 5 cm incision across the liver on a table (~3 s of simulated time at
+# 60 Hz): .vtu frames of the cut liver in frames/, the force trace (CSV) in frames/cutting.csv.
+cutting: build
+	@mkdir -p frames
+	$(BUILD)/examples/cutting > frames/cutting.csv
 
 # A sphere tool presses into the liver on a table, slides and lifts off (~5 s): CSV of the tool
 # force on stdout, a summary on stderr.

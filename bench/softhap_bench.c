@@ -11,6 +11,8 @@
  *   softhap_bench haptic-force [--csv PATH]                 haptic force smoothness, VBM vs ZOH
  *   softhap_bench palpation [FILTER] [--meshes DIR]         a sphere pressed into the liver at 60 Hz
  *                                                           (implicit, per material; palpation.c)
+ *   softhap_bench cut [FILTER] [--reps N] [--meshes DIR]    sh_body_cut time vs body size and cut
+ *                                                           length, the implicit step after a cut (cut.c)
  *
  * Each case builds a world with one body from a mesh in ../shared/meshes (scaled so its largest
  * extent is kMeshSize), gravity on, the highest 1% of the nodes fixed, dt = kDtFraction * dt_crit
@@ -29,6 +31,7 @@
 
 #include "accuracy.h"
 #include "bench_util.h"
+#include "cut.h"
 #include "haptic.h"
 #include "palpation.h"
 
@@ -565,7 +568,7 @@ static void run_contact(const char* filter) {
 static void usage(void) {
     fprintf(stderr,
             "usage: softhap_bench [integrators|implicit|contact] [FILTER] [--steps N] [--meshes DIR]\n"
-            "       softhap_bench accuracy|haptic|haptic-error|haptic-force|palpation ... (see their --help)\n"
+            "       softhap_bench accuracy|haptic|haptic-error|haptic-force|palpation|cut ... (see their --help)\n"
             "  FILTER  keep the cases whose name contains it (e.g. stvk/raptorTetra_19409)\n"
             "  --steps N  timed steps per case (default: adaptive, %d..%d; implicit 100, contact 200)\n"
             "  --meshes DIR  mesh folder (default $SOFTHAP_MESHES, " SOFTHAP_BENCH_MESH_DIR
@@ -577,6 +580,7 @@ int main(int argc, char** argv) {
     if (argc > 1 && strcmp(argv[1], "accuracy") == 0) return run_accuracy(argc - 1, argv + 1);
     if (argc > 1 && is_haptic_command(argv[1])) return run_haptic(argc - 1, argv + 1);
     if (argc > 1 && strcmp(argv[1], "palpation") == 0) return run_palpation(argc - 1, argv + 1);
+    if (argc > 1 && strcmp(argv[1], "cut") == 0) return run_cut(argc - 1, argv + 1);
     const char* filter = NULL;
     int integrators = 0, implicit = 0, contact = 0;
     for (int i = 1; i < argc; ++i) {

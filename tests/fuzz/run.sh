@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target of tests/fuzz for a fixed time over its committed seeds
 # (corpus/<format>/) and regression files (regressions/<format>/), with the format's dictionary
-# when there is one. New inputs go to BUILD/fuzz-work/<format>/corpus (kept between local runs,
-# never into the committed corpus); a failing input goes to BUILD/fuzz-work/<format>/artifacts/.
+# when there is one. A "format" is a target's name without fuzz_: a mesh format, text, or cut
+# (fuzz_cut, whose input is a sequence of cuts and steps). New inputs go to
+# BUILD/fuzz-work/<format>/corpus (kept between local runs, never into the committed corpus); a
+# failing input goes to BUILD/fuzz-work/<format>/artifacts/.
 # Prints one line per target; on a failure, the end of its log. Exits non-zero if any failed.
 # Usage: tests/fuzz/run.sh BUILD SECONDS [FORMAT...]   (default: every format)
 set -euo pipefail
@@ -15,7 +17,7 @@ build=$1
 seconds=$2
 shift 2
 formats=("$@")
-[ ${#formats[@]} -gt 0 ] || formats=(gmsh vtk vtu tetgen text)
+[ ${#formats[@]} -gt 0 ] || formats=(gmsh vtk vtu tetgen text cut)
 here=$(cd "$(dirname "$0")" && pwd)
 
 # Stack traces for UBSan reports (which abort: the fuzzers are built with -fno-sanitize-recover).

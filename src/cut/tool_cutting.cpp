@@ -41,6 +41,20 @@ bool swept_blade(const Collider& tool, double triangles[18]) {
     return norm3(n0) > scale && norm3(n1) > scale;
 }
 
+/// True if the box around body's current nodes meets the box around triangles[18].
+bool near(const Body& body, const double triangles[18]) {
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) lo[k] = INFINITY, hi[k] = -INFINITY;
+    for (int32_t i = 0; i < body.node_count(); ++i)
+        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], at(body.x.data(), i)[k]), hi[k] = std::max(hi[k], at(body.x.data(), i)[k]);
+    for (int k = 0; k < 3; ++k) {
+        double a = INFINITY, b = -INFINITY;
+        for (int c = 0; c < 6; ++c) a = std::min(a, triangles[3 * c + k]), b = std::max(b, triangles[3 * c + k]);
+        if (a > hi[k] || b < lo[k]) return false;
+    }
+    return true;
+}
+
 /// Most triangles of a blade's swept surface kept per body: a blade advancing by at least
 /// 1/256 of an element per step still crosses whole elements with what is kept.
 constexpr size_t kKeptTriangles = 512;
@@ -63,6 +77,7 @@ public:
             double triangles[18];
             if (!tool.is_tool || !tool.cuts || !swept_blade(tool, triangles)) return;
             world.for_each_body([&](Id body_id, const Body& body) {
+                if (!near(body, triangles)) return;  // the blade is away from it
                 vec<double>& swept = swept_of(id, body_id);
                 for (int c = 0; c < 6; ++c) {
                     double rest[3];

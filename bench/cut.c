@@ -1,29 +1,37 @@
 /*
  * softhap_bench cut: the time of one sh_body_cut against body size and cut length, and the time
- * of the first implicit step after a cut (the solver re-analyses the new sparsity pattern)
- * against a step without one. One JSON line per case on stdout, progress on stderr.
+ * of the first implicit step after a cut (the solver analyses the new sparsity pattern) against
+ * a step without one. One JSON line per case on stdout, progress on stderr.
  *
- *   softhap_bench cut [FILTER] [--reps N] [--meshes DIR]
+ *   softhap_bench cut [FILTER] [--reps N] [--factor-reuse X] [--meshes DIR]
  *
  * FILTER keeps the cases whose name, cut/<mesh>/<kind>, contains it. --reps N: repetitions of
- * each single cut (default kReps, fewer if a case passes kCaseSeconds, at least kMinReps).
+ * each single cut (default kReps, fewer once a case has run kCaseSeconds, at least kMinReps).
+ * --factor-reuse X: the implicit settings' factor_reuse (default 0; the library's default, 0.25,
+ * lets a body at rest skip factorising, so that a step without a cut costs almost nothing).
  *
  * Meshes: liver2.msh scaled by 0.1 (as palpation), Armadillo_Tetra_4406.vtu and
  * raptorTetra_19409.vtu scaled to a largest extent of 0.15 m (as the step benches). Each is one
- * FEM body (StVK, E = 30 kPa, nu = 0.45, rho = 1000 kg/m^3, implicit Euler with its default
- * settings, dt = 1/60 s), gravity on, its lowest tenth fixed; kWarmSteps steps (the first builds
- * the solver) and kPlainSteps timed steps before the first cut. The cut surface is a blade: the
- * plane y = 0.47 of the box's depth, reaching past the box in z, run along x (cut_scene.c).
+ * FEM body (StVK, E = 30 kPa, nu = 0.45, rho = 1000 kg/m^3; implicit Euler, dt = 1/60 s, by
+ * default a fresh factorisation at every step, so that a step after a cut differs from one
+ * without only by what the cut costs the solver: the new pattern's analysis), gravity off (at rest: the step's cost is the
+ * solver's, not a swing's), its lowest tenth fixed; kWarmSteps steps (the first builds the
+ * solver), then kPlainSteps timed steps before the first cut. The cut surface is a blade
+ * (cut_scene.c): a plane across the box's shortest axis at 0.47 of it, run along the longest,
+ * reaching past the box along the third.
  * - single-<f>: one cut of the blade from one element before the box to fraction f of the way
- *   through it (0.25, 0.5, 1; 1 cuts the body in two along its length), on a fresh body each
- *   repetition;
- * - blade: the same surface in increments of one mean edge length, each quad continuing the
- *   last, as a blade advances: per increment one cut and two steps.
+ *   through it (0.25, 0.5, 1; 1 cuts the body in two), on a fresh body each repetition, then two
+ *   steps;
+ * - blade-<n>: the whole blade in increments of n mean edge lengths, each quad continuing the
+ *   last, as a blade advances; the two steps after each of the first kBladeSteps cuts that change
+ *   the topology.
  * Per case: the cut's time from sh_cut_report.seconds and the wall time around the call
- * (median, p99; s), tets and nodes added per cut (median, and the total of a blade), the lowest
- * piece quality; step times (median, p99; s) without a cut before ("plain"), the first after a
- * cut that changed the topology ("after_cut") and the second after it, with the factorisation
- * time and count the step report gives for each; steps that did not return SH_OK.
+ * (median, p99; s), tets and nodes added per cut (median, and in all), the lowest piece
+ * quality; for the steps without a cut before ("plain"), the first after a cut that changed the
+ * topology ("after_cut") and the second after it: their count, time and factorisation time
+ * (median, p99; s), factorisations and Newton iterations per step and the most sub-steps; the
+ * first after-cut step's median over the plain one's; steps that did not return SH_OK; the
+ * 1-minute load average (other processes slow every time).
  *
  * Public API only; C99 plus POSIX clocks.
  */
@@ -40,7 +48,8 @@
 
 static const double kDt = 1.0 / 60.0;    /* s: a host's sim thread at 60 Hz */
 static const double kCaseSeconds = 4.0;  /* repetitions of a single cut stop past this */
-enum { kReps = 10, kMinReps = 3, kWarmSteps = 1, kPlainSteps = 2 };
+static double g_factor_reuse = 0.0;      /* --factor-reuse */
+enum { kReps = 10, kMinReps = 3, kWarmSteps = 1, kPlainSteps = 2, kBladeSteps = 4 };
 
 /* A case: a single cut of the blade fraction of the way through the box (elements 0), or the
  * whole blade in increments of `elements` mean edge lengths. */
@@ -69,7 +78,7 @@ typedef struct {
     long factorizations, newton;
 } step_samples;
 
-/* Samples of one case; every array has room for capacity values. */
+/* Samples of one case; every array has room for as many values as samples_make was given. */
 typedef struct {
     int cuts;
     double *cut, *wall, *tets, *nodes; /* per cut: report.seconds, wall (s), tets and nodes added */
@@ -129,7 +138,7 @@ static void steps_after_cut(sh_world* world, cut_samples* s) {
 
 /* A fresh world holding m's body, past its warm-up and plain steps (timed into s). */
 static sh_world* warm_world(const cut_mesh* m, sh_body_id* body, cut_samples* s) {
-    sh_world* world = cut_world(m, body);
+    sh_world* world = cut_world(m, g_factor_reuse, body);
     sh_step_report r;
     for (int i = 0; i < kWarmSteps; ++i) step_timed(world, kDt, &r, &s->failed);
     for (int i = 0; i < kPlainSteps; ++i) timed_step(world, &s->plain, &s->failed);
@@ -150,8 +159,9 @@ static void single_rep(const cut_mesh* m, double fraction, cut_samples* s) {
     CHECK(sh_world_destroy(world));
 }
 
-/* The blade in increments of `elements` mean edges on one fresh body, one step after each cut (a
- * cut per frame). */
+/* The blade in increments of `elements` mean edges on one fresh body; after each of the first
+ * kBladeSteps cuts that change the topology, the two steps after it (a cut per frame; the rest
+ * of the blade is only cut, to keep the case short). */
 static void blade_run(const cut_mesh* m, int elements, cut_samples* s) {
     sh_body_id body;
     sh_world* world = warm_world(m, &body, s);
@@ -160,7 +170,7 @@ static void blade_run(const cut_mesh* m, int elements, cut_samples* s) {
         double tris[18];
         blade_quad(m, start + k * increment, fmin(start + (k + 1) * increment, end), tris);
         const timed_cut t = cut_timed(world, body, tris, 2);
-        timed_step(world, add_cut(s, &t) ? &s->after : &s->plain, &s->failed);
+        if (add_cut(s, &t) && s->after.count < kBladeSteps) steps_after_cut(world, s);
     }
     CHECK(sh_world_destroy(world));
 }
@@ -188,9 +198,9 @@ static void print_steps(const char* key, step_samples* s) {
 /* Case c's JSON line. */
 static void print_case(const char* name, const cut_mesh* m, const cut_case* c, cut_samples* s) {
     printf("{\"case\":\"%s\",\"mesh\":\"%s\",\"tets\":%d,\"nodes\":%d,\"cut\":\"%s\",\"length_m\":%.4g,"
-           "\"increment_m\":%.4g,\"cuts\":%d",
+           "\"increment_m\":%.4g,\"factor_reuse\":%g,\"cuts\":%d",
            name, m->name, m->tet_count, m->node_count, c->elements ? "blade" : "single",
-           blade_at(m, c->fraction) - blade_at(m, 0.0), c->elements * m->edge, s->cuts);
+           blade_at(m, c->fraction) - blade_at(m, 0.0), c->elements * m->edge, g_factor_reuse, s->cuts);
     print_quantiles("cut", s->cut, s->cuts);
     print_quantiles("wall", s->wall, s->cuts);
     const stats tets = summarize(s->tets, s->cuts), nodes = summarize(s->nodes, s->cuts);
@@ -199,8 +209,11 @@ static void print_case(const char* name, const cut_mesh* m, const cut_case* c, c
     print_steps("plain", &s->plain); /* sorts the step samples */
     print_steps("after_cut", &s->after);
     print_steps("second_after_cut", &s->second);
-    const double plain = median(s->plain.wall, s->plain.count), after = median(s->after.wall, s->after.count);
-    printf(",\"after_cut_over_plain\":%.3g,\"failed_steps\":%d}\n", s->after.count ? after / plain : 0.0, s->failed);
+    const double ratio = s->after.count && s->plain.count
+                             ? median(s->after.wall, s->after.count) / median(s->plain.wall, s->plain.count)
+                             : 0.0;
+    printf(",\"after_cut_over_plain\":%.3g,\"failed_steps\":%d,\"load_average\":%.2f}\n", ratio, s->failed,
+           bench_load_average(-1.0));
     fflush(stdout);
 }
 
@@ -227,7 +240,7 @@ static int mesh_wanted(const char* mesh, const char* filter) {
  * one blade; its JSON line. */
 static void run_case(const cut_mesh* m, const cut_case* c, const char* name, int reps) {
     const int count = reps > 0 ? reps : kReps;
-    cut_samples s = samples_make(c->elements ? kPlainSteps + blade_increments(m, c->elements) : kPlainSteps * count);
+    cut_samples s = samples_make(c->elements ? blade_increments(m, c->elements) + kPlainSteps : kPlainSteps * count);
     if (c->elements) {
         blade_run(m, c->elements, &s);
     } else {
@@ -243,9 +256,10 @@ static void run_case(const cut_mesh* m, const cut_case* c, const char* name, int
 
 /* The subcommand's usage on stderr. */
 static void usage(void) {
-    fprintf(stderr, "usage: softhap_bench cut [FILTER] [--reps N] [--meshes DIR]\n"
+    fprintf(stderr, "usage: softhap_bench cut [FILTER] [--reps N] [--factor-reuse X] [--meshes DIR]\n"
                     "  FILTER  keep the cases whose name contains it (cut/<mesh>/single-<f>, cut/<mesh>/blade-<n>)\n"
                     "  --reps N  repetitions of each single cut (default %d, fewer past %g s a case)\n"
+                    "  --factor-reuse X  the implicit body's factor_reuse, in [0, 1) (default 0: factorise every step)\n"
                     "  --meshes DIR  mesh folder holding liver2.msh and the .vtu meshes\n",
                     kReps, kCaseSeconds);
 }
@@ -260,6 +274,8 @@ int run_cut(int argc, char** argv) {
             given_dir = argv[++i];
         } else if (strcmp(argv[i], "--reps") == 0 && i + 1 < argc && (reps = atoi(argv[i + 1])) >= 1) {
             ++i;
+        } else if (strcmp(argv[i], "--factor-reuse") == 0 && i + 1 < argc) {
+            g_factor_reuse = atof(argv[++i]);
         } else {
             const int code = bench_filter_arg(argv[i], &filter, usage);
             if (code >= 0) return code;

@@ -97,10 +97,11 @@ void cut_mesh_free(cut_mesh* m) {
     free(m->fixed);
 }
 
-sh_world* cut_world(const cut_mesh* m, sh_body_id* body) {
+sh_world* cut_world(const cut_mesh* m, double factor_reuse, sh_body_id* body) {
     sh_world* world = bench_world_create(0);
     sh_fem_body_def def = bench_fem_body_def(m->mesh, SH_MATERIAL_STVK, kYoung, kPoisson, kDensity);
     def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+    def.implicit.factor_reuse = factor_reuse;
     CHECK(sh_fem_body_create(world, &def, body));
     CHECK(sh_body_fix_nodes(world, *body, m->fixed, m->fixed_count));
     return world;

@@ -30,9 +30,10 @@ int cut_mesh_load(const char* dir, const char* file, const char* name, double sc
 /* Frees what cut_mesh_load made. */
 void cut_mesh_free(cut_mesh* m);
 
-/* A world without gravity holding one FEM body of m (soft tissue, implicit Euler, its base fixed),
+/* A world without gravity holding one FEM body of m (soft tissue, implicit Euler with the given
+ * factor_reuse (sh_implicit_settings; 0: a fresh factorisation at every step), its base fixed),
  * at rest; the body's id in *body. */
-sh_world* cut_world(const cut_mesh* m, sh_body_id* body);
+sh_world* cut_world(const cut_mesh* m, double factor_reuse, sh_body_id* body);
 
 /* Where along the run axis the blade has gone fraction of the way through the box (fraction 0:
  * one element before it; 1: one element past it). */

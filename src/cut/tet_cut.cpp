@@ -194,12 +194,12 @@ vec<int32_t> TetCut::bad_pieces(const FemBody& body, double largest_omega2) cons
     vec<int32_t> found;
     for (const Piece& piece : pieces) {
         if (!split[static_cast<size_t>(piece.candidate)] || (!found.empty() && found.back() == piece.candidate)) continue;
-        double r[4][3];
-        for (int a = 0; a < 4; ++a) node_position(body, piece.node[a], body.rest.data(), r[a]);
-        const double q = tet_quality(r[0], r[1], r[2], r[3]);
+        vec<double> rest_points(12);  // the piece's corners at rest, 3 each
+        for (int a = 0; a < 4; ++a) node_position(body, piece.node[a], body.rest.data(), &rest_points[3 * static_cast<size_t>(a)]);
+        const double* r = rest_points.data();
+        const double q = tet_quality(r, r + 3, r + 6, r + 9);
         bool bad = q < kMinQuality;
         if (!bad) {
-            vec<double> rest_points(r[0], r[0] + 12);
             const int32_t local[4] = {0, 1, 2, 3};
             double bm[9], v0 = 0.0;
             FemBody::shape_from_rest(rest_points, local, bm, v0);

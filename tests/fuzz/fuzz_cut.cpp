@@ -1,26 +1,30 @@
 // libFuzzer target: sh_body_cut on small bodies, interleaved with sh_world_step. Each input runs
-// in a fresh world holding three bodies made from one structured box (0.125 m, 4 x 4 x 4 cubes of
-// 6 tets: 125 nodes, 384 tets; the nodes at z = 0 fixed, gravity on): an FEM body stepped with
-// symplectic Euler, an FEM body stepped with implicit Euler, and a mass-spring body on the box's
-// edges. They do not touch each other (body contact is opt-in), so they share one place.
+// in a fresh world holding two bodies made from one structured box (0.125 x 0.125 x 0.09375 m,
+// 4 x 4 x 3 cubes of 6 tets: 100 nodes, 288 tets; the nodes at z = 0 fixed, gravity on): an FEM
+// body and a mass-spring body on the box's edges. They do not touch each other (body contact is
+// opt-in), so they share one place.
 //
-// Input: up to kMaxOps operations, each a control byte c and what it needs:
-// - c % 4 = 0, 1, 2: cut body c % 4 (explicit FEM, implicit FEM, springs) with 1 + (c >> 2) % 8
+// Input: a setup byte, then up to kMaxOps operations. The setup byte's bit 0 steps the FEM body
+// with implicit Euler (else symplectic Euler), bits 1-2 choose its material model (sh_material
+// _model). An operation is a control byte c and what it needs:
+// - c % 4 = 0, 1 (FEM body) or 2 (mass-spring body): a cut of that body with 1 + (c >> 2) % 8
 //   triangles; bit 5 passes a NULL report. A triangle is a shape byte s and its three corners:
 //   bits 2k, 2k + 1 of s say where corner k comes from: 0 read here (three coordinates), 1-3 the
 //   last, second-last or third-last corner of this cut (repeated corners: degenerate triangles,
-//   or triangles welded along an edge, such as a quad's two halves). A coordinate is one byte
-//   b: below 0xF0 the grid coordinate (b - 56) / 1024 m (exact: the box's node planes are at
-//   b = 56, 88, 120, 152, 184; the range reaches 0.05 m past the box on each side); 0xF0 and up
-//   a special value (kSpecial below: NaN, infinities, huge, tiny, subnormal, -0, just off a
-//   grid value (one more byte), or any double (eight more bytes, little-endian)).
+//   or triangles welded along an edge, such as a quad's two halves), read here too if the cut
+//   has fewer corners so far. A coordinate is one byte b: below 0xF0 the grid coordinate
+//   (b - 56) / 1024 m (exact: the box's node planes are at b = 56, 88, 120, ...; the range
+//   reaches 0.05 m past the box on each side); 0xF0 and up a special value (kSpecial below: NaN,
+//   infinities, huge, tiny, subnormal, -0; a grid value nudged by 1e-13, an ulp or 1e-9,
+//   halfway to the next, or scaled by 1e-3 (one more byte); any double (eight more bytes,
+//   little-endian)).
 // - c % 4 = 3: one sh_world_step of kStepDt[(c >> 2) % 4] (at most kMaxSteps per input).
 // An input that ends inside an operation stops there.
 //
 // After every cut (tests/fuzz/fuzz_check.hpp's violated() aborts otherwise):
-// - the status is SH_OK or SH_ERR_INVALID_ARGUMENT; the latter exactly when a corner is not
-//   finite, never when every triangle is plainly valid (finite, |coordinate| <= 1e3, area well
-//   above zero: plainly_valid), its message naming "triangles[";
+// - the status is SH_OK or SH_ERR_INVALID_ARGUMENT: the latter whenever a corner is not finite,
+//   never when every triangle is plainly valid (finite, |coordinate| <= 1e3, area well above
+//   zero: plainly_valid), and with a message naming "triangles[";
 // - refused: the body is as it was (node and element counts, topology_version, mass, positions
 //   bit for bit, elements, surface);
 // - done: the total mass is the body's initial one (1e-9 relative); no node is lost and the
@@ -53,8 +57,8 @@ constexpr int kCells[3] = {4, 4, 3};      // cubes along x, y, z
 constexpr double kCube = 1.0 / 32;        // m: a cube's side, a power of two so node planes are exact
 constexpr double kGridStep = 1.0 / 1024;  // m per grid coordinate step
 constexpr int kGridOrigin = 56;           // the byte of coordinate 0
-constexpr int kMaxOps = 16;
-constexpr int kMaxSteps = 4;
+constexpr int kMaxOps = 8;
+constexpr int kMaxSteps = 3;
 constexpr int kBodies = 2;
 constexpr double kStepDt[4] = {1e-3, 4e-3, 1.0 / 60.0, 1e-2};  // s
 constexpr double kTolerance = 1e-9;       // relative, for mass and volume
@@ -105,7 +109,8 @@ const sh_mesh* box_mesh() {
     return mesh.get();
 }
 
-/// The world and its bodies, with what a cut must keep: each body's mass and its own node count.
+/// The world and its bodies (the FEM body, the mass-spring body), with what a cut must keep: each
+/// body's mass and its own node count.
 struct Scene {
     WorldPtr world;
     sh_body_id bodies[kBodies] = {};

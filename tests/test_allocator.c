@@ -497,6 +497,24 @@ static void test_set_material_out_of_memory_changes_nothing(void** state) {
     assert_int_equal(failures, 0);
 }
 
+/* A world with the error estimate on and an implicit FEM bar of length (m) x 1 x 1 cm in
+ * cells x 1 x 1 cubes, its id in *body. */
+static sh_world* implicit_bar(double length, int cells, sh_body_id* body) {
+    sh_world_def wd;
+    sh_world_def_default(&wd);
+    wd.error_estimate = 1;
+    sh_world* world = NULL;
+    assert_ok(sh_world_create(&wd, &world));
+    sh_mesh* mesh = sh_test_box(length, 0.01, 0.01, cells, 1, 1);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+    assert_ok(sh_fem_body_create(world, &def, body));
+    assert_ok(sh_mesh_destroy(mesh));
+    return world;
+}
+
 /* A cut that runs out of memory anywhere (the cut surface, the split, the separation, the
  * body's new arrays, the world's resized step scratch) returns SH_ERR_OUT_OF_MEMORY and leaves
  * the body exactly as it was: same topology, same positions. The body then still steps, and
@@ -504,19 +522,8 @@ static void test_set_material_out_of_memory_changes_nothing(void** state) {
 static void test_cut_out_of_memory_changes_nothing(void** state) {
     (void)state;
     reset_counts();
-    sh_world_def wd;
-    sh_world_def_default(&wd);
-    wd.error_estimate = 1;
-    sh_world* world = NULL;
-    assert_ok(sh_world_create(&wd, &world));
-    sh_mesh* mesh = sh_test_box(0.04, 0.01, 0.01, 4, 1, 1);
-    sh_fem_body_def def;
-    sh_fem_body_def_default(&def);
-    def.mesh = mesh;
-    def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
     sh_body_id body;
-    assert_ok(sh_fem_body_create(world, &def, &body));
-    assert_ok(sh_mesh_destroy(mesh));
+    sh_world* world = implicit_bar(0.04, 4, &body);
     assert_ok(sh_world_step(world, 1e-3, NULL)); /* the body's solver state exists */
     sh_body_info before, now;
     assert_ok(sh_body_get_info(world, body, &before));
@@ -565,19 +572,8 @@ static void test_cut_out_of_memory_changes_nothing(void** state) {
 static void test_implicit_step_out_of_memory_changes_nothing(void** state) {
     (void)state;
     reset_counts();
-    sh_world_def wd;
-    sh_world_def_default(&wd);
-    wd.error_estimate = 1;
-    sh_world* world = NULL;
-    assert_ok(sh_world_create(&wd, &world));
-    sh_mesh* mesh = sh_test_box(0.02, 0.01, 0.01, 2, 1, 1);
-    sh_fem_body_def def;
-    sh_fem_body_def_default(&def);
-    def.mesh = mesh;
-    def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
     sh_body_id body;
-    assert_ok(sh_fem_body_create(world, &def, &body));
-    assert_ok(sh_mesh_destroy(mesh));
+    sh_world* world = implicit_bar(0.02, 2, &body);
     sh_body_info info;
     assert_ok(sh_body_get_info(world, body, &info));
     assert_true(info.node_count <= 64);

@@ -1,6 +1,7 @@
 #include "cut/separation.hpp"
 
 #include "cut/tet_cut.hpp"
+#include "mesh/tet_mesh.hpp"
 
 #include <algorithm>
 #include <numeric>
@@ -10,11 +11,9 @@ namespace {
 
 using Face = std::array<int32_t, 3>;
 
-// A tet's faces as corner triples.
-constexpr int kFace[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
 
 Face sorted_face(const int32_t* tet, int f) {
-    Face face{tet[kFace[f][0]], tet[kFace[f][1]], tet[kFace[f][2]]};
+    Face face{tet[kTetFaces[f][0]], tet[kTetFaces[f][1]], tet[kTetFaces[f][2]]};
     std::sort(face.begin(), face.end());
     return face;
 }

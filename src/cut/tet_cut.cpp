@@ -181,8 +181,8 @@ void TetCut::node_position(const FemBody& body, int32_t node, const double* posi
         for (int k = 0; k < 3; ++k) out[k] = at(positions, node)[k];
         return;
     }
-    const Edge& ed = node >= kProvisional ? edges_[static_cast<size_t>(node - kProvisional)]
-                                          : *std::find_if(edges_.begin(), edges_.end(), [&](const Edge& e) { return e.node == node; });
+    const Edge& ed = edges_[node >= kProvisional ? static_cast<size_t>(node - kProvisional)
+                                                 : new_node_edge_[static_cast<size_t>(node - body.node_count())]];
     for (int k = 0; k < 3; ++k) out[k] = (1.0 - ed.t) * at(positions, ed.lo)[k] + ed.t * at(positions, ed.hi)[k];
 }
 
@@ -216,6 +216,7 @@ void TetCut::number_new_nodes(int32_t node_count) {
         if (!ed.cut) continue;
         ed.node = node_count + static_cast<int32_t>(origins.size());
         origins.push_back(NodeOrigin{ed.lo, ed.hi, ed.t});
+        new_node_edge_.push_back(static_cast<size_t>(&ed - edges_.data()));
     }
 }
 

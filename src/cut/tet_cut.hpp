@@ -96,6 +96,7 @@ private:
     vec<Edge> edges_;           ///< their edges, by (lo, hi)
     vec<int32_t> tet_edge_;     ///< 6 per candidate: its edges' slots in edges_
     vec<int32_t> nodes_;        ///< the candidates' nodes, ascending
+    vec<size_t> new_node_edge_; ///< per new node (in origins' order): its edge's slot
     vec<uint8_t> on_;           ///< per entry of nodes_: the cut goes through it
 };
 

@@ -16,8 +16,6 @@ std::string tet_name(const MeshData& data, size_t t) {
     return format("tet %zu", t);
 }
 
-// Faces of tet (0,1,2,3) oriented outward for a positively oriented tet.
-constexpr int kFaces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
 
 void build_edges(TetMesh& mesh) {
     const int32_t tet_count = mesh.tet_count();
@@ -46,7 +44,7 @@ vec<int32_t> boundary_triangles(const int32_t* tets, size_t tet_count) {
     faces.reserve(tet_count * 4);
     for (size_t t = 0; t < tet_count; ++t) {
         const int32_t* tet = &tets[4 * t];
-        for (const auto& f : kFaces) {
+        for (const auto& f : kTetFaces) {
             Face face{{tet[f[0]], tet[f[1]], tet[f[2]]}, {tet[f[0]], tet[f[1]], tet[f[2]]}};
             std::sort(face.key.begin(), face.key.end());
             faces.push_back(face);

@@ -40,6 +40,9 @@ struct TetMesh {
 /// zero-volume tets; flips inverted tets and counts them.
 TetMesh build_tet_mesh(MeshData data, const std::string& origin);
 
+/// The faces of a tet (corners 0..3) as corner triples, outward for a positively oriented tet.
+constexpr int kTetFaces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+
 /// The faces of tets[0..tet_count) (4 node indices each, positively oriented) that belong to
 /// one tet only, 3 node indices each, outward (counter-clockwise seen from outside).
 vec<int32_t> boundary_triangles(const int32_t* tets, size_t tet_count);

@@ -55,7 +55,8 @@ def test_blade_through_the_block_separates_it_in_two_equal_halves():
     reports = drag(world, tool, 0.017, 130, speed=1.0)
     assert components(body.tets, body.node_count) == 2
     assert sum(r.cut_faces for r in reports) > 0
-    assert all(r.topology_seconds >= 0.0 for r in reports)
+    # the steps that cut report time spent on it
+    assert all(r.topology_seconds > 0.0 for r in reports if r.cut_faces > 0)
     assert body.masses.sum() == pytest.approx(mass, rel=1e-12)  # cutting conserves mass
     x, tets = body.positions, body.tets
     a, b, c, d = (x[tets[:, i]] for i in range(4))

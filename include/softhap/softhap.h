@@ -671,6 +671,12 @@ typedef struct sh_cut_def {
                                       frame (m), distinct; default (0, 0, -5 mm) to (0, 0, 5 mm) */
     double sharpness;            /**< blade sharpness kappa (dimensionless, > 0; 1 = a scalpel),
                                       for criteria that weigh it; default 1 */
+    double resolution;           /**< edge length (m, >= 0) the material is refined to around
+                                      the blade's edge and the path of its ends before it cuts,
+                                      so that the opening reaches to within about this of the
+                                      blade on a coarse mesh (a cut parts whole tet faces);
+                                      0 (default) = a quarter of the blade's length; a length
+                                      above the mesh's elements refines nothing */
 } sh_cut_def;
 
 /** Fill a cut def with defaults. Thread: any. Alloc: none. */
@@ -704,7 +710,8 @@ SH_API sh_status sh_body_get_surface_triangles(const sh_world* world, sh_body_id
 
 /** Copy each node's parent (node_count values: the node it was made from by a cut, -1 for the
  *  body's own nodes) into out_parents, room for capacity nodes. A copy's parent is the node
- *  copied; a node made on a cut edge has the edge's nearer end. Alloc: none. */
+ *  copied; a node made on a cut edge has the edge's nearer end, and one a cutting tool's
+ *  refinement makes at an edge's midpoint has the edge's lower-numbered end. Alloc: none. */
 SH_API sh_status sh_body_get_node_parents(const sh_world* world, sh_body_id body,
                                           int32_t* out_parents, int32_t capacity);
 

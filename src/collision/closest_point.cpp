@@ -46,6 +46,17 @@ double closest_on_triangle(const double* p, const double* a, const double* b, co
     return std::sqrt(dot3(d, d));
 }
 
+double distance_to_segment(const double* p, const double* a, const double* b) {
+    double ab[3], ap[3];
+    sub3(b, a, ab);
+    sub3(p, a, ap);
+    const double length2 = dot3(ab, ab);
+    const double t = length2 > 0.0 ? std::min(std::max(dot3(ap, ab) / length2, 0.0), 1.0) : 0.0;
+    double d[3];
+    for (int k = 0; k < 3; ++k) d[k] = ap[k] - t * ab[k];
+    return std::sqrt(dot3(d, d));
+}
+
 namespace {
 
 // Where p lies against the plane of triangle (a, b, c): its height above it along the outward

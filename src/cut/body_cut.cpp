@@ -3,19 +3,35 @@
 #include "core/clock.hpp"
 #include "core/vec3.hpp"
 #include "cut/cut_surface.hpp"
+#include "cut/refinement.hpp"
 #include "cut/separation.hpp"
 #include "cut/tet_cut.hpp"
 #include "model/fem_body.hpp"
 #include "model/spring_body.hpp"
 #include "world/world.hpp"
 
+#include <algorithm>
+
 namespace sh {
 namespace {
 
-void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report) {
+/// Adds to on_nodes (ascending) the new nodes numbered from first that origins[k] makes
+/// between two of its nodes (or as a copy of one).
+void extend_on_nodes(vec<int32_t>& on_nodes, const vec<NodeOrigin>& origins, int32_t first) {
+    const auto on = [&](int32_t node) { return std::binary_search(on_nodes.begin(), on_nodes.end(), node); };
+    vec<int32_t> added;  // ascending, as the new nodes are numbered
+    const auto on_or_added = [&](int32_t node) { return on(node) || std::binary_search(added.begin(), added.end(), node); };
+    for (size_t k = 0; k < origins.size(); ++k)
+        if (on_or_added(origins[k].a) && on_or_added(origins[k].b)) added.push_back(first + static_cast<int32_t>(k));
+    on_nodes.insert(on_nodes.end(), added.begin(), added.end());
+    std::sort(on_nodes.begin(), on_nodes.end());
+}
+
+void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report,
+             vec<int32_t>* on_nodes) {
     // A surface in the material frame is a tool's growing sweep, cut with again at every step:
     // the quality guard's choices depend on the pieces already there and would not repeat.
-    TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data(), !at_rest);
+    TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data(), !at_rest, on_nodes);
     const int32_t node_count = body.node_count(), tet_count = body.element_count();
     report.faces_separated = separate(cut, node_count);
     report.min_quality = cut.min_quality;
@@ -26,6 +42,12 @@ void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool
     world.topology_changed(id, prepared);
     report.nodes_added = body.node_count() - node_count;
     report.tets_added = body.element_count() - tet_count;
+    if (on_nodes) {
+        on_nodes->insert(on_nodes->end(), cut.cut_nodes.begin(), cut.cut_nodes.end());
+        std::sort(on_nodes->begin(), on_nodes->end());
+        on_nodes->erase(std::unique(on_nodes->begin(), on_nodes->end()), on_nodes->end());
+        extend_on_nodes(*on_nodes, cut.origins, node_count);  // the copies of nodes on the cut
+    }
 }
 
 void cut_springs(World& world, Id id, SpringBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report) {
@@ -48,14 +70,15 @@ void cut_springs(World& world, Id id, SpringBody& body, const CutSurface& surfac
 }
 
 /// Cuts body id along triangles given against its current (at_rest false) or rest positions.
-void cut_in_frame(World& world, Id id, const double* triangles, int32_t count, bool at_rest, sh_cut_report& report) {
+void cut_in_frame(World& world, Id id, const double* triangles, int32_t count, bool at_rest, sh_cut_report& report,
+                  vec<int32_t>* on_nodes) {
     const double start = now_seconds();
     Body& body = world.body(id);
     const CutSurface surface(triangles, count);
     report = sh_cut_report{};
     report.min_quality = 1.0;
     if (body.is_fem())
-        cut_fem(world, id, static_cast<FemBody&>(body), surface, at_rest, report);
+        cut_fem(world, id, static_cast<FemBody&>(body), surface, at_rest, report, on_nodes);
     else
         cut_springs(world, id, static_cast<SpringBody&>(body), surface, at_rest, report);
     report.seconds = now_seconds() - start;
@@ -63,12 +86,31 @@ void cut_in_frame(World& world, Id id, const double* triangles, int32_t count, b
 
 }  // namespace
 
-void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {
-    cut_in_frame(world, id, triangles, count, false, report);
+int32_t refine_body_near(World& world, Id id, const double* segments, int32_t segment_count, double edge_length,
+                         vec<int32_t>* on_nodes) {
+    Body& found = world.body(id);
+    if (!found.is_fem()) return 0;
+    FemBody& body = static_cast<FemBody&>(found);
+    // One refinement adds at most about a body's worth of tets, so a misjudged length cannot
+    // run away with the memory.
+    Refinement refined = refine_near(body, segments, segment_count, edge_length, std::max(body.element_count(), 4096));
+    if (refined.origins.empty()) return 0;
+    const int32_t node_count = body.node_count(), tet_count = body.element_count();
+    TopologyScratch prepared;
+    world.prepare_topology_change(id, node_count + static_cast<int32_t>(refined.origins.size()), prepared);
+    body.retopologize(refined.origins.data(), refined.origins.size(), std::move(refined.tets), refined.source);
+    world.topology_changed(id, prepared);
+    if (on_nodes) extend_on_nodes(*on_nodes, refined.origins, node_count);
+    return body.element_count() - tet_count;
 }
 
-void cut_body_at_rest(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {
-    cut_in_frame(world, id, triangles, count, true, report);
+void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {
+    cut_in_frame(world, id, triangles, count, false, report, nullptr);
+}
+
+void cut_body_at_rest(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report,
+                      vec<int32_t>* on_nodes) {
+    cut_in_frame(world, id, triangles, count, true, report, on_nodes);
 }
 
 }  // namespace sh

@@ -1,6 +1,7 @@
 #include "cut/tet_cut.hpp"
 
 #include "cut/cut_surface.hpp"
+#include "cut/edge_split.hpp"
 #include "core/vec3.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "model/fem_body.hpp"
@@ -24,11 +25,12 @@ const int32_t* corners(const FemBody& body, int32_t t) { return body.element_nod
 
 }  // namespace
 
-TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality)
+TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality,
+               const vec<int32_t>* known_on)
     : frame_(frame) {
     find_candidates(body, surface);
     find_edges(body, surface);
-    snap_earlier_cut_nodes(body, surface);
+    snap_earlier_cut_nodes(body, surface, known_on);
     mark_cut_edges();
     if (guard_quality) settle(body);
     number_new_nodes(body.node_count());
@@ -87,7 +89,10 @@ void TetCut::find_edges(const FemBody& body, const CutSurface& surface) {
     }
 }
 
-void TetCut::snap_earlier_cut_nodes(const FemBody& body, const CutSurface& surface) {
+void TetCut::snap_earlier_cut_nodes(const FemBody& body, const CutSurface& surface, const vec<int32_t>* known_on) {
+    if (known_on)
+        for (size_t i = 0; i < nodes_.size(); ++i)
+            if (std::binary_search(known_on->begin(), known_on->end(), nodes_[i])) on_[i] = 1;
     // Nodes an earlier cut made lie on its surface, so a later cut that passes within a
     // quarter edge of them (extending the earlier one from its border) goes through them.
     vec<double> shortest(nodes_.size(), INFINITY);
@@ -96,8 +101,13 @@ void TetCut::snap_earlier_cut_nodes(const FemBody& body, const CutSurface& surfa
         sub3(at(frame_, ed.hi), at(frame_, ed.lo), d);
         for (const int32_t node : {ed.lo, ed.hi}) shortest[node_slot(node)] = std::min(shortest[node_slot(node)], norm3(d));
     }
+    // A node made by a cut lies on the body's surface (on a cut face); nodes made inside by
+    // refinement ahead of a blade have parents too but lie on no cut.
+    vec<int32_t> surface_nodes(body.surface_triangles.begin(), body.surface_triangles.end());
+    std::sort(surface_nodes.begin(), surface_nodes.end());
     for (size_t i = 0; i < nodes_.size(); ++i) {
         if (on_[i] || body.parent_of(nodes_[i]) < 0) continue;
+        if (!std::binary_search(surface_nodes.begin(), surface_nodes.end(), nodes_[i])) continue;
         int32_t triangle = -1;
         if (std::fabs(surface.signed_distance(at(frame_, nodes_[i]), triangle)) < kSnap * shortest[i]) on_[i] = 1;
     }
@@ -145,32 +155,27 @@ vec<TetCut::Piece> TetCut::bisect(bool final_numbers) const {
     // Pieces of different candidates never share a split, so each candidate is split alone,
     // with its own crossed edges in the global order.
     vec<Piece> pieces(candidates_.size());
+    vec<std::array<int32_t, 4>> split;
     for (size_t c = 0; c < candidates_.size(); ++c) {
-        std::copy(&corner_[4 * c], &corner_[4 * c] + 4, pieces[c].node);
-        pieces[c].candidate = static_cast<int32_t>(c);
         int32_t slots[6], crossed = 0;
         for (int e = 0; e < 6; ++e)
             if (edge(static_cast<int32_t>(c), e).cut) slots[crossed++] = tet_edge_[6 * c + static_cast<size_t>(e)];
         std::sort(slots, slots + crossed);
-        vec<size_t> mine(1, c);  // this candidate's pieces
+        EdgeSplit splits[6];
         for (int k = 0; k < crossed; ++k) {
             const Edge& ed = edges_[static_cast<size_t>(slots[k])];
-            const int32_t middle = final_numbers ? ed.node : kProvisional + slots[k];
-            const size_t count = mine.size();
-            for (size_t m = 0; m < count; ++m) {
-                Piece& piece = pieces[mine[m]];
-                int lo = -1, hi = -1;
-                for (int a = 0; a < 4; ++a) {
-                    if (piece.node[a] == ed.lo) lo = a;
-                    if (piece.node[a] == ed.hi) hi = a;
-                }
-                if (lo < 0 || hi < 0) continue;
-                Piece other = piece;
-                piece.node[hi] = middle;  // the half at lo
-                other.node[lo] = middle;  // the half at hi
-                mine.push_back(pieces.size());
-                pieces.push_back(other);
-            }
+            splits[k] = {ed.lo, ed.hi, final_numbers ? ed.node : kProvisional + slots[k]};
+        }
+        split.clear();
+        split_tet(&corner_[4 * c], splits, crossed, split);
+        for (size_t m = 0; m < split.size(); ++m) {
+            Piece piece;
+            std::copy(split[m].begin(), split[m].end(), piece.node);
+            piece.candidate = static_cast<int32_t>(c);
+            if (m == 0)
+                pieces[c] = piece;
+            else
+                pieces.push_back(piece);
         }
     }
     return pieces;
@@ -247,16 +252,25 @@ void TetCut::add_pieces(const FemBody& body, const vec<Piece>& pieces) {
 
 int8_t TetCut::side_of_tet(const FemBody& body, const CutSurface& surface, const int32_t* tet) const {
     // The corner off the surface farthest from it decides; corners on the surface (nodes the
-    // cut goes through, nodes made on crossed edges) have no side.
-    double farthest = 0.0;
+    // cut goes through, nodes made on crossed edges) have no side. A tet whose corners are all
+    // on the surface (a thin one, its nodes passed through within the snapping distance) lies
+    // on the side its centre does.
+    double farthest = 0.0, centre[3] = {0, 0, 0};
     for (int a = 0; a < 4; ++a) {
         const int32_t node = tet[a];
+        double p[3];
+        node_position(body, node, frame_, p);
+        for (int k = 0; k < 3; ++k) centre[k] += 0.25 * p[k];
         if (node >= body.node_count()) continue;
         const size_t slot = node_slot(node);
         if (slot < nodes_.size() && nodes_[slot] == node && on_[slot]) continue;
         int32_t triangle = -1;
         const double d = surface.signed_distance(at(frame_, node), triangle);
         if (std::fabs(d) > std::fabs(farthest)) farthest = d;
+    }
+    if (farthest == 0.0) {
+        int32_t triangle = -1;
+        farthest = surface.signed_distance(centre, triangle);
     }
     return farthest > 0.0 ? 1 : (farthest < 0.0 ? -1 : 0);
 }

@@ -29,7 +29,10 @@ public:
     /// would make a piece below the quality bound, or too stiff for 0.3 of the uncut body's
     /// critical step, go through a node instead. (Without it, cutting again along the same
     /// surface finds the same crossings: a sweep that is cut with again as it grows.)
-    TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality);
+    /// Nodes listed in known_on (ascending; may be null) lie on the surface whatever their
+    /// distance from it: the nodes an earlier cut along a part of the same surface went through.
+    TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality,
+           const vec<int32_t>* known_on = nullptr);
 
     /// New nodes (appended after the body's), each on a crossed edge.
     vec<NodeOrigin> origins;
@@ -67,7 +70,7 @@ private:
 
     void find_candidates(const FemBody& body, const CutSurface& surface);
     void find_edges(const FemBody& body, const CutSurface& surface);
-    void snap_earlier_cut_nodes(const FemBody& body, const CutSurface& surface);
+    void snap_earlier_cut_nodes(const FemBody& body, const CutSurface& surface, const vec<int32_t>* known_on);
     void settle(const FemBody& body);
     void mark_cut_edges();
     void snap_nearest_end(int32_t candidate);

@@ -9,6 +9,7 @@
 #include "world/world.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <utility>
 
@@ -39,6 +40,28 @@ bool swept_blade(const Collider& tool, double triangles[18]) {
     cross3(d0, d1, n1);
     const double scale = 1e-6 * dot3(e, e);
     return norm3(n0) > scale && norm3(n1) > scale;
+}
+
+/// The four sides of the quad that triangles[18] (as swept_blade makes them) cover: the blade's
+/// edge at the start and at the target, and the paths of its two ends (6 doubles each).
+std::array<double, 24> quad_sides(const double triangles[18]) {
+    // Corners 0, 1, 2 and 5 are the edge's start ends a0, b0, then its target ends b1, a1.
+    const int around[5] = {0, 1, 2, 5, 0};
+    std::array<double, 24> sides;
+    for (int s = 0; s < 4; ++s)
+        for (int k = 0; k < 3; ++k) {
+            sides[6 * static_cast<size_t>(s) + static_cast<size_t>(k)] = triangles[3 * around[s] + k];
+            sides[6 * static_cast<size_t>(s) + 3 + static_cast<size_t>(k)] = triangles[3 * around[s + 1] + k];
+        }
+    return sides;
+}
+
+/// The edge length a tool's cut refines the material to (sh_cut_def.resolution).
+double resolution(const sh_cut_def& def) {
+    if (def.resolution > 0.0) return def.resolution;
+    double d[3];
+    sub3(def.edge[1], def.edge[0], d);
+    return norm3(d) / 4.0;
 }
 
 /// True if the box around body's current nodes meets the box around triangles[18].
@@ -78,15 +101,15 @@ public:
             if (!tool.is_tool || !tool.cuts || !swept_blade(tool, triangles)) return;
             world.for_each_body([&](Id body_id, const Body& body) {
                 if (!near(body, triangles)) return;  // the blade is away from it
-                vec<double>& swept = swept_of(id, body_id);
-                for (int c = 0; c < 6; ++c) {
-                    double rest[3];
-                    to_rest(body, &triangles[3 * c], rest);
-                    swept.insert(swept.end(), rest, rest + 3);
-                }
+                double rest[18];
+                for (int c = 0; c < 6; ++c) to_rest(body, &triangles[3 * c], &rest[3 * c]);
+                Sweep& sweep = sweep_of(id, body_id);
+                refine_body_near(world, body_id, quad_sides(rest).data(), 4, resolution(tool.cutting), &sweep.on_nodes);
+                vec<double>& swept = sweep.triangles;
+                swept.insert(swept.end(), rest, rest + 18);
                 if (swept.size() > 9 * kKeptTriangles) swept.erase(swept.begin(), swept.end() - 9 * kKeptTriangles);
                 sh_cut_report cut{};
-                cut_body_at_rest(world, body_id, swept.data(), static_cast<int32_t>(swept.size() / 9), cut);
+                cut_body_at_rest(world, body_id, swept.data(), static_cast<int32_t>(swept.size() / 9), cut, &sweep.on_nodes);
                 report.cut_faces += cut.faces_separated;
             });
         });
@@ -103,13 +126,14 @@ private:
     struct Sweep {
         Id tool, body;
         vec<double> triangles;  ///< 9 per triangle
+        vec<int32_t> on_nodes;  ///< the nodes the cut along it went through, ascending
     };
 
-    vec<double>& swept_of(Id tool, Id body) {
+    Sweep& sweep_of(Id tool, Id body) {
         for (Sweep& s : swept_)
-            if (s.tool == tool && s.body == body) return s.triangles;
-        swept_.push_back({tool, body, vec<double>()});
-        return swept_.back().triangles;
+            if (s.tool == tool && s.body == body) return s;
+        swept_.push_back({tool, body, vec<double>(), vec<int32_t>()});
+        return swept_.back();
     }
 
     void forget_gone(const World& world) {
@@ -131,6 +155,8 @@ void validate(const sh_cut_def& def) {
     SH_REQUIRE(norm3(d) > 0.0, SH_ERR_INVALID_ARGUMENT, "def->edge[0] and def->edge[1] coincide: a blade needs a length");
     SH_REQUIRE(std::isfinite(def.sharpness) && def.sharpness > 0.0, SH_ERR_INVALID_ARGUMENT,
                "def->sharpness = %g, must be finite and > 0", def.sharpness);
+    SH_REQUIRE(std::isfinite(def.resolution) && def.resolution >= 0.0, SH_ERR_INVALID_ARGUMENT,
+               "def->resolution = %g, must be finite and >= 0", def.resolution);
 }
 
 }  // namespace

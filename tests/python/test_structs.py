@@ -73,7 +73,7 @@ def test_sizes_computed_by_hand():
     assert ctypes.sizeof(_lib.sh_world_def) == 40  # u32, pad 4, 3 doubles, i32, pad 4
     assert ctypes.sizeof(_lib.sh_step_report) == 144  # ... 88, i32, pad 4, 2 doubles, i32, pad 4,
     # double, i32, i32, double
-    assert ctypes.sizeof(_lib.sh_cut_def) == 64  # u32, i32, 6 doubles, double
+    assert ctypes.sizeof(_lib.sh_cut_def) == 72  # u32, i32, 6 doubles, 2 doubles
     assert ctypes.sizeof(_lib.sh_mesh_info) == 88  # 7 int32, pad 4, 7 doubles
     assert ctypes.sizeof(_lib.sh_material) == 32
     assert ctypes.sizeof(_lib.sh_fem_body_def) == 128  # 80 + sh_implicit_settings

@@ -344,6 +344,7 @@ class sh_cut_def(Structure):
         ("criterion", c_int32),
         ("edge", (c_double * 3) * 2),
         ("sharpness", c_double),
+        ("resolution", c_double),
     ]
 
 

@@ -173,6 +173,7 @@ class Tool(_Collider):
         edge: Optional[ArrayLike] = ((0.0, 0.0, -0.005), (0.0, 0.0, 0.005)),
         criterion: str = "geometric",
         sharpness: float = 1.0,
+        resolution: float = 0.0,
     ) -> None:
         """Make the tool a cutting tool, or an ordinary one again with ``set_cutting(None)``.
 
@@ -180,7 +181,10 @@ class Tool(_Collider):
         World.step the surface the edge sweeps from the tool's last pose to its new pose cuts
         every body it passes through (see Body.cut); the report's cut_faces and
         topology_seconds count it. criterion: "geometric" (the material the edge sweeps
-        separates). sharpness: the blade's kappa (> 0)."""
+        separates). sharpness: the blade's kappa (> 0). resolution: the edge length (m) the
+        material is refined to around the blade's edge and the path of its ends before it
+        cuts, so that the opening reaches to within about this of the blade on a coarse mesh;
+        0 means a quarter of the blade's length."""
         handle = self._world_handle("sh_tool_set_cutting")
         if edge is None:
             check(lib.sh_tool_set_cutting(handle, self._cid, None), "sh_tool_set_cutting")
@@ -196,6 +200,7 @@ class Tool(_Collider):
             for k in range(3):
                 raw.edge[e][k] = float(points[e, k])
         raw.sharpness = float(sharpness)
+        raw.resolution = float(resolution)
         check(lib.sh_tool_set_cutting(handle, self._cid, ctypes.byref(raw)), "sh_tool_set_cutting")
 
     def wrench(self) -> Tuple[np.ndarray, np.ndarray]:

@@ -311,6 +311,8 @@ typedef struct sh_step_report {
                                       its inner radius per sub-step (1 = none) */
     int32_t cut_faces;           /**< faces that cutting tools separated in this step */
     double topology_seconds;     /**< time in cuts and topology updates in this step (s) */
+    int32_t springs_broken;      /**< springs that tore (sh_spring_params.break_strain) at the
+                                      start of this step */
 } sh_step_report;
 
 /** Advance every body by dt seconds with its own integrator. A body whose step is rejected
@@ -492,6 +494,10 @@ typedef struct sh_spring_params {
     const double* table;   /**< table: rows of (strain, force N), strain strictly increasing,
                                 copied at creation */
     int32_t table_rows;    /**< table: number of rows, >= 2 */
+    double break_strain;   /**< every law: a spring stretched beyond this strain (l / l0 - 1,
+                                >= 0) breaks at the start of the next step, and a node left
+                                holding pieces joined only through it is split (tearing);
+                                0 (default) = never breaks */
 } sh_spring_params;
 
 /** Definition of a mass-spring body. Initialise with sh_spring_body_def_default. Nodes come

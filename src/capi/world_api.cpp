@@ -3,6 +3,7 @@
 #include "capi/handles.hpp"
 #include "capi/world_handle.hpp"
 #include "core/enum_value.hpp"
+#include "cut/tearing.hpp"
 #include "material/material_params.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "model/fem_body.hpp"
@@ -248,6 +249,7 @@ SH_API sh_status sh_spring_body_create(sh_world* world, const sh_spring_body_def
                 if (!mesh->node_used[i]) masses[i] = 0.0;  // orphans stay out of the dynamics
         const StepSettings settings = step_settings(*def);
         const double damping_mass = checked_damping_mass(*def);
+        if (def->params.break_strain > 0.0) enable_tearing(w);  // before the body: it can fail alone
         out_body->value = w.add_body(
             sh::create<SpringBody>(std::move(nodes), std::move(springs), def->params, masses, damping_mass), settings);
     });

@@ -37,9 +37,49 @@ SpringBody::SpringBody(vec<double> nodes, vec<int32_t> springs, const sh_spring_
         }
         SH_REQUIRE(l2 > 0.0, SH_ERR_INVALID_ARGUMENT, "spring %zu (nodes %d, %d) has zero rest length", s_i, a, b);
         rest_length_[s_i] = std::sqrt(l2);
+        original_.push_back({std::min(a, b), std::max(a, b)});
     }
+    SH_REQUIRE(std::isfinite(params.break_strain) && params.break_strain >= 0.0, SH_ERR_INVALID_ARGUMENT,
+               "params.break_strain = %g, must be finite and >= 0", params.break_strain);
+    break_strain_ = params.break_strain;
+    std::sort(original_.begin(), original_.end());
     row_bound_.resize(static_cast<size_t>(n));
     update_inverse_mass();
+}
+
+vec<uint8_t> SpringBody::overstretched(const double* xs) const {
+    vec<uint8_t> over(rest_length_.size(), 0);
+    if (!(break_strain_ > 0.0)) return over;
+    for (size_t s = 0; s < rest_length_.size(); ++s) {
+        const size_t a = static_cast<size_t>(springs_[2 * s]), b = static_cast<size_t>(springs_[2 * s + 1]);
+        double l2 = 0.0;
+        for (int k = 0; k < 3; ++k) l2 += (xs[3 * b + k] - xs[3 * a + k]) * (xs[3 * b + k] - xs[3 * a + k]);
+        over[s] = std::sqrt(l2) > (1.0 + break_strain_) * rest_length_[s] ? 1 : 0;
+    }
+    return over;
+}
+
+int32_t SpringBody::root_of(int32_t node) const {
+    while (parent_of(node) >= 0) node = parent_of(node);
+    return node;
+}
+
+bool SpringBody::were_joined(int32_t a, int32_t b) const {
+    a = root_of(a), b = root_of(b);
+    return std::binary_search(original_.begin(), original_.end(), std::make_pair(std::min(a, b), std::max(a, b)));
+}
+
+void SpringBody::retopologize(const vec<NodeOrigin>& copies, vec<int32_t> springs, vec<double> rest_lengths,
+                              const vec<double>& masses) {
+    GrownNodes grown = grow_nodes(copies.data(), copies.size());
+    grown.mass = masses;
+    vec<double> row_bound(grown.mass.size());
+    adopt_nodes(grown);
+    springs_.swap(springs);
+    rest_length_.swap(rest_lengths);
+    row_bound_.swap(row_bound);
+    ++topology_version;
+    ++matrix_version;
 }
 
 int32_t SpringBody::remove_springs(const vec<uint8_t>& broken) {

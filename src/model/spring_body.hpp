@@ -4,6 +4,8 @@
 #include "material/spring_laws.hpp"
 #include "model/body.hpp"
 
+#include <utility>
+
 namespace sh {
 
 /// Mass-spring body. Rest lengths are the initial lengths.
@@ -31,9 +33,32 @@ public:
     /// allocation changes nothing. Returns how many went.
     int32_t remove_springs(const vec<uint8_t>& broken);
 
+    /// The strain beyond which a spring breaks (sh_spring_params.break_strain; 0 = never).
+    double break_strain() const { return break_strain_; }
+
+    /// Per spring: 1 if it is stretched beyond break_strain at positions xs, else 0.
+    vec<uint8_t> overstretched(const double* xs) const;
+
+    /// The springs (2 node indices each) and their rest lengths (m).
+    const vec<int32_t>& springs() const { return springs_; }
+    const vec<double>& rest_lengths() const { return rest_length_; }
+
+    /// True if the nodes a and b descend from (through node_parent) were joined by a spring
+    /// when the body was made.
+    bool were_joined(int32_t a, int32_t b) const;
+
+    /// Adopts a new spring list with rest lengths, nodes appended as copies (origins with
+    /// a == b) and every node's mass (the old nodes' and the copies'); bumps topology_version
+    /// and matrix_version. A failed allocation changes nothing.
+    void retopologize(const vec<NodeOrigin>& copies, vec<int32_t> springs, vec<double> rest_lengths, const vec<double>& masses);
+
 private:
+    int32_t root_of(int32_t node) const;
+
     vec<int32_t> springs_;      ///< 2 per spring
     vec<double> rest_length_;   ///< l0 per spring (m)
+    double break_strain_ = 0.0; ///< see break_strain
+    vec<std::pair<int32_t, int32_t>> original_;  ///< the springs at creation, (lo, hi), sorted
     SpringLaw law_;
     mutable vec<double> row_bound_;  ///< stable_step scratch: Gershgorin row sums per node
 };

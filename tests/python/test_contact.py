@@ -75,7 +75,8 @@ def test_new_struct_sizes_computed_by_hand():
     assert _lib.sh_step_report.contact_substeps.offset == 128
     # ... and by cut_faces (i32, in contact_substeps' padding) and topology_seconds
     assert _lib.sh_step_report.cut_faces.offset == 132
-    assert ctypes.sizeof(_lib.sh_step_report) == 144
+    assert _lib.sh_step_report.springs_broken.offset == 144
+    assert ctypes.sizeof(_lib.sh_step_report) == 152
     new = {"sh_shape", "sh_contact_params", "sh_collider_def", "sh_contact_state"}
     assert new <= set(_lib.STRUCTS)  # so test_structs.py checks them against the C compiler
 

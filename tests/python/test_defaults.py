@@ -71,6 +71,7 @@ CASES += [
         "damping": "params.damping",
         "lambda1": "params.lambda1",
         "a": "params.a",
+        "break_strain": "params.break_strain",
         "mass": "node_mass",
     }),
     (softhap.Body.set_material, "sh_fem_body_def_default", _lib.sh_fem_body_def, MATERIAL),

@@ -71,14 +71,14 @@ def test_field_offsets_match_c(c_layout, name):
 def test_sizes_computed_by_hand():
     # Independent of any compiler: the x86-64/aarch64 SysV layout worked out from the header.
     assert ctypes.sizeof(_lib.sh_world_def) == 40  # u32, pad 4, 3 doubles, i32, pad 4
-    assert ctypes.sizeof(_lib.sh_step_report) == 144  # ... 88, i32, pad 4, 2 doubles, i32, pad 4,
-    # double, i32, i32, double
+    assert ctypes.sizeof(_lib.sh_step_report) == 152  # ... 88, i32, pad 4, 2 doubles, i32, pad 4,
+    # double, i32, i32, double, i32, pad 4
     assert ctypes.sizeof(_lib.sh_cut_def) == 72  # u32, i32, 6 doubles, 2 doubles
     assert ctypes.sizeof(_lib.sh_mesh_info) == 88  # 7 int32, pad 4, 7 doubles
     assert ctypes.sizeof(_lib.sh_material) == 32
     assert ctypes.sizeof(_lib.sh_fem_body_def) == 128  # 80 + sh_implicit_settings
-    assert ctypes.sizeof(_lib.sh_spring_params) == 72
-    assert ctypes.sizeof(_lib.sh_spring_body_def) == 208  # 160 + sh_implicit_settings
+    assert ctypes.sizeof(_lib.sh_spring_params) == 80  # int, pad 4, 6 doubles, pointer, i32, pad 4, double
+    assert ctypes.sizeof(_lib.sh_spring_body_def) == 216  # 168 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_body_info) == 48  # 4 int32, 2 doubles, 2 int32, uint64
     assert ctypes.sizeof(_lib.sh_cut_report) == 40  # 4 int32, 2 doubles, 2 int32
     assert ctypes.sizeof(_lib.sh_implicit_settings) == 48  # i32 x2, 2 doubles, i32, pad 4, double, i32, pad 4

@@ -40,7 +40,7 @@ def test_empty_world_steps_and_reports():
             "newton_iterations", "linear_iterations", "newton_residual", "factorize_seconds",
             "solve_seconds", "factorizations", "error_estimate", "error_estimate_seconds",
             "contact_count", "collision_seconds", "contact_substeps", "cut_faces",
-            "topology_seconds",
+            "topology_seconds", "springs_broken",
         }
         with pytest.raises(AttributeError):
             report.no_such_field

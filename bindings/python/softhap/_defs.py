@@ -262,6 +262,7 @@ def _spring_law(
     for name in ("stiffness", "damping", "lambda1", "lambda2", "a", "b"):
         if name in accepted and arguments.get(name) is not None:
             setattr(params, name, float(arguments[name]))
+    params.break_strain = float(arguments.get("break_strain", 0.0))
     table = arguments.get("table")
     if table is not None:
         table_array = _arrays.float_array(table, "table", (None, 2))

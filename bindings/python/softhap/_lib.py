@@ -223,6 +223,7 @@ class sh_step_report(Structure):
         ("contact_substeps", c_int32),
         ("cut_faces", c_int32),
         ("topology_seconds", c_double),
+        ("springs_broken", c_int32),
     ]
 
 
@@ -281,6 +282,7 @@ class sh_spring_params(Structure):
         ("b", c_double),
         ("table", POINTER(c_double)),
         ("table_rows", c_int32),
+        ("break_strain", c_double),
     ]
 
 

@@ -99,7 +99,8 @@ class World(WorldContacts):
         with tools or obstacles: contact_count (contact points at the step's end state),
         collision_seconds and contact_substeps (sub-steps taken so that no tool moves more
         than half its inner radius at once; 1 = none); with cutting: cut_faces (faces cutting
-        tools separated) and topology_seconds).
+        tools separated), springs_broken (springs torn past their break_strain) and
+        topology_seconds).
 
         If a body's step failed (rejected or rolled back: SH_ERR_UNSTABLE; an implicit body's
         SH_ERR_SOLVER or SH_ERR_NOT_CONVERGED) that body is as before and the other bodies still
@@ -218,6 +219,7 @@ class World(WorldContacts):
         a: float = default(0.0),
         b: Optional[float] = None,
         table: Optional[ArrayLike] = None,
+        break_strain: float = 0.0,
         linear_solver: str = "default",
         newton_max_iterations: int = 1,
         newton_tolerance: float = 1e-6,
@@ -240,6 +242,9 @@ class World(WorldContacts):
             "hyperbolic": T = dx / (a |dx| + b), a (1/N), b (m/N; b > 0 has no default);
             "table": table, rows of (strain, force N), strain strictly increasing;
             every law also takes damping c (N s/m).
+        break_strain: a spring stretched beyond this strain (l / l0 - 1) breaks at the start
+            of the next step, and a node left holding pieces joined only through it is split
+            (tearing; the step report's springs_broken counts them); 0 = never.
         mass: a scalar mass per node (kg) or an array of n masses.
         integrator, on_unstable, damping_mass (1/s), runaway_speed (m/s) and the implicit
             settings (linear_solver, newton_max_iterations, ...): as add_fem_body.

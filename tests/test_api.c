@@ -951,6 +951,60 @@ static void test_spring_law_errors(void** state) {
     assert_ok(sh_world_destroy(world));
 }
 
+/* Tearing: a negative or non-finite break strain is an error naming it; a spring stretched past
+ * a valid one breaks at the start of the next step and the report counts it. */
+static void test_spring_break_strain(void** state) {
+    (void)state;
+    sh_world* world = sh_test_world(0.0);
+    const double nodes[6] = {0, 0, 0, 0.01, 0, 0};
+    const int32_t one_spring[2] = {0, 1};
+    sh_spring_body_def def;
+    two_node_def(&def, nodes, one_spring);
+    assert_true(def.params.break_strain == 0.0); /* the default: never tears */
+    def.params.break_strain = -0.1;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "break_strain");
+    def.params.break_strain = NAN;
+    EXPECT_SPRING_ERROR(&def, SH_ERR_INVALID_ARGUMENT, "break_strain");
+    def.params.break_strain = 0.5;
+    sh_body_id body = SH_NULL_ID;
+    assert_ok(sh_spring_body_create(world, &def, &body));
+    /* 1 cm to 1.4 cm: strain 0.4, below 0.5; then 1.6 cm: strain 0.6, above. */
+    const double stretched[2][6] = {{0, 0, 0, 0.014, 0, 0}, {0, 0, 0, 0.016, 0, 0}};
+    const int32_t expected[2] = {0, 1};
+    for (int k = 0; k < 2; ++k) {
+        assert_ok(sh_body_set_positions(world, body, stretched[k], 2));
+        sh_step_report report;
+        assert_ok(sh_world_step(world, 1e-9, &report));
+        assert_int_equal(report.springs_broken, expected[k]);
+    }
+    sh_body_info info;
+    assert_ok(sh_body_get_info(world, body, &info));
+    assert_int_equal(info.element_count, 0);
+    assert_ok(sh_world_destroy(world));
+}
+
+/* A cutting tool's resolution must be finite and >= 0; a refused definition changes nothing. */
+static void test_cut_def_resolution(void** state) {
+    (void)state;
+    sh_world* world = make_world();
+    sh_collider_def tool_def;
+    sh_collider_def_default(&tool_def);
+    sh_tool_id tool = SH_NULL_ID;
+    assert_ok(sh_tool_create(world, &tool_def, &tool));
+    sh_cut_def cut;
+    sh_cut_def_default(&cut);
+    assert_true(cut.resolution == 0.0); /* the default: a quarter of the blade */
+    const double bad[3] = {-0.001, NAN, INFINITY};
+    for (int k = 0; k < 3; ++k) {
+        cut.resolution = bad[k];
+        assert_error(sh_tool_set_cutting(world, tool, &cut), SH_ERR_INVALID_ARGUMENT, "resolution");
+    }
+    cut.resolution = 0.002;
+    assert_ok(sh_tool_set_cutting(world, tool, &cut));
+    assert_ok(sh_tool_set_cutting(world, tool, NULL));
+    assert_ok(sh_world_destroy(world));
+}
+
 /* Measured-curve springs: tables that are not strictly increasing in strain, not finite, too
  * short or missing are errors naming the table; a valid one makes a body. */
 static void test_spring_table_errors(void** state) {
@@ -1433,6 +1487,8 @@ int main(void) {
         cmocka_unit_test(test_spring_def_topology_errors),
         cmocka_unit_test(test_spring_law_errors),
         cmocka_unit_test(test_spring_table_errors),
+        cmocka_unit_test(test_spring_break_strain),
+        cmocka_unit_test(test_cut_def_resolution),
         cmocka_unit_test_setup_teardown(test_step_rejects_bad_dt, setup_moved_box_and_spring, teardown_moved_box),
         cmocka_unit_test_setup_teardown(test_set_state_rejects_non_finite_and_wrong_counts, setup_moved_box, teardown_moved_box),
         cmocka_unit_test_setup_teardown(test_get_capacity_too_small, setup_moved_box, teardown_moved_box),

@@ -130,12 +130,8 @@ Torn tear(const SpringBody& body, const vec<uint8_t>& broken) {
 }
 
 /// Tears every mass-spring body with a breaking strain before the step's motion.
-class Tearing final : public StepHook {
+class Tearing final : public BeforeMotionHook {
 public:
-    void before_step(World&) override {}
-    void after_step(World&, double) override {}
-    void detach() override {}
-
     void before_motion(World& world, sh_step_report& report) override {
         const double start = now_seconds();
         bool any = false;
@@ -160,15 +156,6 @@ public:
 
 }  // namespace
 
-void enable_tearing(World& world) {
-    if (world.owned_hook(&kTearingKey)) return;
-    Tearing* hook = sh::create<Tearing>();
-    try {
-        world.own_hook(hook, &kTearingKey);
-    } catch (...) {
-        sh::destroy(hook);
-        throw;
-    }
-}
+void enable_tearing(World& world) { world.own_hook_once<Tearing>(&kTearingKey); }
 
 }  // namespace sh

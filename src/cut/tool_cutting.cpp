@@ -87,12 +87,8 @@ constexpr size_t kKeptTriangles = 512;
 /// swept is kept and cut with whole; it is kept in each body's rest shape (the material
 /// frame), where it stays with the material as the body moves, so that cutting again along
 /// where the blade has been finds the same faces and shaves nothing off them.
-class ToolCutting final : public StepHook {
+class ToolCutting final : public BeforeMotionHook {
 public:
-    void before_step(World&) override {}
-    void after_step(World&, double) override {}
-    void detach() override {}
-
     void before_motion(World& world, sh_step_report& report) override {
         const double start = now_seconds();
         forget_gone(world);
@@ -164,15 +160,7 @@ void validate(const sh_cut_def& def) {
 void set_tool_cutting(World& world, Id id, const sh_cut_def* def) {
     Collider& tool = world.collider(id, true);
     if (def) validate(*def);
-    if (def && !world.owned_hook(&kCuttingKey)) {
-        ToolCutting* hook = sh::create<ToolCutting>();
-        try {
-            world.own_hook(hook, &kCuttingKey);
-        } catch (...) {
-            sh::destroy(hook);
-            throw;
-        }
-    }
+    if (def) world.own_hook_once<ToolCutting>(&kCuttingKey);
     tool.cuts = def != nullptr;
     if (def) tool.cutting = *def;
     if (StepHook* hook = world.owned_hook(&kCuttingKey)) static_cast<ToolCutting*>(hook)->forget(id);

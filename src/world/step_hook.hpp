@@ -39,4 +39,13 @@ public:
     virtual void detach() = 0;
 };
 
+/// A hook that only changes the scene before each step's motion (cutting, tearing): its other
+/// calls do nothing.
+class BeforeMotionHook : public StepHook {
+public:
+    void before_step(World&) override {}
+    void after_step(World&, double) override {}
+    void detach() override {}
+};
+
 }  // namespace sh

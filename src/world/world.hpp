@@ -115,6 +115,21 @@ public:
     /// The hook owned under key, or null.
     StepHook* owned_hook(const void* key) const;
 
+    /// The Hook owned under key, made (default-constructed) and owned first if there is none.
+    /// Throws std::bad_alloc owning nothing new.
+    template <class Hook>
+    Hook& own_hook_once(const void* key) {
+        if (StepHook* found = owned_hook(key)) return static_cast<Hook&>(*found);
+        Hook* hook = sh::create<Hook>();
+        try {
+            own_hook(hook, key);
+        } catch (...) {
+            sh::destroy(hook);
+            throw;
+        }
+        return *hook;
+    }
+
     /// The contact state of body id after the last step, or null if it has none yet.
     const BodyContacts* contacts_of(Id id) const;
 

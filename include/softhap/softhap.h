@@ -427,10 +427,14 @@ typedef struct sh_material {
     double young;            /**< Young's modulus E (Pa), > 0 */
     double poisson;          /**< Poisson's ratio nu (dimensionless), in (-1, 0.5) */
     double density;          /**< mass density rho (kg/m^3), > 0 */
+    double toughness;        /**< fracture toughness G_c (J/m^2, >= 0): the energy a crack
+                                  needs per unit area of new crack, read by cutting tools with
+                                  SH_CUT_PHYSICAL; 0 = never breaks that way. Liver about
+                                  200, skin 1000-3000 */
 } sh_material;
 
 /** Fill a material with the defaults of soft tissue: StVK, E = 3 kPa, nu = 0.45,
- *  rho = 1000 kg/m^3. Thread: any. Alloc: none. */
+ *  rho = 1000 kg/m^3, toughness 200 J/m^2 (liver). Thread: any. Alloc: none. */
 SH_API void sh_material_default(sh_material* material);
 
 /** @} */
@@ -666,7 +670,12 @@ SH_API sh_status sh_body_cut(sh_world* world, sh_body_id body, const double* tri
 /** When a cutting tool breaks the material its blade reaches. */
 typedef enum sh_cut_criterion {
     SH_CUT_GEOMETRIC = 0,  /**< the blade separates whatever its edge sweeps through */
-    SH_CUT_CRITERION_COUNT = 1 /**< number of criteria, not a criterion */
+    SH_CUT_PHYSICAL = 1,   /**< the blade's edge holds the material just ahead of it and drags
+                                it along; the material breaks one resolution ahead once the
+                                work the blade did since the last break pays for that crack:
+                                toughness / sharpness times the engaged length times the
+                                resolution (an energy balance, Griffith's) */
+    SH_CUT_CRITERION_COUNT = 2 /**< number of criteria, not a criterion */
 } sh_cut_criterion;
 
 /** How a tool cuts. */

@@ -174,6 +174,7 @@ SH_API void sh_material_default(sh_material* material) {
     material->young = 3000.0;
     material->poisson = 0.45;
     material->density = 1000.0;
+    material->toughness = 200.0;
 }
 
 SH_API void sh_fem_body_def_default(sh_fem_body_def* def) {

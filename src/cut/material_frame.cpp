@@ -38,25 +38,39 @@ void nearest_node_offset(const Body& body, const double p[3], double out[3]) {
 
 }  // namespace
 
-void to_rest(const Body& body, const double p[3], double out[3]) {
-    if (body.nodes_per_element() != 4 || body.element_count() == 0) return nearest_node_offset(body, p, out);
-    double best_w[4] = {0, 0, 0, 0}, best_inside = -INFINITY;
-    const int32_t* best_tet = nullptr;
+RestPoint rest_point(const Body& body, const double p[3]) {
+    RestPoint found;
+    if (body.nodes_per_element() != 4 || body.element_count() == 0) {
+        nearest_node_offset(body, p, found.position);
+        return found;
+    }
+    double best_w[4] = {0, 0, 0, 0};
+    found.inside = -INFINITY;
     for (int32_t t = 0; t < body.element_count(); ++t) {
         const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(t);
         double w[4];
         if (!weights_in(body.x.data(), tet, p, w)) continue;
         const double inside = std::fmin(std::fmin(w[0], w[1]), std::fmin(w[2], w[3]));  // >= 0 inside
-        if (inside <= best_inside) continue;
-        best_inside = inside, best_tet = tet;
+        if (inside <= found.inside) continue;
+        found.inside = inside, found.tet = t;
         for (int a = 0; a < 4; ++a) best_w[a] = w[a];
         if (inside >= 0.0) break;
     }
-    if (!best_tet) return nearest_node_offset(body, p, out);
-    for (int k = 0; k < 3; ++k) {
-        out[k] = 0.0;
-        for (int a = 0; a < 4; ++a) out[k] += best_w[a] * at(body.rest.data(), best_tet[a])[k];
+    if (found.tet < 0) {
+        nearest_node_offset(body, p, found.position);
+        return found;
     }
+    const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(found.tet);
+    for (int k = 0; k < 3; ++k) {
+        found.position[k] = 0.0;
+        for (int a = 0; a < 4; ++a) found.position[k] += best_w[a] * at(body.rest.data(), tet[a])[k];
+    }
+    return found;
+}
+
+void to_rest(const Body& body, const double p[3], double out[3]) {
+    const RestPoint found = rest_point(body, p);
+    for (int k = 0; k < 3; ++k) out[k] = found.position[k];
 }
 
 }  // namespace sh

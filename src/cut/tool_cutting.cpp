@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "core/vec3.hpp"
 #include "cut/body_cut.hpp"
+#include "cut/breaking.hpp"
 #include "cut/material_frame.hpp"
 #include "world/world.hpp"
 
@@ -93,46 +94,120 @@ public:
         const double start = now_seconds();
         forget_gone(world);
         world.for_each_collider([&](Id id, const Collider& tool) {
-            double triangles[18];
-            if (!tool.is_tool || !tool.cuts || !swept_blade(tool, triangles)) return;
+            if (!tool.is_tool || !tool.cuts) return;
             world.for_each_body([&](Id body_id, const Body& body) {
-                if (!near(body, triangles)) return;  // the blade is away from it
-                double rest[18];
-                for (int c = 0; c < 6; ++c) to_rest(body, &triangles[3 * c], &rest[3 * c]);
-                Sweep& sweep = sweep_of(id, body_id);
-                refine_body_near(world, body_id, quad_sides(rest).data(), 4, resolution(tool.cutting), &sweep.on_nodes);
-                vec<double>& swept = sweep.triangles;
-                swept.insert(swept.end(), rest, rest + 18);
-                if (swept.size() > 9 * kKeptTriangles) swept.erase(swept.begin(), swept.end() - 9 * kKeptTriangles);
-                sh_cut_report cut{};
-                cut_body_at_rest(world, body_id, swept.data(), static_cast<int32_t>(swept.size() / 9), cut, &sweep.on_nodes);
-                report.cut_faces += cut.faces_separated;
+                report.cut_faces += tool.cutting.criterion == SH_CUT_PHYSICAL ? break_ahead(world, id, tool, body_id, body)
+                                                                             : cut_swept(world, id, tool, body_id, body);
             });
         });
         report.topology_seconds += now_seconds() - start;
     }
 
-    /// Forgets what tool id's blade swept (it stopped cutting).
-    void forget(Id tool) {
+    /// A physical blade feels the material it holds: its force joins the tool's reaction.
+    void after_step(World& world, double) override {
+        for (const Sweep& sweep : swept_) {
+            if (sweep.breaking.held.empty() || !world.is_valid(sweep.body)) continue;
+            Collider& tool = world.collider(sweep.tool, true);
+            double force[3], arm[3], torque[3];
+            blade_force(world.body(sweep.body), sweep.breaking, force);
+            double a[3], b[3];
+            tool.target.to_world(tool.cutting.edge[0], a);
+            tool.target.to_world(tool.cutting.edge[1], b);
+            for (int k = 0; k < 3; ++k) arm[k] = 0.5 * (a[k] + b[k]) - tool.target.p[k];
+            cross3(arm, force, torque);
+            for (int k = 0; k < 3; ++k) tool.state.force[k] += force[k], tool.state.torque[k] += torque[k];
+        }
+    }
+
+    /// Forgets what tool id's blade swept (it stopped cutting), letting go what it held.
+    void forget(World& world, Id tool) {
+        for (Sweep& s : swept_)
+            if (s.tool == tool && world.is_valid(s.body)) release(world.body(s.body), s.breaking);
         swept_.erase(std::remove_if(swept_.begin(), swept_.end(), [&](const Sweep& s) { return s.tool == tool; }), swept_.end());
     }
 
 private:
-    /// What one tool's blade swept through one body, in the body's rest shape.
+    /// What one tool's blade swept (or broke) through one body, in the body's rest shape.
     struct Sweep {
         Id tool, body;
         vec<double> triangles;  ///< 9 per triangle
         vec<int32_t> on_nodes;  ///< the nodes the cut along it went through, ascending
+        BreakState breaking;    ///< the physical criterion's hold and count
     };
+
+    /// The geometric criterion: cuts body along what the blade swept from its start pose to
+    /// its target pose, with what it swept before. Returns the faces separated.
+    int32_t cut_swept(World& world, Id id, const Collider& tool, Id body_id, const Body& body) {
+        double triangles[18];
+        if (!swept_blade(tool, triangles) || !near(body, triangles)) return 0;  // no motion, or away from it
+        return cut_along(world, sweep_of(id, body_id), body_id, body, triangles, resolution(tool.cutting));
+    }
+
+    /// The physical criterion: the edge holds the material just ahead of it and drags it
+    /// along; once the work it did since the last break pays for the crack (toughness /
+    /// sharpness x engaged length x the resolution), the material breaks from the edge one
+    /// resolution ahead along the motion. Returns the faces separated.
+    int32_t break_ahead(World& world, Id id, const Collider& tool, Id body_id, const Body& body) {
+        double ahead[18];
+        const double advance = resolution(tool.cutting);
+        if (!crack_ahead(tool, advance, ahead) || !near(body, ahead)) return 0;  // resting, or away: the hold stays
+        Sweep& sweep = sweep_of(id, body_id);
+        Body& held = world.body(body_id);
+        count_work(body, sweep.breaking);
+        const Engagement engaged = engage(body, tool);
+        const double needed = engaged.toughness / tool.cutting.sharpness * engaged.length * advance;
+        if (!(needed > 0.0)) {
+            release(held, sweep.breaking);  // out of the material, or one that never breaks
+            return 0;
+        }
+        double rest[18];
+        if (sweep.breaking.work >= needed && break_at_rest(body, tool, sweep.breaking, sweep.on_nodes, advance, rest)) {
+            // Work beyond the crack's price (the last step overshot it) goes to the next one,
+            // so that over a steady cut all of the blade's work pays for crack.
+            const double excess = std::min(sweep.breaking.work - needed, needed);
+            release(held, sweep.breaking);
+            sweep.breaking.work = excess;
+            return cut_along_rest(world, sweep, body_id, rest, advance);
+        }
+        if (sweep.breaking.held.empty()) {
+            // Refine before holding, so that nodes lie within reach ahead of the edge.
+            for (int c = 0; c < 6; ++c) to_rest(body, &ahead[3 * c], &rest[3 * c]);
+            refine_body_near(world, body_id, quad_sides(rest).data(), 4, advance, &sweep.on_nodes);
+        }
+        hold_ahead(held, tool, advance, sweep.on_nodes, sweep.breaking);
+        return 0;
+    }
+
+    /// Refines body around the quad triangles[18] (world frame, as swept_blade lays it out)
+    /// to edge_length and cuts it along the quad and the rest of sweep. Returns the faces
+    /// separated.
+    int32_t cut_along(World& world, Sweep& sweep, Id body_id, const Body& body, const double triangles[18], double edge_length) {
+        double rest[18];
+        for (int c = 0; c < 6; ++c) to_rest(body, &triangles[3 * c], &rest[3 * c]);
+        return cut_along_rest(world, sweep, body_id, rest, edge_length);
+    }
+
+    /// cut_along with the quad given in the body's rest shape.
+    int32_t cut_along_rest(World& world, Sweep& sweep, Id body_id, const double rest[18], double edge_length) {
+        refine_body_near(world, body_id, quad_sides(rest).data(), 4, edge_length, &sweep.on_nodes);
+        vec<double>& swept = sweep.triangles;
+        swept.insert(swept.end(), rest, rest + 18);
+        if (swept.size() > 9 * kKeptTriangles) swept.erase(swept.begin(), swept.end() - 9 * kKeptTriangles);
+        sh_cut_report cut{};
+        cut_body_at_rest(world, body_id, swept.data(), static_cast<int32_t>(swept.size() / 9), cut, &sweep.on_nodes);
+        return cut.faces_separated;
+    }
 
     Sweep& sweep_of(Id tool, Id body) {
         for (Sweep& s : swept_)
             if (s.tool == tool && s.body == body) return s;
-        swept_.push_back({tool, body, vec<double>(), vec<int32_t>()});
+        swept_.push_back({tool, body, vec<double>(), vec<int32_t>(), BreakState{}});
         return swept_.back();
     }
 
-    void forget_gone(const World& world) {
+    void forget_gone(World& world) {
+        for (Sweep& s : swept_)
+            if (!world.is_valid_collider(s.tool, true) && world.is_valid(s.body)) release(world.body(s.body), s.breaking);
         swept_.erase(std::remove_if(swept_.begin(), swept_.end(),
                                     [&](const Sweep& s) { return !world.is_valid_collider(s.tool, true) || !world.is_valid(s.body); }),
                      swept_.end());
@@ -163,7 +238,7 @@ void set_tool_cutting(World& world, Id id, const sh_cut_def* def) {
     if (def) world.own_hook_once<ToolCutting>(&kCuttingKey);
     tool.cuts = def != nullptr;
     if (def) tool.cutting = *def;
-    if (StepHook* hook = world.owned_hook(&kCuttingKey)) static_cast<ToolCutting*>(hook)->forget(id);
+    if (StepHook* hook = world.owned_hook(&kCuttingKey)) static_cast<ToolCutting*>(hook)->forget(world, id);
 }
 
 }  // namespace sh

@@ -13,6 +13,7 @@ void validate_material(const sh_material& m, const char* context) {
     SH_REQUIRE(std::isfinite(m.young) && m.young > 0.0, SH_ERR_INVALID_ARGUMENT, "%s: material.young = %g Pa, must be finite and > 0", context, m.young);
     SH_REQUIRE(std::isfinite(m.poisson) && m.poisson > -1.0 && m.poisson < 0.5, SH_ERR_INVALID_ARGUMENT, "%s: material.poisson = %g, must lie in (-1, 0.5)", context, m.poisson);
     SH_REQUIRE(std::isfinite(m.density) && m.density > 0.0, SH_ERR_INVALID_ARGUMENT, "%s: material.density = %g kg/m^3, must be finite and > 0", context, m.density);
+    SH_REQUIRE(std::isfinite(m.toughness) && m.toughness >= 0.0, SH_ERR_INVALID_ARGUMENT, "%s: material.toughness = %g J/m^2, must be finite and >= 0", context, m.toughness);
 }
 
 double lame_lambda(const sh_material& m) {

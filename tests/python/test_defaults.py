@@ -34,6 +34,7 @@ MATERIAL = {
     "young": "material.young",
     "poisson": "material.poisson",
     "density": "material.density",
+    "toughness": "material.toughness",
 }
 BODY_OPTIONS = {
     "integrator": ("integrator", _lib.INTEGRATORS),

@@ -75,8 +75,8 @@ def test_sizes_computed_by_hand():
     # double, i32, i32, double, i32, pad 4
     assert ctypes.sizeof(_lib.sh_cut_def) == 72  # u32, i32, 6 doubles, 2 doubles
     assert ctypes.sizeof(_lib.sh_mesh_info) == 88  # 7 int32, pad 4, 7 doubles
-    assert ctypes.sizeof(_lib.sh_material) == 32
-    assert ctypes.sizeof(_lib.sh_fem_body_def) == 128  # 80 + sh_implicit_settings
+    assert ctypes.sizeof(_lib.sh_material) == 40  # u32, int, 4 doubles
+    assert ctypes.sizeof(_lib.sh_fem_body_def) == 136  # 88 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_spring_params) == 80  # int, pad 4, 6 doubles, pointer, i32, pad 4, double
     assert ctypes.sizeof(_lib.sh_spring_body_def) == 216  # 168 + sh_implicit_settings
     assert ctypes.sizeof(_lib.sh_body_info) == 48  # 4 int32, 2 doubles, 2 int32, uint64

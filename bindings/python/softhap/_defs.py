@@ -104,6 +104,7 @@ MATERIAL_FIELDS: Fields = {
     "young": float,
     "poisson": float,
     "density": float,
+    "toughness": float,
 }
 BODY_FIELDS: Fields = {  # shared by sh_fem_body_def and sh_spring_body_def
     "integrator": _choice(INTEGRATORS, "integrator"),

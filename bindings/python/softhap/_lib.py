@@ -145,6 +145,7 @@ SH_SHAPE_COUNT = len(SHAPE_KINDS)
 
 CUT_CRITERIA = {
     "geometric": 0,
+    "physical": 1,
 }
 SH_CUT_CRITERION_COUNT = len(CUT_CRITERIA)
 
@@ -250,6 +251,7 @@ class sh_material(Structure):
         ("young", c_double),
         ("poisson", c_double),
         ("density", c_double),
+        ("toughness", c_double),
     ]
 
 

@@ -302,16 +302,17 @@ class Body(WorldEntity):
         young: float = 3000.0,
         poisson: float = 0.45,
         density: float = 1000.0,
+        toughness: float = 200.0,
     ) -> None:
         """Set the material of the listed elements (a region of an FEM body). Masses are
         recomputed from the new density.
 
-        model is "stvk", "linear", "corotational" or "neohookean"; young (Pa), poisson and
-        density (kg/m^3). The C API has no per-element material getter, so a field not given
+        model is "stvk", "linear", "corotational" or "neohookean"; young (Pa), poisson,
+        density (kg/m^3) and toughness (J/m^2, for cutting tools with criterion="physical"). The C API has no per-element material getter, so a field not given
         takes the sh_fem_body_def_default value shown in the signature, not the element's
         current value. Invalid values raise softhap.Error (SH_ERR_INVALID_ARGUMENT).
         """
-        arguments = dict(model=model, young=young, poisson=poisson, density=density)
+        arguments = dict(model=model, young=young, poisson=poisson, density=density, toughness=toughness)
         handle = self._world_handle("sh_body_set_material")
         elements = _arrays.index_list(element_indices, "element_indices")
         material = _defs.material(arguments)

@@ -154,6 +154,7 @@ class World(WorldContacts):
         young: float = 3000.0,
         poisson: float = 0.45,
         density: float = 1000.0,
+        toughness: float = 200.0,
         integrator: str = "symplectic_euler",
         damping_mass: float = 0.0,
         damping_stiffness: float = 0.0,
@@ -172,6 +173,8 @@ class World(WorldContacts):
         The defaults are those of sh_fem_body_def_default (soft tissue):
           model: "stvk", "linear", "corotational" or "neohookean";
           young: Young's modulus (Pa); poisson: Poisson's ratio; density: kg/m^3;
+          toughness: fracture toughness G_c (J/m^2) for cutting tools with
+          criterion="physical" (0: never breaks that way);
           integrator: "symplectic_euler", "forward_euler", "rk2", "rk4" or "implicit_euler";
           damping_mass: Rayleigh alpha (1/s); damping_stiffness: Rayleigh beta (s);
           on_unstable: "substep" or "reject": explicit steps above the critical step are

@@ -697,13 +697,18 @@ typedef struct sh_cut_def {
 /** Fill a cut def with defaults. Thread: any. Alloc: none. */
 SH_API void sh_cut_def_default(sh_cut_def* def);
 
-/** Make tool a cutting tool with def, or an ordinary one again with NULL. At every
- *  sh_world_step, before the bodies move, the surface the blade edge sweeps from the tool's
- *  last pose to its new pose cuts every body it passes through (as sh_body_cut would), so a
- *  blade that has entered the material separates it as it advances, and a cut continues from
- *  where the last step's ended. The tool's shape still touches the material through contact.
- *  A def not from sh_cut_def_default, coincident edge points or non-finite values are
- *  SH_ERR_INVALID_ARGUMENT. Thread: sim. Alloc: may. */
+/** Make tool a cutting tool with def, or an ordinary one again with NULL (which lets go any
+ *  material its edge holds). At every sh_world_step, before the bodies move: with
+ *  SH_CUT_GEOMETRIC the surface the blade edge sweeps from the tool's last pose to its new
+ *  pose cuts every body it passes through (as sh_body_cut would), so a blade that has entered
+ *  the material separates it as it advances, and a cut continues from where the last step's
+ *  ended; with SH_CUT_PHYSICAL the edge holds the FEM material just ahead of it (those nodes
+ *  move with the blade's motion across the edge, as prescribed nodes) and the material breaks
+ *  one resolution beyond the crack's front once the work the blade did on it since the last
+ *  break reaches material.toughness / sharpness x engaged length x resolution; the held
+ *  material's reaction joins the tool's (sh_tool_get_wrench). The tool's shape still touches
+ *  the material through contact. A def not from sh_cut_def_default, coincident edge points or
+ *  non-finite values are SH_ERR_INVALID_ARGUMENT. Thread: sim. Alloc: may. */
 SH_API sh_status sh_tool_set_cutting(sh_world* world, sh_tool_id tool, const sh_cut_def* def);
 
 /** Copy the FEM body's tets (element_count x 4 node indices, positively oriented) into

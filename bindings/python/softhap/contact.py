@@ -181,10 +181,15 @@ class Tool(_Collider):
         World.step the surface the edge sweeps from the tool's last pose to its new pose cuts
         every body it passes through (see Body.cut); the report's cut_faces and
         topology_seconds count it. criterion: "geometric" (the material the edge sweeps
-        separates). sharpness: the blade's kappa (> 0). resolution: the edge length (m) the
-        material is refined to around the blade's edge and the path of its ends before it
-        cuts, so that the opening reaches to within about this of the blade on a coarse mesh;
-        0 means a quarter of the blade's length."""
+        separates) or "physical" (the edge holds the material just ahead of it and drags it
+        along, and it breaks one resolution ahead once the work the blade did since the last
+        break pays toughness / sharpness x engaged length x resolution: in steady cutting the
+        blade's force is toughness x engaged length / sharpness; tool.force includes it).
+        sharpness: the blade's kappa (> 0; 1 a scalpel, larger is sharper). resolution: the
+        edge length (m) the material is refined to around the blade's edge and the path of
+        its ends before it cuts, so that the opening reaches to within about this of the blade
+        on a coarse mesh (and, physically, how far the crack advances per break); 0 means a
+        quarter of the blade's length."""
         handle = self._world_handle("sh_tool_set_cutting")
         if edge is None:
             check(lib.sh_tool_set_cutting(handle, self._cid, None), "sh_tool_set_cutting")

@@ -22,22 +22,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 import softhap  # noqa: E402
 
-
-def box_mesh(size, cells):
-    """A box [0, size] of cells[0] x cells[1] x cells[2] cubes, six Kuhn tets each."""
-    planes = [np.linspace(0.0, size[k], cells[k] + 1) for k in range(3)]
-    ny, nz = cells[1], cells[2]
-    nodes = np.array(np.meshgrid(*planes, indexing="ij")).reshape(3, -1).T
-    cubes = np.array(np.meshgrid(*[np.arange(c) for c in cells], indexing="ij")).reshape(3, -1)
-    tets = []
-    for path in [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]:
-        corner = cubes.copy()
-        tet = [(corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2]]
-        for axis in path:
-            corner[axis] += 1
-            tet.append((corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2])
-        tets.append(np.stack(tet, axis=1))
-    return softhap.Mesh(nodes, np.stack(tets, axis=1).reshape(-1, 4))
+# The tests' structured block (Kuhn-split cubes), so that the report cuts the blocks they do.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "python"))
+from test_contact import box_mesh  # noqa: E402
 
 
 BLOCK, CELLS, DEPTH, PLANE_Y = (0.08, 0.01, 0.015), (32, 4, 6), 0.01, 0.0051

@@ -29,9 +29,9 @@ void extend_on_nodes(vec<int32_t>& on_nodes, const vec<NodeOrigin>& origins, int
 
 void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report,
              vec<int32_t>* on_nodes) {
-    // A surface in the material frame is a tool's growing sweep, cut with again at every step:
-    // the quality guard's choices depend on the pieces already there and would not repeat.
-    TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data(), !at_rest, on_nodes);
+    // A surface in the material frame is a tool's growing sweep, cut with again at every step;
+    // the nodes it went through (on_nodes) keep the quality guard's earlier choices.
+    TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data(), true, on_nodes);
     const int32_t node_count = body.node_count(), tet_count = body.element_count();
     report.faces_separated = separate(cut, node_count);
     report.min_quality = cut.min_quality;

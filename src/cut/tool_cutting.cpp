@@ -87,7 +87,8 @@ constexpr size_t kKeptTriangles = 512;
 /// that advances by less than an element per step crosses each tet bit by bit, so what it
 /// swept is kept and cut with whole; it is kept in each body's rest shape (the material
 /// frame), where it stays with the material as the body moves, so that cutting again along
-/// where the blade has been finds the same faces and shaves nothing off them.
+/// where the blade has been finds the same faces and shaves nothing off them. A physical
+/// blade's breaks are kept the same way (breaking.hpp has how it holds and breaks).
 class ToolCutting final : public BeforeMotionHook {
 public:
     void before_motion(World& world, sh_step_report& report) override {
@@ -145,8 +146,8 @@ private:
 
     /// The physical criterion: the edge holds the material just ahead of it and drags it
     /// along; once the work it did since the last break pays for the crack (toughness /
-    /// sharpness x engaged length x the resolution), the material breaks from the edge one
-    /// resolution ahead along the motion. Returns the faces separated.
+    /// sharpness x engaged length x the resolution), the material breaks from the edge to one
+    /// resolution beyond the crack's front. Returns the faces separated.
     int32_t break_ahead(World& world, Id id, const Collider& tool, Id body_id, const Body& body) {
         double ahead[18];
         const double advance = resolution(tool.cutting);

@@ -441,6 +441,59 @@ static void test_rejected_step_allocates_nothing(void** state) {
     destroy_world_checking_leaks(world);
 }
 
+/* A call that may fail on an allocation, and the check that a failed one changed nothing. */
+typedef sh_status (*fallible_call)(sh_world* world, void* context);
+typedef int (*unchanged_check)(sh_world* world, void* context); /* 1 if nothing changed */
+
+/* Runs call with the allocator failing after 0, 1, 2, ... allocations until a run gets all it
+ * asks for (which must succeed). Every failed run must return SH_ERR_OUT_OF_MEMORY and pass
+ * unchanged; each that does not is printed (naming name) and counted in *failures. Returns
+ * the number of failed runs. */
+static long fail_each_allocation(sh_world* world, fallible_call call, unchanged_check unchanged, void* context,
+                                 const char* name, int* failures) {
+    long n = 0;
+    for (; n < 100000; ++n) {
+        reset_counts();
+        g.fail_after = n;
+        const sh_status status = call(world, context);
+        const size_t failed = g.failed;
+        g.fail_after = -1;
+        if (failed == 0) {
+            assert_ok(status);
+            break;
+        }
+        assert_status(status, SH_ERR_OUT_OF_MEMORY);
+        if (!unchanged(world, context)) {
+            print_error("%s failing after %ld allocations returned SH_ERR_OUT_OF_MEMORY but changed the body\n", name, n);
+            ++*failures;
+        }
+    }
+    return n;
+}
+
+/* What the set-material test changes and compares. */
+typedef struct {
+    sh_body_id body;
+    int32_t node_count;
+    double masses[64], forces[3 * 64];
+} material_case;
+
+static sh_status set_other_material(sh_world* world, void* context) {
+    const material_case* c = context;
+    const int32_t region[3] = {1, 4, 9};
+    const sh_material other = sh_test_material(SH_MATERIAL_COROTATIONAL, 9e3, 0.3, 2500);
+    return sh_body_set_material(world, c->body, region, 3, &other);
+}
+
+static int masses_and_forces_unchanged(sh_world* world, void* context) {
+    const material_case* c = context;
+    double masses[64], forces[3 * 64];
+    assert_ok(sh_body_get_masses(world, c->body, masses, 64));
+    assert_ok(sh_body_get_elastic_forces(world, c->body, forces, 64));
+    return memcmp(masses, c->masses, sizeof(double) * (size_t)c->node_count) == 0 &&
+           memcmp(forces, c->forces, sizeof(double) * 3 * (size_t)c->node_count) == 0;
+}
+
 /* SH_ERR_OUT_OF_MEMORY means "nothing was changed": sh_body_set_material failing on any of
  * its allocations leaves the masses and the elastic forces bitwise as they were. */
 static void test_set_material_out_of_memory_changes_nothing(void** state) {
@@ -457,42 +510,19 @@ static void test_set_material_out_of_memory_changes_nothing(void** state) {
     sh_body_info info;
     assert_ok(sh_body_get_info(world, body, &info));
     assert_true(info.node_count <= 64);
-    double x[3 * 64], masses[64], forces[3 * 64], masses_now[64], forces_now[3 * 64];
+    material_case c = {body, info.node_count, {0}, {0}};
+    double x[3 * 64], masses_now[64];
     assert_ok(sh_body_get_positions(world, body, x, 64));
     for (int i = 0; i < 3 * info.node_count; ++i) x[i] *= 1.0 + 0.01 * (i % 5); /* strained */
     assert_ok(sh_body_set_positions(world, body, x, info.node_count));
-    assert_ok(sh_body_get_masses(world, body, masses, 64));
-    assert_ok(sh_body_get_elastic_forces(world, body, forces, 64));
+    assert_ok(sh_body_get_masses(world, body, c.masses, 64));
+    assert_ok(sh_body_get_elastic_forces(world, body, c.forces, 64));
 
-    const int32_t region[3] = {1, 4, 9};
-    const sh_material other = sh_test_material(SH_MATERIAL_COROTATIONAL, 9e3, 0.3, 2500);
     int failures = 0;
-    for (long n = 0; n < 10000; ++n) {
-        reset_counts();
-        g.fail_after = n;
-        const sh_status status = sh_body_set_material(world, body, region, 3, &other);
-        const size_t failed = g.failed;
-        g.fail_after = -1;
-        if (failed == 0) {
-            assert_ok(status);
-            break;
-        }
-        assert_status(status, SH_ERR_OUT_OF_MEMORY);
-        assert_ok(sh_body_get_masses(world, body, masses_now, 64));
-        assert_ok(sh_body_get_elastic_forces(world, body, forces_now, 64));
-        if (memcmp(masses_now, masses, sizeof(double) * (size_t)info.node_count) != 0 ||
-            memcmp(forces_now, forces, sizeof(double) * 3 * (size_t)info.node_count) != 0) {
-            print_error("sh_body_set_material failing after %ld allocations returned SH_ERR_OUT_OF_MEMORY but "
-                        "changed the body (masses %s, elastic forces %s)\n",
-                        n, memcmp(masses_now, masses, sizeof(double) * (size_t)info.node_count) ? "changed" : "same",
-                        memcmp(forces_now, forces, sizeof(double) * 3 * (size_t)info.node_count) ? "changed"
-                                                                                                  : "same");
-            ++failures;
-        }
-    }
+    fail_each_allocation(world, set_other_material, masses_and_forces_unchanged, &c, "sh_body_set_material", &failures);
     /* The successful call does change them. */
     assert_ok(sh_body_get_masses(world, body, masses_now, 64));
-    assert_true(memcmp(masses_now, masses, sizeof(double) * (size_t)info.node_count) != 0);
+    assert_true(memcmp(masses_now, c.masses, sizeof(double) * (size_t)info.node_count) != 0);
     destroy_world_checking_leaks(world);
     assert_int_equal(failures, 0);
 }
@@ -515,6 +545,35 @@ static sh_world* implicit_bar(double length, int cells, sh_body_id* body) {
     return world;
 }
 
+/* What the cut test cuts with and compares; after each failed cut the body steps on. */
+typedef struct {
+    sh_body_id body;
+    sh_body_info before;
+    double x[3 * 64];
+} cut_case;
+
+static sh_status cut_the_bar(sh_world* world, void* context) {
+    const cut_case* c = context;
+    /* the plane x = 2.3 cm, crossing the bar's middle cells */
+    const double plane[18] = {0.023, -1, -1, 0.023, 1, -1, 0.023, 1, 1, 0.023, -1, -1, 0.023, 1, 1, 0.023, -1, 1};
+    sh_cut_report report;
+    return sh_body_cut(world, c->body, plane, 2, &report);
+}
+
+static int uncut_and_steps_on(sh_world* world, void* context) {
+    cut_case* c = context;
+    sh_body_info now;
+    double x_now[3 * 64];
+    assert_ok(sh_body_get_info(world, c->body, &now));
+    assert_ok(sh_body_get_positions(world, c->body, x_now, 64));
+    const int same = now.node_count == c->before.node_count && now.element_count == c->before.element_count &&
+                     now.topology_version == c->before.topology_version &&
+                     memcmp(x_now, c->x, sizeof(double) * 3 * (size_t)c->before.node_count) == 0;
+    assert_ok(sh_world_step(world, 1e-3, NULL));
+    assert_ok(sh_body_get_positions(world, c->body, c->x, 64));
+    return same;
+}
+
 /* A cut that runs out of memory anywhere (the cut surface, the split, the separation, the
  * body's new arrays, the world's resized step scratch) returns SH_ERR_OUT_OF_MEMORY and leaves
  * the body exactly as it was: same topology, same positions. The body then still steps, and
@@ -522,47 +581,41 @@ static sh_world* implicit_bar(double length, int cells, sh_body_id* body) {
 static void test_cut_out_of_memory_changes_nothing(void** state) {
     (void)state;
     reset_counts();
-    sh_body_id body;
-    sh_world* world = implicit_bar(0.04, 4, &body);
+    cut_case c;
+    sh_world* world = implicit_bar(0.04, 4, &c.body);
     assert_ok(sh_world_step(world, 1e-3, NULL)); /* the body's solver state exists */
-    sh_body_info before, now;
-    assert_ok(sh_body_get_info(world, body, &before));
-    assert_true(before.node_count <= 64);
-    double x[3 * 64], x_now[3 * 64];
-    assert_ok(sh_body_get_positions(world, body, x, 64));
-    /* the plane x = 2.3 cm, crossing the bar's middle cells */
-    const double plane[18] = {0.023, -1, -1, 0.023, 1, -1, 0.023, 1, 1, 0.023, -1, -1, 0.023, 1, 1, 0.023, -1, 1};
+    assert_ok(sh_body_get_info(world, c.body, &c.before));
+    assert_true(c.before.node_count <= 64);
+    assert_ok(sh_body_get_positions(world, c.body, c.x, 64));
     int failures = 0;
-    long n = 0;
-    for (; n < 100000; ++n) {
-        reset_counts();
-        g.fail_after = n;
-        sh_cut_report report;
-        const sh_status status = sh_body_cut(world, body, plane, 2, &report);
-        const size_t failed = g.failed;
-        g.fail_after = -1;
-        if (failed == 0) {
-            assert_ok(status);
-            break;
-        }
-        assert_status(status, SH_ERR_OUT_OF_MEMORY);
-        assert_ok(sh_body_get_info(world, body, &now));
-        assert_ok(sh_body_get_positions(world, body, x_now, 64));
-        if (now.node_count != before.node_count || now.element_count != before.element_count ||
-            now.topology_version != before.topology_version ||
-            memcmp(x_now, x, sizeof(double) * 3 * (size_t)before.node_count) != 0) {
-            print_error("sh_body_cut failing after %ld allocations returned SH_ERR_OUT_OF_MEMORY but changed the body\n", n);
-            ++failures;
-        }
-        assert_ok(sh_world_step(world, 1e-3, NULL));
-        assert_ok(sh_body_get_positions(world, body, x, 64));
-    }
-    assert_true(n > 5); /* the cut does allocate: the failures above were tried */
-    assert_ok(sh_body_get_info(world, body, &now));
-    assert_true(now.node_count > before.node_count && now.topology_version > before.topology_version);
+    const long tried = fail_each_allocation(world, cut_the_bar, uncut_and_steps_on, &c, "sh_body_cut", &failures);
+    assert_true(tried > 5); /* the cut does allocate: the failures above were tried */
+    sh_body_info now;
+    assert_ok(sh_body_get_info(world, c.body, &now));
+    assert_true(now.node_count > c.before.node_count && now.topology_version > c.before.topology_version);
     assert_ok(sh_world_step(world, 1e-3, NULL));
     destroy_world_checking_leaks(world);
     assert_int_equal(failures, 0);
+}
+
+/* What the implicit-step test steps and compares. */
+typedef struct {
+    sh_body_id body;
+    size_t bytes;
+    double x[3 * 64], v[3 * 64];
+} step_case;
+
+static sh_status step_once(sh_world* world, void* context) {
+    (void)context;
+    return sh_world_step(world, 1e-3, NULL);
+}
+
+static int positions_and_velocities_unchanged(sh_world* world, void* context) {
+    const step_case* c = context;
+    double x[3 * 64], v[3 * 64];
+    assert_ok(sh_body_get_positions(world, c->body, x, 64));
+    assert_ok(sh_body_get_velocities(world, c->body, v, 64));
+    return memcmp(x, c->x, c->bytes) == 0 && memcmp(v, c->v, c->bytes) == 0;
 }
 
 /* The first implicit step builds the body's solver state (and, with the error estimate, the
@@ -572,38 +625,21 @@ static void test_cut_out_of_memory_changes_nothing(void** state) {
 static void test_implicit_step_out_of_memory_changes_nothing(void** state) {
     (void)state;
     reset_counts();
-    sh_body_id body;
-    sh_world* world = implicit_bar(0.02, 2, &body);
+    step_case c;
+    sh_world* world = implicit_bar(0.02, 2, &c.body);
     sh_body_info info;
-    assert_ok(sh_body_get_info(world, body, &info));
+    assert_ok(sh_body_get_info(world, c.body, &info));
     assert_true(info.node_count <= 64);
-    double x[3 * 64], v[3 * 64], x_now[3 * 64], v_now[3 * 64];
-    assert_ok(sh_body_get_positions(world, body, x, 64));
+    assert_ok(sh_body_get_positions(world, c.body, c.x, 64));
     const int32_t pulled = 0;
-    const double target[3] = {x[0] - 1e-3, x[1], x[2]};
-    assert_ok(sh_body_prescribe_positions(world, body, &pulled, target, 1));
-    assert_ok(sh_body_get_velocities(world, body, v, 64));
-    const size_t bytes = sizeof(double) * 3 * (size_t)info.node_count;
+    const double target[3] = {c.x[0] - 1e-3, c.x[1], c.x[2]};
+    assert_ok(sh_body_prescribe_positions(world, c.body, &pulled, target, 1));
+    assert_ok(sh_body_get_velocities(world, c.body, c.v, 64));
+    c.bytes = sizeof(double) * 3 * (size_t)info.node_count;
     int failures = 0;
-    for (long n = 0; n < 10000; ++n) {
-        reset_counts();
-        g.fail_after = n;
-        const sh_status status = sh_world_step(world, 1e-3, NULL);
-        const size_t failed = g.failed;
-        g.fail_after = -1;
-        if (failed == 0) {
-            assert_ok(status);
-            break;
-        }
-        assert_status(status, SH_ERR_OUT_OF_MEMORY);
-        assert_ok(sh_body_get_positions(world, body, x_now, 64));
-        assert_ok(sh_body_get_velocities(world, body, v_now, 64));
-        if (memcmp(x_now, x, bytes) != 0 || memcmp(v_now, v, bytes) != 0) {
-            print_error("sh_world_step failing after %ld allocations changed the body\n", n);
-            ++failures;
-        }
-    }
-    assert_ok(sh_body_get_positions(world, body, x_now, 64));
+    fail_each_allocation(world, step_once, positions_and_velocities_unchanged, &c, "sh_world_step", &failures);
+    double x_now[3 * 64];
+    assert_ok(sh_body_get_positions(world, c.body, x_now, 64));
     assert_memory_equal(x_now, target, sizeof target);
     destroy_world_checking_leaks(world);
     assert_int_equal(failures, 0);

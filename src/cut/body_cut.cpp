@@ -86,22 +86,21 @@ void cut_in_frame(World& world, Id id, const double* triangles, int32_t count, b
 
 }  // namespace
 
-int32_t refine_body_near(World& world, Id id, const double* segments, int32_t segment_count, double edge_length,
-                         vec<int32_t>* on_nodes) {
+void refine_body_near(World& world, Id id, const double* segments, int32_t segment_count, double edge_length,
+                      vec<int32_t>* on_nodes) {
     Body& found = world.body(id);
-    if (!found.is_fem()) return 0;
+    if (!found.is_fem()) return;
     FemBody& body = static_cast<FemBody&>(found);
     // One refinement adds at most about a body's worth of tets, so a misjudged length cannot
     // run away with the memory.
     Refinement refined = refine_near(body, segments, segment_count, edge_length, std::max(body.element_count(), 4096));
-    if (refined.origins.empty()) return 0;
-    const int32_t node_count = body.node_count(), tet_count = body.element_count();
+    if (refined.origins.empty()) return;
+    const int32_t node_count = body.node_count();
     TopologyScratch prepared;
     world.prepare_topology_change(id, node_count + static_cast<int32_t>(refined.origins.size()), prepared);
     body.retopologize(refined.origins.data(), refined.origins.size(), std::move(refined.tets), refined.source);
     world.topology_changed(id, prepared);
     if (on_nodes) extend_on_nodes(*on_nodes, refined.origins, node_count);
-    return body.element_count() - tet_count;
 }
 
 void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {

@@ -29,9 +29,9 @@ void cut_body_at_rest(World& world, Id id, const double* triangles, int32_t coun
 /// Refines FEM body id of world around the segments (segment_count of them, 6 doubles each:
 /// two points of its rest shape) to edges of at most edge_length, as refine_near describes,
 /// as one topology change; mass-spring bodies are left alone. A new node between two nodes of
-/// on_nodes (ascending, may be null: the nodes a cut went through) is added to it. Returns the
-/// tets added. Throws std::bad_alloc leaving the body as it was.
-int32_t refine_body_near(World& world, Id id, const double* segments, int32_t segment_count, double edge_length,
-                         vec<int32_t>* on_nodes = nullptr);
+/// on_nodes (ascending, may be null: the nodes a cut went through) is added to it. Throws
+/// std::bad_alloc leaving the body as it was.
+void refine_body_near(World& world, Id id, const double* segments, int32_t segment_count, double edge_length,
+                      vec<int32_t>* on_nodes = nullptr);
 
 }  // namespace sh

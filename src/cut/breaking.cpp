@@ -74,30 +74,26 @@ bool crack_ahead(const Collider& tool, double advance, double triangles[18]) {
     return true;
 }
 
-/// The internal force (N) on each held node, 3 per node.
-vec<double> held_forces(const Body& body, const BreakState& state) {
-    vec<double> on_held;
-    if (state.held.empty()) return on_held;
+void measure_held(const Body& body, BreakState& state, double force[3]) {
+    force[0] = force[1] = force[2] = 0.0;
+    state.forces.clear();
+    if (state.held.empty()) return;
     vec<double> f(body.x.size(), 0.0);
     body.add_internal_forces(body.x.data(), nullptr, f.data());
-    for (const int32_t i : state.held) on_held.insert(on_held.end(), at(f.data(), i), at(f.data(), i) + 3);
-    return on_held;
-}
-
-void blade_force(const Body& body, const BreakState& state, double force[3]) {
-    const vec<double> on_held = held_forces(body, state);
-    force[0] = force[1] = force[2] = 0.0;
-    for (size_t j = 0; j < on_held.size(); ++j) force[j % 3] += on_held[j];
+    for (const int32_t i : state.held) {
+        state.forces.insert(state.forces.end(), at(f.data(), i), at(f.data(), i) + 3);
+        for (int k = 0; k < 3; ++k) force[k] += at(f.data(), i)[k];
+    }
 }
 
 void count_work(const Body& body, BreakState& state) {
-    const vec<double> on_held = held_forces(body, state);
+    if (state.forces.size() != state.previous.size()) return;  // held since the last step: nothing done yet
     for (size_t h = 0; h < state.held.size(); ++h) {
         const double* x = at(body.x.data(), state.held[h]);
         double moved[3];
         sub3(x, &state.previous[3 * h], moved);
         // The blade held the node against the material's force f: it did work -f.dx on it.
-        state.work += std::max(0.0, -dot3(&on_held[3 * h], moved));
+        state.work += std::max(0.0, -dot3(&state.forces[3 * h], moved));
         for (int k = 0; k < 3; ++k) state.previous[3 * h + static_cast<size_t>(k)] = x[k];
     }
 }
@@ -188,6 +184,7 @@ void release(Body& body, BreakState& state) {
     if (!state.held.empty()) body.release_nodes(state.held.data(), static_cast<int32_t>(state.held.size()));
     state.held.clear();
     state.previous.clear();
+    state.forces.clear();
     state.work = 0.0;
 }
 

@@ -19,6 +19,7 @@ struct BreakState {
     double work = 0.0;       ///< work (J) the blade did on the body since the last break
     vec<int32_t> held;       ///< the nodes the edge holds, ascending
     vec<double> previous;    ///< their positions (3 each) when the work was last counted
+    vec<double> forces;      ///< the material's force on each (3 each) at the last step's end
 };
 
 /// The blade of tool against body at the tool's pose before this step's motion.
@@ -38,12 +39,13 @@ Engagement engage(const Body& body, const Collider& tool);
 /// motion runs along the edge or is nil.
 bool crack_ahead(const Collider& tool, double advance, double triangles[18]);
 
-/// The force (N, world) the material pushes the blade with through the held nodes at their
-/// current positions (the internal forces on them).
-void blade_force(const Body& body, const BreakState& state, double force[3]);
+/// Measures, after a step, the material's force on each held node (state.forces) and their sum
+/// in force (N, world): what the material pushes the blade with.
+void measure_held(const Body& body, BreakState& state, double force[3]);
 
 /// Adds to state.work the work the blade did holding the nodes against the material since the
-/// last count, and takes their current positions as the next count's start.
+/// last count (their displacement against the forces measure_held found at the step's end),
+/// and takes their current positions as the next count's start.
 void count_work(const Body& body, BreakState& state);
 
 /// Holds the free nodes of body the blade's edge meets, if it holds none: those not on the cut

@@ -153,8 +153,6 @@ struct Working {
             if (p > 0) out.tets.resize(out.tets.size() + 4), out.source.push_back(0);
             std::copy(pieces[p].begin(), pieces[p].end(), &out.tets[4 * slot]);
             out.source[slot] = -1 - from;
-            const double* r = rest.data();
-            out.min_quality = std::min(out.min_quality, tet_quality(at(r, pieces[p][0]), at(r, pieces[p][1]), at(r, pieces[p][2]), at(r, pieces[p][3])));
         }
     }
 };

@@ -20,8 +20,6 @@ struct Refinement {
     vec<int32_t> tets;
     /// Per tet of tets: the body tet it is, or -1 - s for a piece of body tet s.
     vec<int32_t> source;
-    /// Lowest quality (tet_quality at rest) of the pieces made; 1 if none.
-    double min_quality = 1.0;
 };
 
 /// Bisects the tets of body that one of the segments (segment_count of them, 6 doubles each:

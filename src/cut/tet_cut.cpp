@@ -255,12 +255,9 @@ int8_t TetCut::side_of_tet(const FemBody& body, const CutSurface& surface, const
     // cut goes through, nodes made on crossed edges) have no side. A tet whose corners are all
     // on the surface (a thin one, its nodes passed through within the snapping distance) lies
     // on the side its centre does.
-    double farthest = 0.0, centre[3] = {0, 0, 0};
+    double farthest = 0.0;
     for (int a = 0; a < 4; ++a) {
         const int32_t node = tet[a];
-        double p[3];
-        node_position(body, node, frame_, p);
-        for (int k = 0; k < 3; ++k) centre[k] += 0.25 * p[k];
         if (node >= body.node_count()) continue;
         const size_t slot = node_slot(node);
         if (slot < nodes_.size() && nodes_[slot] == node && on_[slot]) continue;
@@ -269,6 +266,12 @@ int8_t TetCut::side_of_tet(const FemBody& body, const CutSurface& surface, const
         if (std::fabs(d) > std::fabs(farthest)) farthest = d;
     }
     if (farthest == 0.0) {
+        double centre[3] = {0, 0, 0};
+        for (int a = 0; a < 4; ++a) {
+            double p[3];
+            node_position(body, tet[a], frame_, p);
+            for (int k = 0; k < 3; ++k) centre[k] += 0.25 * p[k];
+        }
         int32_t triangle = -1;
         farthest = surface.signed_distance(centre, triangle);
     }

@@ -106,11 +106,11 @@ public:
 
     /// A physical blade feels the material it holds: its force joins the tool's reaction.
     void after_step(World& world, double) override {
-        for (const Sweep& sweep : swept_) {
+        for (Sweep& sweep : swept_) {
             if (sweep.breaking.held.empty() || !world.is_valid(sweep.body)) continue;
             Collider& tool = world.collider(sweep.tool, true);
             double force[3], arm[3], torque[3];
-            blade_force(world.body(sweep.body), sweep.breaking, force);
+            measure_held(world.body(sweep.body), sweep.breaking, force);
             double a[3], b[3];
             tool.target.to_world(tool.cutting.edge[0], a);
             tool.target.to_world(tool.cutting.edge[1], b);

@@ -549,7 +549,7 @@ static sh_world* implicit_bar(double length, int cells, sh_body_id* body) {
 typedef struct {
     sh_body_id body;
     sh_body_info before;
-    double x[3 * 64];
+    double x[3 * 128];
 } cut_case;
 
 static sh_status cut_the_bar(sh_world* world, void* context) {
@@ -563,30 +563,30 @@ static sh_status cut_the_bar(sh_world* world, void* context) {
 static int uncut_and_steps_on(sh_world* world, void* context) {
     cut_case* c = context;
     sh_body_info now;
-    double x_now[3 * 64];
+    double x_now[3 * 128];
     assert_ok(sh_body_get_info(world, c->body, &now));
-    assert_ok(sh_body_get_positions(world, c->body, x_now, 64));
+    assert_ok(sh_body_get_positions(world, c->body, x_now, 128));
     const int same = now.node_count == c->before.node_count && now.element_count == c->before.element_count &&
                      now.topology_version == c->before.topology_version &&
                      memcmp(x_now, c->x, sizeof(double) * 3 * (size_t)c->before.node_count) == 0;
     assert_ok(sh_world_step(world, 1e-3, NULL));
-    assert_ok(sh_body_get_positions(world, c->body, c->x, 64));
+    assert_ok(sh_body_get_positions(world, c->body, c->x, 128));
     return same;
 }
 
-/* A cut that runs out of memory anywhere (the cut surface, the split, the separation, the
- * body's new arrays, the world's resized step scratch) returns SH_ERR_OUT_OF_MEMORY and leaves
- * the body exactly as it was: same topology, same positions. The body then still steps, and
- * the cut that finally gets its memory cuts the bar in two (more nodes, a new version). */
-static void test_cut_out_of_memory_changes_nothing(void** state) {
-    (void)state;
+/* A cut of an implicit bar of `cells` 1 cm cubes that runs out of memory anywhere (the cut
+ * surface, the split, the separation, the body's new arrays, the world's resized step scratch)
+ * returns SH_ERR_OUT_OF_MEMORY and leaves the body exactly as it was: same topology, same
+ * positions. The body then still steps, and the cut that finally gets its memory cuts the bar
+ * in two (more nodes, a new version). */
+static void check_cut_out_of_memory_changes_nothing(int cells) {
     reset_counts();
     cut_case c;
-    sh_world* world = implicit_bar(0.04, 4, &c.body);
+    sh_world* world = implicit_bar(0.01 * cells, cells, &c.body);
     assert_ok(sh_world_step(world, 1e-3, NULL)); /* the body's solver state exists */
     assert_ok(sh_body_get_info(world, c.body, &c.before));
-    assert_true(c.before.node_count <= 64);
-    assert_ok(sh_body_get_positions(world, c.body, c.x, 64));
+    assert_true(c.before.node_count <= 128);
+    assert_ok(sh_body_get_positions(world, c.body, c.x, 128));
     int failures = 0;
     const long tried = fail_each_allocation(world, cut_the_bar, uncut_and_steps_on, &c, "sh_body_cut", &failures);
     assert_true(tried > 5); /* the cut does allocate: the failures above were tried */
@@ -596,6 +596,19 @@ static void test_cut_out_of_memory_changes_nothing(void** state) {
     assert_ok(sh_world_step(world, 1e-3, NULL));
     destroy_world_checking_leaks(world);
     assert_int_equal(failures, 0);
+}
+
+/* On a 4-cube bar the cut changes a third of the tets: the body rebuilds all its elements. */
+static void test_cut_out_of_memory_changes_nothing(void** state) {
+    (void)state;
+    check_cut_out_of_memory_changes_nothing(4);
+}
+
+/* On a 16-cube bar it changes a few: the body updates them in place (emptied lanes, new
+ * blocks, its surface updated from the changed tets). */
+static void test_local_cut_out_of_memory_changes_nothing(void** state) {
+    (void)state;
+    check_cut_out_of_memory_changes_nothing(16);
 }
 
 /* What the implicit-step test steps and compares. */
@@ -803,6 +816,7 @@ int main(void) {
         cmocka_unit_test(test_set_material_out_of_memory_changes_nothing),
         cmocka_unit_test(test_implicit_step_out_of_memory_changes_nothing),
         cmocka_unit_test(test_cut_out_of_memory_changes_nothing),
+        cmocka_unit_test(test_local_cut_out_of_memory_changes_nothing),
         cmocka_unit_test(test_failing_allocator), /* last: a leak would stay behind */
     };
     return cmocka_run_group_tests(tests, setup_install, NULL);

@@ -42,17 +42,21 @@ TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* fra
 }
 
 void TetCut::find_candidates(const FemBody& body, const CutSurface& surface) {
-    const double* x = frame_;
+    // A tet's box misses the surface's exactly when all its corners lie beyond one of the
+    // box's six planes: one bit per plane and node, and the tet's corners' bits ANDed.
+    vec<uint8_t> beyond(static_cast<size_t>(body.node_count()));
+    for (int32_t n = 0; n < body.node_count(); ++n) {
+        uint8_t bits = 0;
+        for (int k = 0; k < 3; ++k)
+            bits |= static_cast<uint8_t>((at(frame_, n)[k] < surface.lower()[k] ? 1 : 0) << k |
+                                         (at(frame_, n)[k] > surface.upper()[k] ? 1 : 0) << (k + 3));
+        beyond[static_cast<size_t>(n)] = bits;
+    }
     for (int32_t t = 0; t < body.element_count(); ++t) {
-        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (int a = 0; a < 4; ++a)
-            for (int k = 0; k < 3; ++k) {
-                lo[k] = std::min(lo[k], at(x, corners(body, t)[a])[k]);
-                hi[k] = std::max(hi[k], at(x, corners(body, t)[a])[k]);
-            }
-        bool near = true;
-        for (int k = 0; k < 3; ++k) near = near && lo[k] <= surface.upper()[k] && hi[k] >= surface.lower()[k];
-        if (!near) continue;
+        const int32_t* tet = corners(body, t);
+        if (beyond[static_cast<size_t>(tet[0])] & beyond[static_cast<size_t>(tet[1])] & beyond[static_cast<size_t>(tet[2])] &
+            beyond[static_cast<size_t>(tet[3])])
+            continue;
         candidates_.push_back(t);
         corner_.insert(corner_.end(), corners(body, t), corners(body, t) + 4);
     }
@@ -103,11 +107,8 @@ void TetCut::snap_earlier_cut_nodes(const FemBody& body, const CutSurface& surfa
     }
     // A node made by a cut lies on the body's surface (on a cut face); nodes made inside by
     // refinement ahead of a blade have parents too but lie on no cut.
-    vec<int32_t> surface_nodes(body.surface_triangles.begin(), body.surface_triangles.end());
-    std::sort(surface_nodes.begin(), surface_nodes.end());
     for (size_t i = 0; i < nodes_.size(); ++i) {
-        if (on_[i] || body.parent_of(nodes_[i]) < 0) continue;
-        if (!std::binary_search(surface_nodes.begin(), surface_nodes.end(), nodes_[i])) continue;
+        if (on_[i] || body.parent_of(nodes_[i]) < 0 || !body.on_surface(nodes_[i])) continue;
         int32_t triangle = -1;
         if (std::fabs(surface.signed_distance(at(frame_, nodes_[i]), triangle)) < kSnap * shortest[i]) on_[i] = 1;
     }
@@ -284,15 +285,13 @@ void TetCut::collect_cut(const FemBody& body, const CutSurface& surface) {
     for (size_t k = 0; k < origins.size(); ++k) cut_nodes.push_back(body.node_count() + static_cast<int32_t>(k));
     for (auto& entry : piece_side_) entry.second = side_of_tet(body, surface, &tets[4 * static_cast<size_t>(entry.first)]);
     // Whole tets with a node the cut goes through.
+    vec<uint8_t> on_node(static_cast<size_t>(body.node_count()), 0);
+    for (size_t i = 0; i < nodes_.size(); ++i) on_node[static_cast<size_t>(nodes_[i])] = on_[i];
     for (int32_t t = 0; t < body.element_count(); ++t) {
-        if (source[static_cast<size_t>(t)] < 0) continue;
-        bool touches = false;
-        for (int a = 0; a < 4 && !touches; ++a) {
-            const int32_t node = corners(body, t)[a];
-            const size_t slot = node_slot(node);
-            touches = slot < nodes_.size() && nodes_[slot] == node && on_[slot];
-        }
-        if (touches) piece_side_.push_back({t, side_of_tet(body, surface, corners(body, t))});
+        const int32_t* tet = corners(body, t);
+        const bool touches = on_node[static_cast<size_t>(tet[0])] | on_node[static_cast<size_t>(tet[1])] |
+                             on_node[static_cast<size_t>(tet[2])] | on_node[static_cast<size_t>(tet[3])];
+        if (touches && source[static_cast<size_t>(t)] >= 0) piece_side_.push_back({t, side_of_tet(body, surface, tet)});
     }
     std::sort(piece_side_.begin(), piece_side_.end());
     for (const auto& entry : piece_side_) {

@@ -74,6 +74,7 @@ FemBody::FemBody(const TetMesh& mesh, const sh_material& material, double dampin
     set.omega2.assign(tet_count, -1.0);
     for (size_t t = 0; t < tet_count; ++t) shape_from_rest(rest, &set.tets[4 * t], &set.inverse_rest[9 * t], set.volume[t]);
     adopt(set, nullptr);
+    surface_index_.build(surface_triangles, mass.size());
 }
 
 void FemBody::shape_from_rest(const vec<double>& rest_positions, const int32_t* tet, double* bm_out, double& volume) {
@@ -102,6 +103,9 @@ void FemBody::set_material(const int32_t* elements, int32_t count, const sh_mate
 
 void FemBody::retopologize(const NodeOrigin* origins, size_t origin_count, vec<int32_t> tets, const vec<int32_t>& source) {
     GrownNodes grown = grow_nodes(origins, origin_count);
+    const vec<int32_t> changed = changed_tets(tets, source);
+    const size_t old_changed = static_cast<size_t>(std::lower_bound(changed.begin(), changed.end(), element_count()) - changed.begin());
+    if (changes_locally(changed.size(), old_changed)) return change_locally(grown, tets, source, changed);
     const size_t tet_count = tets.size() / 4;
     ElementSet set;
     set.tets = std::move(tets);
@@ -109,20 +113,122 @@ void FemBody::retopologize(const NodeOrigin* origins, size_t origin_count, vec<i
     set.volume.resize(tet_count);
     set.materials.resize(tet_count);
     set.omega2.resize(tet_count);
-    for (size_t t = 0; t < tet_count; ++t) {
-        const bool piece = source[t] < 0;
-        const size_t from = static_cast<size_t>(piece ? -1 - source[t] : source[t]);
-        set.materials[t] = materials_[from];
-        if (piece) {
-            shape_from_rest(grown.rest, &set.tets[4 * t], &set.inverse_rest[9 * t], set.volume[t]);
-            set.omega2[t] = -1.0;
-        } else {
-            std::copy(&inverse_rest_[9 * from], &inverse_rest_[9 * from] + 9, &set.inverse_rest[9 * t]);
-            set.volume[t] = volume_[from];
-            set.omega2[t] = element_omega2_[from];
-        }
-    }
+    for (size_t t = 0; t < tet_count; ++t) element_from_source(grown.rest, &set.tets[4 * t], source[t], set, t);
     adopt(set, &grown);
+}
+
+void FemBody::element_from_source(const vec<double>& rest_positions, const int32_t* tet, int32_t source, ElementSet& set,
+                                  size_t slot) const {
+    const bool piece = source < 0;
+    const size_t from = static_cast<size_t>(piece ? -1 - source : source);
+    set.materials[slot] = materials_[from];
+    if (piece) {
+        shape_from_rest(rest_positions, tet, &set.inverse_rest[9 * slot], set.volume[slot]);
+        set.omega2[slot] = -1.0;  // computed by whoever adopts it
+    } else {
+        std::copy(&inverse_rest_[9 * from], &inverse_rest_[9 * from] + 9, &set.inverse_rest[9 * slot]);
+        set.volume[slot] = volume_[from];
+        set.omega2[slot] = element_omega2_[from];
+    }
+}
+
+vec<int32_t> FemBody::changed_tets(const vec<int32_t>& tets, const vec<int32_t>& source) const {
+    vec<int32_t> changed;
+    const size_t old_count = volume_.size();
+    for (size_t t = 0; t < tets.size() / 4; ++t)
+        if (t >= old_count || source[t] != static_cast<int32_t>(t) || !std::equal(&tets[4 * t], &tets[4 * t] + 4, &tets_[4 * t]))
+            changed.push_back(static_cast<int32_t>(t));
+    return changed;
+}
+
+bool FemBody::changes_locally(size_t changed, size_t old) const {
+    size_t lanes = 0;
+    for (const vec<TetBlock>& blocks : blocks_) lanes += blocks.size() * kLanes;
+    // Emptied lanes cost force passes their time: past a quarter, every block is rebuilt.
+    return 4 * changed <= volume_.size() && 4 * (vacant_lanes_ + old) <= lanes;
+}
+
+void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source, const vec<int32_t>& changed) {
+    const size_t old_count = volume_.size(), new_count = tets.size() / 4, count = changed.size();
+    // The changed tets' element data, aside, in changed's order.
+    ElementSet fresh;
+    fresh.tets.resize(4 * count), fresh.inverse_rest.resize(9 * count), fresh.volume.resize(count);
+    fresh.materials.resize(count), fresh.omega2.resize(count);
+    for (size_t k = 0; k < count; ++k) {
+        const size_t t = static_cast<size_t>(changed[k]);
+        std::copy(&tets[4 * t], &tets[4 * t] + 4, &fresh.tets[4 * k]);
+        element_from_source(grown.rest, &tets[4 * t], source[t], fresh, k);
+        if (fresh.omega2[k] < 0.0) fresh.omega2[k] = element_max_frequency_squared(&fresh.inverse_rest[9 * k], fresh.volume[k], fresh.materials[k]);
+    }
+    // Masses: the changed tets' shares move from their old nodes to their new ones.
+    std::copy(mass.begin(), mass.end(), grown.mass.begin());
+    for (size_t k = 0; k < count; ++k) {
+        const size_t t = static_cast<size_t>(changed[k]);
+        if (t < old_count)
+            for (int a = 0; a < 4; ++a) grown.mass[static_cast<size_t>(tets_[4 * t + a])] -= materials_[t].density * volume_[t] / 4.0;
+        for (int a = 0; a < 4; ++a) grown.mass[static_cast<size_t>(fresh.tets[4 * k + a])] += fresh.materials[k].density * fresh.volume[k] / 4.0;
+    }
+    vec<int32_t> surface;
+    SurfaceIndex index;
+    surface_index_.update(surface_triangles, TetChange{tets_.data(), old_count, tets.data(), new_count, changed}, grown.mass.size(),
+                          surface, index);
+    // The changed tets go into new blocks after each model's own.
+    vec<TetBlock> added[SH_MATERIAL_COUNT];
+    vec<int32_t> lanes(count, -1);
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
+        vec<uint32_t> members;
+        for (size_t k = 0; k < count; ++k)
+            if (fresh.materials[k].model == model) members.push_back(static_cast<uint32_t>(k));
+        added[model].assign(block_count(members.size()), TetBlock{});
+        const size_t first = blocks_[model].size();
+        spread_over_lanes(members.data(), members.size(), [&](uint32_t k, bool used, size_t block, int lane) {
+            fill_lane(fresh, k, used, added[model][block], lane);
+            if (used) lanes[k] = static_cast<int32_t>((first + block) * kLanes + static_cast<size_t>(lane));
+        });
+    }
+    // Capacity first, so that nothing below allocates (amortised: a body cut again and again
+    // does not copy its elements at every cut).
+    const auto room = [](auto& v, size_t n) { if (v.capacity() < n) v.reserve(std::max(n, v.capacity() + v.capacity() / 2)); };
+    room(tets_, 4 * new_count), room(inverse_rest_, 9 * new_count), room(volume_, new_count), room(materials_, new_count);
+    room(element_omega2_, new_count), room(lane_of_, new_count);
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) room(blocks_[model], blocks_[model].size() + added[model].size());
+
+    // Commit: nothing below allocates.
+    adopt_nodes(grown);
+    surface_triangles.swap(surface);
+    surface_index_.swap(index);
+    ++topology_version;
+    for (const int32_t t : changed)
+        if (static_cast<size_t>(t) < old_count) vacate_lane(static_cast<size_t>(t));
+    tets_.resize(4 * new_count), inverse_rest_.resize(9 * new_count), volume_.resize(new_count), materials_.resize(new_count);
+    element_omega2_.resize(new_count), lane_of_.resize(new_count);
+    for (size_t k = 0; k < count; ++k) {
+        const size_t t = static_cast<size_t>(changed[k]);
+        std::copy(&fresh.tets[4 * k], &fresh.tets[4 * k] + 4, &tets_[4 * t]);
+        std::copy(&fresh.inverse_rest[9 * k], &fresh.inverse_rest[9 * k] + 9, &inverse_rest_[9 * t]);
+        volume_[t] = fresh.volume[k], materials_[t] = fresh.materials[k], element_omega2_[t] = fresh.omega2[k];
+        lane_of_[t] = lanes[k];
+    }
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
+        blocks_[model].insert(blocks_[model].end(), added[model].begin(), added[model].end());
+    stable_step_ = stable_step_at(*std::max_element(element_omega2_.begin(), element_omega2_.end()));
+    ++matrix_version;
+}
+
+void FemBody::vacate_lane(size_t t) {
+    TetBlock& b = blocks_[materials_[t].model][static_cast<size_t>(lane_of_[t]) / kLanes];
+    const int lane = lane_of_[t] % kLanes;
+    b.lambda_w[lane] = 0.0;
+    b.mu_w[lane] = 0.0;
+    // Like an unused lane, it repeats a live tet of its block (its old nodes may have parted).
+    for (int l = 0; l < kLanes; ++l) {
+        if (l == lane || b.mu_w[l] == 0.0) continue;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) b.Bm.m[i][j][lane] = b.Bm.m[i][j][l];
+        for (int a = 0; a < 4; ++a) b.node[a][lane] = b.node[a][l];
+        break;
+    }
+    ++vacant_lanes_;
 }
 
 vec<double> FemBody::lumped_mass(const ElementSet& set, size_t node_count) {
@@ -137,6 +243,7 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
     const size_t tet_count = set.volume.size();
     vec<double> new_mass = lumped_mass(set, grown ? grown->mass.size() : mass.size());
     vec<TetBlock> new_blocks[SH_MATERIAL_COUNT];
+    vec<int32_t> new_lane_of(tet_count, -1);
     const vec<uint32_t> order = locality_order(set.tets, grown ? grown->x : x);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         vec<uint32_t> members;
@@ -146,9 +253,12 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
         blocks.assign(block_count(members.size()), TetBlock{});
         spread_over_lanes(members.data(), members.size(), [&](uint32_t t, bool used, size_t k, int l) {
             fill_lane(set, t, used, blocks[k], l);
+            if (used) new_lane_of[t] = static_cast<int32_t>(k * kLanes + static_cast<size_t>(l));
         });
     }
     vec<int32_t> surface = grown ? boundary_triangles(set.tets.data(), tet_count) : vec<int32_t>();
+    SurfaceIndex index;
+    if (grown) index.build(surface, grown->mass.size());
 
     double largest = 0.0;
     for (size_t t = 0; t < tet_count; ++t) {
@@ -159,6 +269,7 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
     if (grown) {
         adopt_nodes(*grown);
         surface_triangles.swap(surface);
+        surface_index_.swap(index);
         ++topology_version;
     }
     stable_step_ = stable_step_at(largest);
@@ -170,6 +281,8 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
     materials_.swap(set.materials);
     mass.swap(new_mass);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) blocks_[model].swap(new_blocks[model]);
+    lane_of_.swap(new_lane_of);
+    vacant_lanes_ = 0;
     ++matrix_version;
     update_inverse_mass();
 }
@@ -195,17 +308,30 @@ void FemBody::fill_lane_from(const double* bm, double v0, const sh_material& m, 
 double FemBody::element_max_frequency_squared(const double* bm, double v0, const sh_material& material) {
     // Largest eigenvalue of M_e^-1 K_e with the rest (small-strain) stiffness and the element's
     // share of the lumped mass: an upper bound of the assembled system's (Irons-Treharne).
+    // K_e = V0 B^T D B (B: the 6 x 12 strain-displacement matrix, D: Voigt elasticity) has the
+    // nonzero eigenvalues of V0 D^1/2 B B^T D^1/2, a 6 x 6 problem instead of a 12 x 12 one.
     Eigen::Vector3d g[4];
     for (int a = 0; a < 3; ++a) g[a + 1] = Eigen::Vector3d(bm[3 * a], bm[3 * a + 1], bm[3 * a + 2]);
     g[0] = -(g[1] + g[2] + g[3]);
+    Eigen::Matrix<double, 6, 12> strain = Eigen::Matrix<double, 6, 12>::Zero();  // engineering shears
+    for (int a = 0; a < 4; ++a) {
+        const double x = g[a](0), y = g[a](1), z = g[a](2);
+        strain(0, 3 * a) = x, strain(1, 3 * a + 1) = y, strain(2, 3 * a + 2) = z;
+        strain(3, 3 * a) = y, strain(3, 3 * a + 1) = x;
+        strain(4, 3 * a + 1) = z, strain(4, 3 * a + 2) = y;
+        strain(5, 3 * a) = z, strain(5, 3 * a + 2) = x;
+    }
+    // D's normal block 2 mu I + lambda 1 1^T has eigenvalues 2 mu + 3 lambda (along 1 1 1) and
+    // 2 mu; its shear block is mu I.
     const double lambda = lame_lambda(material), mu = lame_mu(material);
-    Eigen::Matrix<double, 12, 12> k;
-    for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b)
-            k.block<3, 3>(3 * a, 3 * b) = v0 * (lambda * g[a] * g[b].transpose() + mu * g[b] * g[a].transpose() +
-                                                 mu * g[a].dot(g[b]) * Eigen::Matrix3d::Identity());
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> eigen(k, Eigen::EigenvaluesOnly);  // ascending
-    return eigen.eigenvalues()(11) * 4.0 / (material.density * v0);
+    const double shear_root = std::sqrt(2.0 * mu), bulk_root = std::sqrt(std::max(0.0, 2.0 * mu + 3.0 * lambda));
+    Eigen::Matrix<double, 6, 6> d_root = Eigen::Matrix<double, 6, 6>::Zero();
+    d_root.topLeftCorner<3, 3>() = shear_root * Eigen::Matrix3d::Identity() + (bulk_root - shear_root) / 3.0 * Eigen::Matrix3d::Ones();
+    d_root.bottomRightCorner<3, 3>() = std::sqrt(mu) * Eigen::Matrix3d::Identity();
+    const Eigen::Matrix<double, 6, 12> a = d_root * strain;
+    const Eigen::Matrix<double, 6, 6> reduced = v0 * a * a.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(reduced, Eigen::EigenvaluesOnly);  // ascending
+    return eigen.eigenvalues()(5) * 4.0 / (material.density * v0);
 }
 
 void FemBody::add_internal_forces(const double* xs, const double* vs, double* f) const {

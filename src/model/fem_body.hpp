@@ -1,6 +1,7 @@
 // FemBody: a tetrahedral FEM body with per-element materials, lumped mass and Rayleigh damping.
 #pragma once
 
+#include "mesh/surface_index.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "model/body.hpp"
 #include "model/tet_block.hpp"
@@ -23,7 +24,9 @@ public:
     /// rest shape and material (its nodes may be copies of s's), source[t] = -1 - s is a piece
     /// of tet s (s's material, its rest shape from its nodes' rest positions). Recomputes
     /// masses, blocks, the surface and the stable step, and bumps topology_version; a failed
-    /// allocation changes nothing.
+    /// allocation changes nothing. A change of a few tets costs time in their count plus linear
+    /// copies: their old lanes are emptied and they go into new blocks (every block is rebuilt
+    /// in locality order once the emptied lanes reach a quarter of them, or the change is large).
     void retopologize(const NodeOrigin* origins, size_t origin_count, vec<int32_t> tets, const vec<int32_t>& source);
 
     /// Rest volume of tet t (m^3).
@@ -58,6 +61,9 @@ public:
     int32_t inverted_elements() const override { return inverted_elements_; }
     void clear_inverted_elements() override { inverted_elements_ = 0; }
 
+    /// True if node is a corner of a surface triangle.
+    bool on_surface(int32_t node) const { return surface_index_.has_node(node); }
+
     /// The material of tet t.
     const sh_material& material(size_t t) const { return materials_[t]; }
 
@@ -84,6 +90,20 @@ private:
     /// Adopts set (and grown's nodes, for a topology change, then also the new surface):
     /// masses, blocks and the stable step, all or nothing.
     void adopt(ElementSet& set, GrownNodes* grown);
+    /// Writes into slot of set (all but its nodes) the element data of tet (4 nodes over
+    /// rest_positions) coming from body tet `source` as retopologize's source[] says: copied,
+    /// or a piece with its own rest shape (its frequency left negative: to be computed).
+    void element_from_source(const vec<double>& rest_positions, const int32_t* tet, int32_t source, ElementSet& set,
+                             size_t slot) const;
+    /// The tets of tets (after a change described by source, as retopologize takes them) that
+    /// differ from the body's, ascending.
+    vec<int32_t> changed_tets(const vec<int32_t>& tets, const vec<int32_t>& source) const;
+    /// True if a change of `changed` tets (of which old were the body's) is done in place.
+    bool changes_locally(size_t changed, size_t old) const;
+    /// retopologize for the few tets `changed`, in place: see retopologize.
+    void change_locally(GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source, const vec<int32_t>& changed);
+    /// Empties the lane of body tet t (zero weights, a live tet's shape).
+    void vacate_lane(size_t t);
     /// Lumped masses of set over node_count nodes.
     static vec<double> lumped_mass(const ElementSet& set, size_t node_count);
     /// fill_lane for tet t of set.
@@ -104,6 +124,9 @@ private:
     double reference_omega2_ = 0.0;  ///< see reference_frequency_squared
     vec<double> element_omega2_; ///< per tet: its largest squared frequency (Irons-Treharne)
     mutable int32_t inverted_elements_ = 0;  ///< most elements with det F <= 0 at one evaluation
+    vec<int32_t> lane_of_;       ///< per tet: block * kLanes + lane in its model's blocks
+    size_t vacant_lanes_ = 0;    ///< lanes emptied by local changes since blocks were last built
+    SurfaceIndex surface_index_; ///< surface_triangles by their nodes
 };
 
 }  // namespace sh

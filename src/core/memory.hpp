@@ -46,6 +46,14 @@ struct Allocator {
 template <class T>
 using vec = std::vector<T, Allocator<T>>;
 
+/// Makes room in v for n elements without changing its contents; grows the capacity by at
+/// least half when it must grow, so that a body that gains a few nodes or elements at a time
+/// (cut after cut) copies its arrays amortised O(1) times per element. Throws std::bad_alloc.
+template <class T>
+void reserve_growing(vec<T>& v, size_t n) {
+    if (v.capacity() < n) v.reserve(n > v.capacity() + v.capacity() / 2 ? n : v.capacity() + v.capacity() / 2);
+}
+
 /// Constructs a T in memory from sh::allocate.
 template <class T, class... Args>
 T* create(Args&&... args) {

@@ -86,16 +86,23 @@ void measure_held(const Body& body, BreakState& state, double force[3]) {
     }
 }
 
-void count_work(const Body& body, BreakState& state) {
-    if (state.forces.size() != state.previous.size()) return;  // held since the last step: nothing done yet
+double pending_work(const Body& body, const BreakState& state) {
+    if (state.forces.size() != state.previous.size()) return 0.0;  // held since the last step: nothing done yet
+    double work = 0.0;
     for (size_t h = 0; h < state.held.size(); ++h) {
-        const double* x = at(body.x.data(), state.held[h]);
         double moved[3];
-        sub3(x, &state.previous[3 * h], moved);
+        sub3(at(body.x.data(), state.held[h]), &state.previous[3 * h], moved);
         // The blade held the node against the material's force f: it did work -f.dx on it.
-        state.work += std::max(0.0, -dot3(&state.forces[3 * h], moved));
-        for (int k = 0; k < 3; ++k) state.previous[3 * h + static_cast<size_t>(k)] = x[k];
+        work += std::max(0.0, -dot3(&state.forces[3 * h], moved));
     }
+    return work;
+}
+
+void count_work(const Body& body, BreakState& state) {
+    state.work += pending_work(body, state);
+    if (state.forces.size() != state.previous.size()) return;
+    for (size_t h = 0; h < state.held.size(); ++h)
+        for (int k = 0; k < 3; ++k) state.previous[3 * h + static_cast<size_t>(k)] = at(body.x.data(), state.held[h])[k];
 }
 
 void hold_ahead(Body& body, const Collider& tool, double reach, const vec<int32_t>& cut_nodes, BreakState& state) {
@@ -127,6 +134,7 @@ void hold_ahead(Body& body, const Collider& tool, double reach, const vec<int32_
             state.held.push_back(i);
             state.previous.insert(state.previous.end(), at(body.x.data(), i), at(body.x.data(), i) + 3);
         }
+        if (!state.held.empty()) ++state.hold;
     }
     for (const int32_t i : state.held) {
         double target[3];

@@ -20,6 +20,8 @@ struct BreakState {
     vec<int32_t> held;       ///< the nodes the edge holds, ascending
     vec<double> previous;    ///< their positions (3 each) when the work was last counted
     vec<double> forces;      ///< the material's force on each (3 each) at the last step's end
+    double needed = 0.0;     ///< the work (J) a break costs at the blade's last engagement
+    uint64_t hold = 0;       ///< counts the holds: each new set of nodes held gets the next
 };
 
 /// The blade of tool against body at the tool's pose before this step's motion.
@@ -43,9 +45,12 @@ bool crack_ahead(const Collider& tool, double advance, double triangles[18]);
 /// in force (N, world): what the material pushes the blade with.
 void measure_held(const Body& body, BreakState& state, double force[3]);
 
-/// Adds to state.work the work the blade did holding the nodes against the material since the
-/// last count (their displacement against the forces measure_held found at the step's end),
-/// and takes their current positions as the next count's start.
+/// The work (J) the blade did holding the nodes against the material since the last count:
+/// their displacement against the forces measure_held found at the step's end.
+double pending_work(const Body& body, const BreakState& state);
+
+/// Adds pending_work to state.work and takes the held nodes' current positions as the next
+/// count's start.
 void count_work(const Body& body, BreakState& state);
 
 /// Holds the free nodes of body the blade's edge meets, if it holds none: those not on the cut

@@ -120,6 +120,19 @@ public:
         }
     }
 
+    /// What tool's blade holds of body (for the haptic contexts).
+    bool blade_hold(const World& world, Id tool, Id body, BladeHold& out) const override {
+        for (const Sweep& s : swept_) {
+            const BreakState& b = s.breaking;
+            if (s.tool != tool || s.body != body || b.held.empty() || b.forces.size() != 3 * b.held.size()) continue;
+            out.nodes = b.held.data(), out.forces = b.forces.data(), out.count = b.held.size();
+            out.work = b.work + pending_work(world.body(body), b);
+            out.needed = b.needed, out.serial = b.hold;
+            return true;
+        }
+        return false;
+    }
+
     /// Forgets what tool id's blade swept (it stopped cutting), letting go what it held.
     void forget(World& world, Id tool) {
         for (Sweep& s : swept_)
@@ -157,6 +170,7 @@ private:
         count_work(body, sweep.breaking);
         const Engagement engaged = engage(body, tool);
         const double needed = engaged.toughness / tool.cutting.sharpness * engaged.length * advance;
+        sweep.breaking.needed = needed;
         if (!(needed > 0.0)) {
             release(held, sweep.breaking);  // out of the material, or one that never breaks
             return 0;

@@ -55,6 +55,19 @@ struct Buffer {
                                      ///< excess_weight, as the full model weighs it
     double* edge_size = nullptr;     ///< per edge: its rest length (m)
     int32_t* surface_nodes = nullptr;
+    /// A physical blade's hold (cut/breaking.hpp): the buffer nodes the tool's edge holds
+    /// follow the device's tool pose at held_offset (3 each, in the tool's frame), and the
+    /// material's pull on them is rendered; held nodes the buffer does not have add their
+    /// full-model force and torque (about the tool's position) as they were at extraction.
+    int32_t held_count = 0;
+    int32_t* held = nullptr;
+    double* held_offset = nullptr;
+    double held_outside_force[3] = {}, held_outside_torque[3] = {};
+    /// The hold's work so far and its price (J), and which hold it is: the haptic side counts
+    /// the work on and lets go (renders the drop) once it pays the price, before the full
+    /// model breaks the material at its next step.
+    double held_work = 0.0, held_needed = 0.0;
+    uint64_t held_serial = 0;
 
     /// Carves the arrays for capacity from arena (or measures them).
     void carve(Arena& arena, const BufferCapacity& capacity) {
@@ -70,6 +83,8 @@ struct Buffer {
         triangle_size = arena.take<double>(static_cast<size_t>(capacity.triangles()));
         edge_size = arena.take<double>(static_cast<size_t>(capacity.edges()));
         surface_nodes = arena.take<int32_t>(n);
+        held = arena.take<int32_t>(n);
+        held_offset = arena.take<double>(3 * n);
     }
 };
 

@@ -300,9 +300,37 @@ void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], do
     std::fill(other_contact_.begin(), other_contact_.end(), 0);
 }
 
+void HapticContext::fill_held(const World& world, const Collider& tool, Buffer& out) {
+    BladeHold hold;
+    if (!world.blade_hold(def_.tool.value, out.body, hold)) return;
+    const Body& body = world.body(out.body);
+    out.held_work = hold.work;
+    out.held_needed = hold.needed;
+    out.held_serial = hold.serial;
+    for (size_t h = 0; h < hold.count; ++h) {
+        const int32_t node = hold.nodes[h];
+        const int32_t* found = std::lower_bound(out.node_id, out.node_id + out.node_count, node);
+        if (found != out.node_id + out.node_count && *found == node) {
+            const int32_t i = static_cast<int32_t>(found - out.node_id);
+            tool.target.to_local(at(out.x_end, i), &out.held_offset[3 * out.held_count]);
+            out.held[out.held_count++] = i;
+            continue;
+        }
+        double arm[3], torque[3];
+        const double* f = &hold.forces[3 * h];
+        sub3(at(body.x.data(), node), tool.target.p, arm);
+        cross3(arm, f, torque);
+        for (int k = 0; k < 3; ++k) out.held_outside_force[k] += f[k], out.held_outside_torque[k] += torque[k];
+    }
+}
+
 void HapticContext::extract(World& world, double period, Buffer& out) {
     out.body = 0;
     out.node_count = out.tet_count = out.triangle_count = out.surface_node_count = out.edge_count = 0;
+    out.held_count = 0;
+    out.held_work = out.held_needed = 0.0;
+    out.held_serial = 0;
+    for (int k = 0; k < 3; ++k) out.held_outside_force[k] = out.held_outside_torque[k] = 0.0;
     for (int32_t& b : out.block_begin) b = 0;
     out.warnings = 0;
     out.has_proxy = false;
@@ -348,6 +376,7 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
         contacts->mark_nodes_of_other_contacts(&tool, other_contact_.data());
     select_tets(*near.fem, near.point, near.triangle, out);
     fill_buffer(*near.fem, world.gravity, world.step_settings(near.body).runaway_speed, out);
+    fill_held(world, tool, out);
 }
 
 }  // namespace sh

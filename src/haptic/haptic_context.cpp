@@ -23,6 +23,7 @@ struct WorkingArrays {
     double* saved_v;
     double* path_x;
     double* path_v;
+    double* held_pull;
     FrictionRecord* friction;
 };
 
@@ -40,6 +41,7 @@ void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3
     w.saved_v = arena.take<double>(3 * n);
     w.path_x = arena.take<double>(3 * n);
     w.path_v = arena.take<double>(3 * n);
+    w.held_pull = arena.take<double>(3 * n);
     w.friction = arena.take<FrictionRecord>(static_cast<size_t>(capacity.friction_records()));
 }
 
@@ -103,6 +105,7 @@ HapticContext::HapticContext(World& world, const sh_haptic_def& def)
     saved_v_ = w.saved_v;
     path_x_ = w.path_x;
     path_v_ = w.path_v;
+    held_pull_ = w.held_pull;
     friction_ = w.friction;
     friction_capacity_ = capacity_of(def).friction_records();
     pose_ = tool_.target;

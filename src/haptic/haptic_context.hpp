@@ -82,10 +82,14 @@ private:
     void fill_triangles(const FemBody& body, Buffer& out);
     void fill_surface_features(const FemBody& body, Buffer& out);
     void ensure_adjacency(const FemBody& body, Id id);
+    void fill_held(const World& world, const Collider& tool, Buffer& out);
 
     // haptic side
     void load_state(const Buffer& b, bool keep);
     void follow_boundary(const Buffer& b, double t, double* x, double* v) const;
+    void hold_nodes(const Buffer& b, double* x, double* v);
+    void add_held_reaction(const Buffer& b, const double* x, double force[3], double torque[3]);
+    bool hold_broken(const Buffer& b) const { return b.held_serial != 0 && b.held_serial == broken_hold_ && b.body == broken_body_; }
     void adopt(const Buffer& b);
     bool step_buffer(const Buffer& b, double dt, double force[3], double torque[3], int32_t& substeps, bool& contact);
     void add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double force[3],
@@ -121,6 +125,12 @@ private:
     double* saved_v_ = nullptr;
     double* path_x_ = nullptr;  ///< where each boundary node's path starts: the haptic side's
     double* path_v_ = nullptr;  ///< state of the node at the hand-over, else the full model's
+    double* held_pull_ = nullptr;  ///< 3 per held node: the material's pull at the last sub-step
+    double held_work_ = 0.0;       ///< the blade's work on the held nodes since the last break (J)
+    uint64_t broken_hold_ = 0;     ///< the hold the haptic side let go (Buffer::held_serial), 0 none
+    Id broken_body_ = kNullId;     ///< and its body
+    Pose held_pose_;               ///< the tool's pose when the held nodes last moved
+    bool have_held_pose_ = false;
     FrictionRecord* friction_ = nullptr;  ///< the sub-step's friction contacts
     int32_t friction_capacity_ = 0;
     int32_t friction_count_ = 0;

@@ -149,8 +149,51 @@ void HapticContext::follow_boundary(const Buffer& b, double t, double* x, double
     }
 }
 
+void HapticContext::hold_nodes(const Buffer& b, double* x, double* v) {
+    // A physical blade drags the nodes it holds: they move with the device's tool, and the
+    // work it does against the material's pull counts towards the break, as the full model
+    // counts it (cut/breaking.hpp). Once the work pays for the crack, the haptic side lets
+    // them go: the device feels the drop now, the full model breaks the material at its
+    // next step, and until a buffer without the hold arrives its nodes follow the full model.
+    if (hold_broken(b)) return;
+    for (int32_t h = 0; h < b.held_count; ++h) {
+        const int32_t i = b.held[h];
+        const double* offset = &b.held_offset[3 * h];
+        tool_.pose.to_world(offset, at(x, i));
+        tool_.point_velocity(at(x, i), at(v, i));
+        if (!have_held_pose_) continue;
+        double from[3], moved[3];
+        held_pose_.to_world(offset, from);
+        sub3(at(x, i), from, moved);
+        held_work_ += std::max(0.0, -dot3(&held_pull_[3 * h], moved));
+    }
+    held_pose_ = tool_.pose;
+    have_held_pose_ = true;
+    if (b.held_needed > 0.0 && held_work_ >= b.held_needed) broken_hold_ = b.held_serial, broken_body_ = b.body;
+}
+
+void HapticContext::add_held_reaction(const Buffer& b, const double* x, double force[3], double torque[3]) {
+    // The material pulls on the held nodes (force_ holds their weight and elastic force): the
+    // blade holding them feels that pull, and the full model's pull on those it holds outside
+    // the buffer.
+    if (hold_broken(b)) return;
+    for (int32_t h = 0; h < b.held_count; ++h) {
+        const int32_t i = b.held[h];
+        double* pull = &held_pull_[3 * h];
+        double arm[3], t[3];
+        for (int k = 0; k < 3; ++k) pull[k] = at(force_, i)[k] - b.mass[i] * b.gravity[k];
+        sub3(at(x, i), tool_.pose.p, arm);
+        cross3(arm, pull, t);
+        for (int k = 0; k < 3; ++k) force[k] += pull[k], torque[k] += t[k];
+    }
+    for (int k = 0; k < 3; ++k) force[k] += b.held_outside_force[k], torque[k] += b.held_outside_torque[k];
+}
+
 void HapticContext::adopt(const Buffer& b) {
     load_state(b, b.period > 0.0);
+    held_work_ = b.held_work;  // the full model's count up to the buffer's step
+    have_held_pose_ = false;
+    std::memset(held_pull_, 0, 3 * static_cast<size_t>(b.held_count) * sizeof(double));
     age_ = 0.0;
     for (int k = 0; k < SH_WARN_COUNT; ++k)
         if (b.warnings & (1u << k)) warnings_[k].fetch_add(1, std::memory_order_relaxed);
@@ -280,6 +323,7 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
     for (int32_t s = 0; s < substeps; ++s) {
         tool_.pose = interpolate(start, tool_.target, static_cast<double>(s + 1) / substeps);
         follow_boundary(b, t0 + (s + 1) * h, x, v);
+        hold_nodes(b, x, v);
         for (int32_t i = 0; i < b.node_count; ++i)
             for (int k = 0; k < 3; ++k) at(force_, i)[k] = b.mass[i] * b.gravity[k];
         const double* damped_v = b.damping_stiffness > 0.0 ? v : nullptr;
@@ -289,6 +333,7 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
                                                b.damping_stiffness, force_);
         });
         double f_tool[3] = {0.0, 0.0, 0.0}, t_tool[3] = {0.0, 0.0, 0.0};
+        add_held_reaction(b, x, f_tool, t_tool);
         bool touching = false;
         add_contact_forces(b, x, v, force_, f_tool, t_tool, touching);
         contact = touching;

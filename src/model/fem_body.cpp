@@ -188,10 +188,10 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
     }
     // Capacity first, so that nothing below allocates (amortised: a body cut again and again
     // does not copy its elements at every cut).
-    const auto room = [](auto& v, size_t n) { if (v.capacity() < n) v.reserve(std::max(n, v.capacity() + v.capacity() / 2)); };
-    room(tets_, 4 * new_count), room(inverse_rest_, 9 * new_count), room(volume_, new_count), room(materials_, new_count);
-    room(element_omega2_, new_count), room(lane_of_, new_count);
-    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) room(blocks_[model], blocks_[model].size() + added[model].size());
+    reserve_growing(tets_, 4 * new_count), reserve_growing(inverse_rest_, 9 * new_count), reserve_growing(volume_, new_count);
+    reserve_growing(materials_, new_count), reserve_growing(element_omega2_, new_count), reserve_growing(lane_of_, new_count);
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
+        reserve_growing(blocks_[model], blocks_[model].size() + added[model].size());
 
     // Commit: nothing below allocates.
     adopt_nodes(grown);
@@ -332,6 +332,21 @@ double FemBody::element_max_frequency_squared(const double* bm, double v0, const
     const Eigen::Matrix<double, 6, 6> reduced = v0 * a * a.transpose();
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(reduced, Eigen::EigenvaluesOnly);  // ascending
     return eigen.eigenvalues()(5) * 4.0 / (material.density * v0);
+}
+
+double FemBody::element_frequency_bound(const double* bm, const sh_material& material) {
+    // trace K_e = V0 (lambda + 4 mu) sum_a |g_a|^2 (each diagonal block of K_e is
+    // V0 (lambda g_a g_a^T + mu g_a g_a^T + mu |g_a|^2 I)), and K_e is positive semi-definite.
+    double sum = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        double g0 = 0.0;  // g_0 = -(g_1 + g_2 + g_3)
+        for (int a = 0; a < 3; ++a) {
+            sum += bm[3 * a + i] * bm[3 * a + i];
+            g0 -= bm[3 * a + i];
+        }
+        sum += g0 * g0;
+    }
+    return 4.0 * (lame_lambda(material) + 4.0 * lame_mu(material)) * sum / material.density;
 }
 
 void FemBody::add_internal_forces(const double* xs, const double* vs, double* f) const {

@@ -45,6 +45,11 @@ public:
     /// rest volume v0 and material would have.
     static double element_max_frequency_squared(const double* bm, double v0, const sh_material& material);
 
+    /// An upper bound of element_max_frequency_squared (1/s^2), from the trace of the
+    /// element's stiffness (which is at least its largest eigenvalue): at most 6 times it,
+    /// at a tenth of its cost.
+    static double element_frequency_bound(const double* bm, const sh_material& material);
+
     /// Inverse rest shape Bm (9, row-major) and rest volume of tet (4 node indices) at
     /// rest_positions.
     static void shape_from_rest(const vec<double>& rest_positions, const int32_t* tet, double* bm, double& volume);

@@ -17,6 +17,15 @@ void IntegratorWorkspace::resize(int32_t node_count) {
     }
 }
 
+void IntegratorWorkspace::reserve(int32_t node_count) {
+    const size_t n = 3 * static_cast<size_t>(node_count);
+    for (vec<double>* array : {&x0, &v0, &xs, &vs}) reserve_growing(*array, n);
+    for (int i = 0; i < kMaxStages; ++i) {
+        reserve_growing(stage_v[i], n);
+        reserve_growing(stage_a[i], n);
+    }
+}
+
 void save_start_state(SteppedBody& stepped) {
     const Body& body = *stepped.body;
     std::copy(body.x.begin(), body.x.end(), stepped.workspace.x0.begin());

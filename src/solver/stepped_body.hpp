@@ -34,6 +34,10 @@ struct IntegratorWorkspace {
 
     /// Sizes every array for node_count nodes.
     void resize(int32_t node_count);
+
+    /// Makes room in every array for node_count nodes (reserve_growing), so that a later
+    /// resize to at most that many allocates nothing. Throws std::bad_alloc.
+    void reserve(int32_t node_count);
 };
 
 /// A body with its step settings, scratch and the Newton solves' data for it.

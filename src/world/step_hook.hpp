@@ -6,9 +6,23 @@
 
 #include <softhap/softhap.h>
 
+#include <cstddef>
+#include <cstdint>
+
 namespace sh {
 
 class World;
+
+/// What a cutting tool's blade holds of a body under the physical criterion, as the cutting
+/// hook shows it to the haptic contexts (a view: valid until the next step or cut).
+struct BladeHold {
+    const int32_t* nodes = nullptr;   ///< the held nodes, ascending
+    const double* forces = nullptr;   ///< the material's force on each (3 each, N) at the last step's end
+    size_t count = 0;
+    double work = 0.0;     ///< the blade's work on them since the last break, to the last step's end (J)
+    double needed = 0.0;   ///< the work a break costs (J)
+    uint64_t serial = 0;   ///< which hold it is: each new set of held nodes gets the next
+};
 
 /// Something a world calls before and after each full step, in registration order.
 class StepHook {
@@ -37,6 +51,13 @@ public:
 
     /// The world is being destroyed: the hook must not touch it again.
     virtual void detach() = 0;
+
+    /// Fills out with what tool's blade holds of body, if this hook cuts with it and holds
+    /// something; false otherwise.
+    virtual bool blade_hold(const World& world, Id tool, Id body, BladeHold& out) const {
+        (void)world, (void)tool, (void)body, (void)out;
+        return false;
+    }
 };
 
 /// A hook that only changes the scene before each step's motion (cutting, tearing): its other

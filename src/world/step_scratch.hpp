@@ -30,7 +30,7 @@ struct StepScratch {
     /// values, so that a step allocates nothing. Throws std::bad_alloc.
     void reserve_body(size_t slot_count, size_t index, size_t state_size) {
         if (bodies.size() < slot_count) bodies.resize(slot_count);
-        bodies[index].saved.reserve(state_size);
+        reserve_growing(bodies[index].saved, state_size);
         skip.reserve(slot_count);
     }
 

@@ -112,14 +112,15 @@ TopologyScratch::~TopologyScratch() { sh::destroy(doubling); }
 
 void World::prepare_topology_change(Id id, int32_t node_count, TopologyScratch& out) {
     body(id);  // validates
-    out.workspace.resize(node_count);
+    slots_[id_index(id)].stepped->workspace.reserve(node_count);  // room only: its size follows the body's
+    out.node_count = node_count;
     if (error_estimate_) out.doubling = sh::create<StepDoubling>(3 * static_cast<size_t>(node_count));
     scratch_.reserve_body(slots_.size(), id_index(id), 6 * static_cast<size_t>(node_count));
 }
 
 void World::topology_changed(Id id, TopologyScratch& prepared) noexcept {
     Slot& slot = slots_[id_index(id)];
-    std::swap(slot.stepped->workspace, prepared.workspace);
+    slot.stepped->workspace.resize(prepared.node_count);  // within the room prepared: no allocation
     std::swap(slot.doubling, prepared.doubling);
     sh::destroy(slot.contacts);  // rebuilt over the new surface on the next step with contact
     slot.contacts = nullptr;
@@ -193,6 +194,12 @@ StepHook* World::owned_hook(const void* key) const {
     for (const auto& owned : owned_hooks_)
         if (owned.first == key) return owned.second;
     return nullptr;
+}
+
+bool World::blade_hold(Id tool, Id body, BladeHold& out) const {
+    for (const StepHook* hook : hooks_)
+        if (hook->blade_hold(*this, tool, body, out)) return true;
+    return false;
 }
 
 void World::remove_hook(StepHook* hook) { hooks_.erase(std::remove(hooks_.begin(), hooks_.end(), hook), hooks_.end()); }

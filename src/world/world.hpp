@@ -26,7 +26,7 @@ struct StepDoubling;
 /// What a world needs for a body whose topology is about to change, allocated beforehand
 /// (World::prepare_topology_change) so that the change itself cannot fail.
 struct TopologyScratch {
-    IntegratorWorkspace workspace;     ///< the body's integrator scratch at its new size
+    int32_t node_count = 0;            ///< the body's node count after the change
     StepDoubling* doubling = nullptr;  ///< its step-doubling scratch, with error estimates only
     TopologyScratch() = default;
     ~TopologyScratch();
@@ -114,6 +114,10 @@ public:
 
     /// The hook owned under key, or null.
     StepHook* owned_hook(const void* key) const;
+
+    /// What tool's blade holds of body (StepHook::blade_hold, asked of every hook); false if
+    /// it holds nothing.
+    bool blade_hold(Id tool, Id body, BladeHold& out) const;
 
     /// The Hook owned under key, made (default-constructed) and owned first if there is none.
     /// Throws std::bad_alloc owning nothing new.

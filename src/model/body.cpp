@@ -61,43 +61,67 @@ void Body::prescribe_positions(const int32_t* nodes, const double* positions, in
     update_inverse_mass();
 }
 
-GrownNodes Body::grow_nodes(const NodeOrigin* origins, size_t count) const {
+const double* GrownNodes::rest_of(const Body& body, int32_t node) const {
+    const size_t i = static_cast<size_t>(node);
+    return i < first ? &body.rest[3 * i] : &rest[3 * (i - first)];
+}
+
+vec<double> GrownNodes::joined(const vec<double>& values, const vec<double>& appended) {
+    vec<double> all;
+    all.reserve(values.size() + appended.size());
+    all.insert(all.end(), values.begin(), values.end());
+    all.insert(all.end(), appended.begin(), appended.end());
+    return all;
+}
+
+GrownNodes Body::grow_nodes(const NodeOrigin* origins, size_t count) {
     GrownNodes g;
     const size_t n = mass.size(), total = n + count;
-    g.x = x, g.v = v, g.rest = rest, g.target = target, g.external_force = external_force;
-    g.kinematic = kinematic;
-    g.x.resize(3 * total), g.v.resize(3 * total), g.rest.resize(3 * total), g.target.resize(3 * total);
-    g.external_force.resize(3 * total, 0.0);
-    g.kinematic.resize(total, 0);
-    g.mass.assign(total, 0.0);
-    g.inverse_mass.assign(total, 0.0);
-    g.parent.assign(total, -1);
-    std::copy(node_parent.begin(), node_parent.end(), g.parent.begin());
-    if (!node_damping.empty()) g.node_damping = node_damping, g.node_damping.resize(total);
+    g.first = n;
+    g.x.resize(3 * count), g.v.resize(3 * count), g.rest.resize(3 * count), g.target.resize(3 * count);
+    g.kinematic.resize(count), g.parent.resize(count);
+    if (!node_damping.empty()) g.node_damping.resize(count);
+    // An origin may name a node appended before it (a copy of a node made on a crossed edge).
+    const auto of = [&](const vec<double>& own, const vec<double>& appended, size_t node, int stride) {
+        return node < n ? &own[static_cast<size_t>(stride) * node] : &appended[static_cast<size_t>(stride) * (node - n)];
+    };
     for (size_t k = 0; k < count; ++k) {
         const NodeOrigin& o = origins[k];
-        const size_t a = static_cast<size_t>(o.a), b = static_cast<size_t>(o.b), i = n + k;
+        const size_t a = static_cast<size_t>(o.a), b = static_cast<size_t>(o.b);
         const double t = o.t, s = 1.0 - t;
+        const auto held = [&](size_t node) { return node < n ? kinematic[node] != 0 : g.kinematic[node - n] != 0; };
+        g.kinematic[k] = held(a) && held(b);
         for (int c = 0; c < 3; ++c) {
-            g.x[3 * i + c] = s * g.x[3 * a + c] + t * g.x[3 * b + c];
-            g.v[3 * i + c] = s * g.v[3 * a + c] + t * g.v[3 * b + c];
-            g.rest[3 * i + c] = s * g.rest[3 * a + c] + t * g.rest[3 * b + c];
-            g.target[3 * i + c] = s * g.target[3 * a + c] + t * g.target[3 * b + c];
+            g.x[3 * k + c] = s * of(x, g.x, a, 3)[c] + t * of(x, g.x, b, 3)[c];
+            g.v[3 * k + c] = s * of(v, g.v, a, 3)[c] + t * of(v, g.v, b, 3)[c];
+            g.rest[3 * k + c] = s * of(rest, g.rest, a, 3)[c] + t * of(rest, g.rest, b, 3)[c];
+            // a free node's target is where it is
+            g.target[3 * k + c] = g.kinematic[k] ? s * of(target, g.target, a, 3)[c] + t * of(target, g.target, b, 3)[c] : g.x[3 * k + c];
         }
-        g.kinematic[i] = g.kinematic[a] && g.kinematic[b];
-        if (!g.kinematic[i])  // a free node's target is where it is
-            for (int c = 0; c < 3; ++c) g.target[3 * i + c] = g.x[3 * i + c];
-        if (!g.node_damping.empty()) g.node_damping[i] = s * g.node_damping[a] + t * g.node_damping[b];
-        g.parent[i] = t <= 0.5 ? o.a : o.b;
+        if (!node_damping.empty()) g.node_damping[k] = s * *of(node_damping, g.node_damping, a, 1) + t * *of(node_damping, g.node_damping, b, 1);
+        g.parent[k] = t <= 0.5 ? o.a : o.b;
     }
+    for (vec<double>* values : {&x, &v, &rest, &target, &external_force}) reserve_growing(*values, 3 * total);
+    for (vec<double>* values : {&mass, &inverse_mass}) reserve_growing(*values, total);
+    if (!node_damping.empty()) reserve_growing(node_damping, total);
+    reserve_growing(kinematic, total);
+    reserve_growing(node_parent, total);
     return g;
 }
 
-void Body::adopt_nodes(GrownNodes& g) noexcept {
-    x.swap(g.x), v.swap(g.v), rest.swap(g.rest), target.swap(g.target);
-    external_force.swap(g.external_force), node_damping.swap(g.node_damping);
-    mass.swap(g.mass), inverse_mass.swap(g.inverse_mass), kinematic.swap(g.kinematic);
-    node_parent.swap(g.parent);
+void Body::adopt_nodes(const GrownNodes& g) noexcept {
+    const size_t count = g.kinematic.size(), total = g.first + count;
+    x.insert(x.end(), g.x.begin(), g.x.end());
+    v.insert(v.end(), g.v.begin(), g.v.end());
+    rest.insert(rest.end(), g.rest.begin(), g.rest.end());
+    target.insert(target.end(), g.target.begin(), g.target.end());
+    external_force.resize(3 * total, 0.0);
+    if (!node_damping.empty()) node_damping.insert(node_damping.end(), g.node_damping.begin(), g.node_damping.end());
+    mass.resize(total, 0.0);
+    inverse_mass.resize(total, 0.0);
+    kinematic.insert(kinematic.end(), g.kinematic.begin(), g.kinematic.end());
+    node_parent.resize(g.first, -1);  // the body's own nodes have none until a cut appends some
+    node_parent.insert(node_parent.end(), g.parent.begin(), g.parent.end());
     update_inverse_mass();
 }
 

@@ -21,12 +21,26 @@ struct NodeOrigin {
     double t = 0.0;        ///< where on the edge, in [0, 1]
 };
 
-/// A body's node arrays grown by appended nodes, built aside (Body::grow_nodes) so that a
-/// failed allocation leaves the body as it was; Body::adopt_nodes swaps them in.
+class Body;
+
+/// The nodes a topology change appends to a body, built aside (Body::grow_nodes, which also
+/// makes room for them in the body's arrays) so that a failed allocation leaves the body as
+/// it was; Body::adopt_nodes appends them without allocating.
 struct GrownNodes {
-    vec<double> x, v, rest, target, external_force, node_damping, mass, inverse_mass;
+    size_t first = 0;  ///< the first appended node's index: the body's node count before
+    vec<double> x, v, rest, target;  ///< 3 per appended node
+    vec<double> node_damping;        ///< 1 per appended node, if the body has node damping
     vec<uint8_t> kinematic;
     vec<int32_t> parent;
+
+    /// Node count once appended.
+    size_t node_count() const { return first + kinematic.size(); }
+
+    /// The rest position (3 values) of node, the body's own or an appended one.
+    const double* rest_of(const Body& body, int32_t node) const;
+
+    /// values (3 per node of the body) followed by appended's (3 per appended node).
+    static vec<double> joined(const vec<double>& values, const vec<double>& appended);
 };
 
 /// A deformable body. Orphan nodes have zero mass and are never integrated.
@@ -113,14 +127,17 @@ public:
 
     int32_t node_count() const { return static_cast<int32_t>(mass.size()); }
 
-    /// The node arrays with the nodes of origins[0..count) appended, each interpolated along its
-    /// edge (positions, velocities, targets, damping): a node is held (fixed or prescribed) if
-    /// both ends are, carries no external force, and its parent is the nearer end (or the one
-    /// copied). mass is sized and zero: the body's elements give it. Throws std::bad_alloc.
-    GrownNodes grow_nodes(const NodeOrigin* origins, size_t count) const;
+    /// The nodes of origins[0..count), each interpolated along its edge (positions,
+    /// velocities, targets, damping): a node is held (fixed or prescribed) if both ends are,
+    /// carries no external force, and its parent is the nearer end (or the one copied). Makes
+    /// room for them in the body's node arrays (reserve_growing: a body grown node by node
+    /// copies its arrays amortised O(1) times per node), changing nothing else. Throws
+    /// std::bad_alloc.
+    GrownNodes grow_nodes(const NodeOrigin* origins, size_t count);
 
-    /// Swaps grown's arrays in (allocation-free) and recomputes inverse_mass.
-    void adopt_nodes(GrownNodes& grown) noexcept;
+    /// Appends grown's nodes (allocation-free after grow_nodes), with zero mass (the body's
+    /// elements give it) and no external force, and recomputes inverse_mass.
+    void adopt_nodes(const GrownNodes& grown) noexcept;
 
     /// The node each node was made from by a cut (-1 for nodes the body was created with).
     int32_t parent_of(int32_t node) const {

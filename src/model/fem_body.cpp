@@ -78,9 +78,15 @@ FemBody::FemBody(const TetMesh& mesh, const sh_material& material, double dampin
 }
 
 void FemBody::shape_from_rest(const vec<double>& rest_positions, const int32_t* tet, double* bm_out, double& volume) {
+    const double* corners[4];
+    for (int a = 0; a < 4; ++a) corners[a] = &rest_positions[3 * static_cast<size_t>(tet[a])];
+    shape_from_corners(corners, bm_out, volume);
+}
+
+void FemBody::shape_from_corners(const double* const corners[4], double* bm_out, double& volume) {
     Eigen::Matrix3d dm;
     for (int a = 0; a < 3; ++a)
-        for (int i = 0; i < 3; ++i) dm(i, a) = rest_positions[3 * tet[a + 1] + i] - rest_positions[3 * tet[0] + i];
+        for (int i = 0; i < 3; ++i) dm(i, a) = corners[a + 1][i] - corners[0][i];
     volume = dm.determinant() / 6.0;
     const Eigen::Matrix3d bm = dm.inverse();
     for (int i = 0; i < 3; ++i)
@@ -113,17 +119,18 @@ void FemBody::retopologize(const NodeOrigin* origins, size_t origin_count, vec<i
     set.volume.resize(tet_count);
     set.materials.resize(tet_count);
     set.omega2.resize(tet_count);
-    for (size_t t = 0; t < tet_count; ++t) element_from_source(grown.rest, &set.tets[4 * t], source[t], set, t);
+    for (size_t t = 0; t < tet_count; ++t) element_from_source(grown, &set.tets[4 * t], source[t], set, t);
     adopt(set, &grown);
 }
 
-void FemBody::element_from_source(const vec<double>& rest_positions, const int32_t* tet, int32_t source, ElementSet& set,
-                                  size_t slot) const {
+void FemBody::element_from_source(const GrownNodes& grown, const int32_t* tet, int32_t source, ElementSet& set, size_t slot) const {
     const bool piece = source < 0;
     const size_t from = static_cast<size_t>(piece ? -1 - source : source);
     set.materials[slot] = materials_[from];
     if (piece) {
-        shape_from_rest(rest_positions, tet, &set.inverse_rest[9 * slot], set.volume[slot]);
+        const double* corners[4];
+        for (int a = 0; a < 4; ++a) corners[a] = grown.rest_of(*this, tet[a]);
+        shape_from_corners(corners, &set.inverse_rest[9 * slot], set.volume[slot]);
         set.omega2[slot] = -1.0;  // computed by whoever adopts it
     } else {
         std::copy(&inverse_rest_[9 * from], &inverse_rest_[9 * from] + 9, &set.inverse_rest[9 * slot]);
@@ -148,33 +155,24 @@ bool FemBody::changes_locally(size_t changed, size_t old) const {
     return 4 * changed <= volume_.size() && 4 * (vacant_lanes_ + old) <= lanes;
 }
 
-void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source, const vec<int32_t>& changed) {
-    const size_t old_count = volume_.size(), new_count = tets.size() / 4, count = changed.size();
-    // The changed tets' element data, aside, in changed's order.
+FemBody::ElementSet FemBody::fresh_elements(const GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source,
+                                            const vec<int32_t>& changed) const {
+    const size_t count = changed.size();
     ElementSet fresh;
     fresh.tets.resize(4 * count), fresh.inverse_rest.resize(9 * count), fresh.volume.resize(count);
     fresh.materials.resize(count), fresh.omega2.resize(count);
     for (size_t k = 0; k < count; ++k) {
         const size_t t = static_cast<size_t>(changed[k]);
         std::copy(&tets[4 * t], &tets[4 * t] + 4, &fresh.tets[4 * k]);
-        element_from_source(grown.rest, &tets[4 * t], source[t], fresh, k);
+        element_from_source(grown, &tets[4 * t], source[t], fresh, k);
         if (fresh.omega2[k] < 0.0) fresh.omega2[k] = element_max_frequency_squared(&fresh.inverse_rest[9 * k], fresh.volume[k], fresh.materials[k]);
     }
-    // Masses: the changed tets' shares move from their old nodes to their new ones.
-    std::copy(mass.begin(), mass.end(), grown.mass.begin());
-    for (size_t k = 0; k < count; ++k) {
-        const size_t t = static_cast<size_t>(changed[k]);
-        if (t < old_count)
-            for (int a = 0; a < 4; ++a) grown.mass[static_cast<size_t>(tets_[4 * t + a])] -= materials_[t].density * volume_[t] / 4.0;
-        for (int a = 0; a < 4; ++a) grown.mass[static_cast<size_t>(fresh.tets[4 * k + a])] += fresh.materials[k].density * fresh.volume[k] / 4.0;
-    }
-    vec<int32_t> surface;
-    SurfaceIndex index;
-    surface_index_.update(surface_triangles, TetChange{tets_.data(), old_count, tets.data(), new_count, changed}, grown.mass.size(),
-                          surface, index);
-    // The changed tets go into new blocks after each model's own.
-    vec<TetBlock> added[SH_MATERIAL_COUNT];
-    vec<int32_t> lanes(count, -1);
+    return fresh;
+}
+
+void FemBody::fill_new_blocks(const ElementSet& fresh, vec<TetBlock> (&added)[SH_MATERIAL_COUNT], vec<int32_t>& lanes) const {
+    const size_t count = fresh.volume.size();
+    lanes.assign(count, -1);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         vec<uint32_t> members;
         for (size_t k = 0; k < count; ++k)
@@ -186,6 +184,29 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
             if (used) lanes[k] = static_cast<int32_t>((first + block) * kLanes + static_cast<size_t>(lane));
         });
     }
+}
+
+void FemBody::move_masses(const vec<int32_t>& changed, const ElementSet& fresh) noexcept {
+    // The changed tets' shares move from their old nodes to their new ones.
+    for (size_t k = 0; k < changed.size(); ++k) {
+        const size_t t = static_cast<size_t>(changed[k]);
+        if (t < volume_.size())
+            for (int a = 0; a < 4; ++a) mass[static_cast<size_t>(tets_[4 * t + a])] -= materials_[t].density * volume_[t] / 4.0;
+        for (int a = 0; a < 4; ++a) mass[static_cast<size_t>(fresh.tets[4 * k + a])] += fresh.materials[k].density * fresh.volume[k] / 4.0;
+    }
+    update_inverse_mass();
+}
+
+void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source, const vec<int32_t>& changed) {
+    const size_t old_count = volume_.size(), new_count = tets.size() / 4;
+    const ElementSet fresh = fresh_elements(grown, tets, source, changed);  // in changed's order
+    vec<int32_t> surface;
+    SurfaceIndex index;
+    surface_index_.update(surface_triangles, TetChange{tets_.data(), old_count, tets.data(), new_count, changed}, grown.node_count(),
+                          surface, index);
+    vec<TetBlock> added[SH_MATERIAL_COUNT];  // after each model's own blocks
+    vec<int32_t> lanes;
+    fill_new_blocks(fresh, added, lanes);
     // Capacity first, so that nothing below allocates (amortised: a body cut again and again
     // does not copy its elements at every cut).
     reserve_growing(tets_, 4 * new_count), reserve_growing(inverse_rest_, 9 * new_count), reserve_growing(volume_, new_count);
@@ -195,6 +216,7 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
 
     // Commit: nothing below allocates.
     adopt_nodes(grown);
+    move_masses(changed, fresh);
     surface_triangles.swap(surface);
     surface_index_.swap(index);
     ++topology_version;
@@ -202,7 +224,7 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
         if (static_cast<size_t>(t) < old_count) vacate_lane(static_cast<size_t>(t));
     tets_.resize(4 * new_count), inverse_rest_.resize(9 * new_count), volume_.resize(new_count), materials_.resize(new_count);
     element_omega2_.resize(new_count), lane_of_.resize(new_count);
-    for (size_t k = 0; k < count; ++k) {
+    for (size_t k = 0; k < changed.size(); ++k) {
         const size_t t = static_cast<size_t>(changed[k]);
         std::copy(&fresh.tets[4 * k], &fresh.tets[4 * k] + 4, &tets_[4 * t]);
         std::copy(&fresh.inverse_rest[9 * k], &fresh.inverse_rest[9 * k] + 9, &inverse_rest_[9 * t]);
@@ -241,10 +263,10 @@ vec<double> FemBody::lumped_mass(const ElementSet& set, size_t node_count) {
 void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
     // Everything is built aside and swapped in at the end: a failed allocation changes nothing.
     const size_t tet_count = set.volume.size();
-    vec<double> new_mass = lumped_mass(set, grown ? grown->mass.size() : mass.size());
+    vec<double> new_mass = lumped_mass(set, grown ? grown->node_count() : mass.size());
     vec<TetBlock> new_blocks[SH_MATERIAL_COUNT];
     vec<int32_t> new_lane_of(tet_count, -1);
-    const vec<uint32_t> order = locality_order(set.tets, grown ? grown->x : x);
+    const vec<uint32_t> order = locality_order(set.tets, grown ? GrownNodes::joined(x, grown->x) : x);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         vec<uint32_t> members;
         for (const uint32_t t : order)
@@ -258,7 +280,7 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
     }
     vec<int32_t> surface = grown ? boundary_triangles(set.tets.data(), tet_count) : vec<int32_t>();
     SurfaceIndex index;
-    if (grown) index.build(surface, grown->mass.size());
+    if (grown) index.build(surface, grown->node_count());
 
     double largest = 0.0;
     for (size_t t = 0; t < tet_count; ++t) {

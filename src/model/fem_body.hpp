@@ -54,6 +54,10 @@ public:
     /// rest_positions.
     static void shape_from_rest(const vec<double>& rest_positions, const int32_t* tet, double* bm, double& volume);
 
+    /// Inverse rest shape Bm (9, row-major) and rest volume of the tet with corners[4] (3
+    /// values each) at rest.
+    static void shape_from_corners(const double* const corners[4], double* bm, double& volume);
+
     void add_internal_forces(const double* x, const double* v, double* f) const override;
     double elastic_energy(const double* x) const override;
     double stable_step(const double* x) const override;
@@ -95,11 +99,20 @@ private:
     /// Adopts set (and grown's nodes, for a topology change, then also the new surface):
     /// masses, blocks and the stable step, all or nothing.
     void adopt(ElementSet& set, GrownNodes* grown);
-    /// Writes into slot of set (all but its nodes) the element data of tet (4 nodes over
-    /// rest_positions) coming from body tet `source` as retopologize's source[] says: copied,
-    /// or a piece with its own rest shape (its frequency left negative: to be computed).
-    void element_from_source(const vec<double>& rest_positions, const int32_t* tet, int32_t source, ElementSet& set,
-                             size_t slot) const;
+    /// Writes into slot of set (all but its nodes) the element data of tet (4 nodes, the
+    /// body's or grown's) coming from body tet `source` as retopologize's source[] says:
+    /// copied, or a piece with its own rest shape (its frequency left negative: to be computed).
+    void element_from_source(const GrownNodes& grown, const int32_t* tet, int32_t source, ElementSet& set, size_t slot) const;
+    /// The element data of the tets `changed` of tets (as retopologize takes them), in
+    /// changed's order, frequencies computed.
+    ElementSet fresh_elements(const GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source,
+                              const vec<int32_t>& changed) const;
+    /// Blocks per model for fresh's tets, to go after the body's own, and each tet's lane in
+    /// them (block * kLanes + lane, counting the body's blocks).
+    void fill_new_blocks(const ElementSet& fresh, vec<TetBlock> (&added)[SH_MATERIAL_COUNT], vec<int32_t>& lanes) const;
+    /// Moves the lumped masses of the tets `changed` from their old nodes to fresh's (the body's
+    /// elements still the old ones) and recomputes inverse_mass.
+    void move_masses(const vec<int32_t>& changed, const ElementSet& fresh) noexcept;
     /// The tets of tets (after a change described by source, as retopologize takes them) that
     /// differ from the body's, ascending.
     vec<int32_t> changed_tets(const vec<int32_t>& tets, const vec<int32_t>& source) const;

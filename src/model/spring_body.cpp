@@ -72,9 +72,11 @@ bool SpringBody::were_joined(int32_t a, int32_t b) const {
 void SpringBody::retopologize(const vec<NodeOrigin>& copies, vec<int32_t> springs, vec<double> rest_lengths,
                               const vec<double>& masses) {
     GrownNodes grown = grow_nodes(copies.data(), copies.size());
-    grown.mass = masses;
-    vec<double> row_bound(grown.mass.size());
+    vec<double> new_mass = masses;
+    vec<double> row_bound(grown.node_count());
     adopt_nodes(grown);
+    mass.swap(new_mass);
+    update_inverse_mass();
     springs_.swap(springs);
     rest_length_.swap(rest_lengths);
     row_bound_.swap(row_bound);

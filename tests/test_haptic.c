@@ -118,7 +118,8 @@ typedef struct scene {
     sh_tool_id tool;
 } scene;
 
-static scene make_scene(double damping_mass, double tool_z) {
+/* The scene with the block stepped by integrator. */
+static scene make_scene_stepped(double damping_mass, double tool_z, sh_integrator integrator) {
     scene s;
     s.world = sh_test_world(0.0);
     sh_mesh* mesh = sh_test_box(kBlock[0], kBlock[1], kBlock[2], 8, 8, 4);
@@ -130,6 +131,7 @@ static scene make_scene(double damping_mass, double tool_z) {
     def.material.poisson = 0.3;
     def.material.density = 1000.0;
     def.damping_mass = damping_mass;
+    def.integrator = integrator;
     assert_ok(sh_fem_body_create(s.world, &def, &s.body));
     const sh_mesh_info info = sh_test_mesh_info(mesh);
     double* x = malloc(3 * sizeof(double) * (size_t)info.node_count);
@@ -152,6 +154,13 @@ static scene make_scene(double damping_mass, double tool_z) {
     tool.position[2] = tool_z;
     assert_ok(sh_tool_create(s.world, &tool, &s.tool));
     return s;
+}
+
+/* The scene (symplectic Euler, the default). */
+static scene make_scene(double damping_mass, double tool_z) {
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    return make_scene_stepped(damping_mass, tool_z, def.integrator);
 }
 
 static sh_haptic_def haptic_def(const scene* s) {
@@ -663,6 +672,59 @@ static void test_convex_tool_steps_without_allocating(void** state) {
 #endif
 }
 
+/* A physical blade dragged through the block with a haptic context: the haptic side moves the
+ * held nodes with the device, renders their pull, counts the blade's work and lets go, and
+ * adopts the buffers the full model's breaks re-cut, all without allocating. The hold is
+ * felt (a force against the motion), and the full model breaks the block on the way. */
+static void test_physical_blade_hold_steps_without_allocating(void** state) {
+    (void)state;
+    const double top = kBlock[2], y = 0.5 * kBlock[1] + 1e-4, dt = 1e-3, speed = 0.02;
+    scene s = make_scene_stepped(40.0, top + 0.005, SH_INTEGRATOR_IMPLICIT_EULER);
+    assert_ok(sh_tool_destroy(s.world, s.tool));
+    sh_collider_def tool;
+    sh_collider_def_default(&tool);
+    tool.shape.radius = 0.0005; /* the blade's only contact: its own shape stays above the block */
+    tool.position[0] = -0.003, tool.position[1] = y, tool.position[2] = top + 0.005;
+    assert_ok(sh_tool_create(s.world, &tool, &s.tool));
+    sh_cut_def cut;
+    sh_cut_def_default(&cut);
+    cut.criterion = SH_CUT_PHYSICAL;
+    cut.edge[0][2] = -0.011, cut.edge[1][2] = 0.0; /* reaches 6 mm into the block */
+    cut.resolution = 0.0025;
+    assert_ok(sh_tool_set_cutting(s.world, s.tool, &cut));
+    sh_haptic_def def = haptic_def(&s);
+    def.radius = 0.008;
+    def.stale_after = 1e3;
+    sh_haptic* haptic = NULL;
+    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    int32_t cut_faces = 0;
+    double largest = 0.0;
+    long allocations = 0;
+    for (int i = 0; -0.003 + speed * dt * i < kBlock[0] + 0.003; ++i) {
+        const double p[3] = {-0.003 + speed * dt * i, y, top + 0.005};
+        if (i % 17 == 0) { /* the full model at 60 Hz */
+            assert_ok(sh_tool_set_pose(s.world, s.tool, p, kIdentity));
+            sh_step_report report;
+            assert_ok(sh_world_step(s.world, 1.0 / 60.0, &report));
+            cut_faces += report.cut_faces;
+        }
+        sh_haptic_output out;
+        atomic_store(&g_watched_allocations, 0);
+        tl_watched = 1;
+        assert_ok(sh_haptic_step(haptic, p, kIdentity, dt, &out));
+        tl_watched = 0;
+        allocations += atomic_load(&g_watched_allocations);
+        largest = fmax(largest, -out.raw_force[0]);
+    }
+    printf("physical blade through the block: %d faces cut, largest rendered force %.4g N, %ld allocations\n", cut_faces,
+           largest, allocations);
+    assert_int_equal(allocations, 0);
+    assert_true(cut_faces > 0);
+    assert_true(largest > 0.01);
+    assert_ok(sh_haptic_destroy(haptic));
+    sh_world_destroy(s.world);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_whole_body_buffer_matches_static_solve),
@@ -672,6 +734,7 @@ int main(void) {
         cmocka_unit_test(test_first_force_one_tick_after_contact),
         cmocka_unit_test(test_capacity_overflow_keeps_the_nearest),
         cmocka_unit_test(test_convex_tool_steps_without_allocating),
+        cmocka_unit_test(test_physical_blade_hold_steps_without_allocating),
         cmocka_unit_test(test_haptic_thread_never_allocates_nor_locks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

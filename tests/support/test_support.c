@@ -30,6 +30,11 @@ sh_material sh_test_material(sh_material_model model, double young, double poiss
     return m;
 }
 
+void sh_test_skip_from_environment(void) {
+    const char* pattern = getenv("SOFTHAP_SKIP_TESTS");
+    if (pattern && pattern[0]) cmocka_set_skip_filter(pattern);
+}
+
 sh_world* sh_test_world(double gravity_z) {
     sh_world_def def;
     sh_world_def_default(&def);

@@ -21,6 +21,11 @@
 /** Asserts that expr returns SH_OK. */
 #define assert_ok(expr) assert_status((expr), SH_OK)
 
+/** Skips the tests whose names match the cmocka pattern in the environment variable
+ *  SOFTHAP_SKIP_TESTS, if set: for runs that leave out what another run covers (the
+ *  sanitizer builds leave out their slowest explicit-contact study, see the Makefile). */
+void sh_test_skip_from_environment(void);
+
 /** Implementation of assert_status. */
 void sh_test_assert_status(sh_status got, sh_status expected, const char* expr, const char* file, int line);
 

@@ -164,8 +164,7 @@ FemBody::ElementSet FemBody::fresh_elements(const GrownNodes& grown, const vec<i
     for (size_t k = 0; k < count; ++k) {
         const size_t t = static_cast<size_t>(changed[k]);
         std::copy(&tets[4 * t], &tets[4 * t] + 4, &fresh.tets[4 * k]);
-        element_from_source(grown, &tets[4 * t], source[t], fresh, k);
-        if (fresh.omega2[k] < 0.0) fresh.omega2[k] = element_max_frequency_squared(&fresh.inverse_rest[9 * k], fresh.volume[k], fresh.materials[k]);
+        element_from_source(grown, &tets[4 * t], source[t], fresh, k);  // a piece's frequency: when asked for
     }
     return fresh;
 }
@@ -233,7 +232,7 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
     }
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
         blocks_[model].insert(blocks_[model].end(), added[model].begin(), added[model].end());
-    stable_step_ = stable_step_at(*std::max_element(element_omega2_.begin(), element_omega2_.end()));
+    stable_step_known_ = false;  // new pieces' frequencies are found when the step is asked for
     ++matrix_version;
 }
 
@@ -295,6 +294,7 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
         ++topology_version;
     }
     stable_step_ = stable_step_at(largest);
+    stable_step_known_ = true;
     if (!grown) reference_omega2_ = largest;
     tets_.swap(set.tets);
     inverse_rest_.swap(set.inverse_rest);
@@ -390,7 +390,21 @@ double FemBody::elastic_energy(const double* xs) const {
     return energy;
 }
 
-double FemBody::stable_step(const double*) const { return stable_step_; }
+double FemBody::frequency_squared_of(size_t t) const {
+    double& omega2 = element_omega2_[t];
+    if (omega2 < 0.0) omega2 = element_max_frequency_squared(&inverse_rest_[9 * t], volume_[t], materials_[t]);
+    return omega2;
+}
+
+double FemBody::stable_step(const double*) const {
+    if (!stable_step_known_) {
+        double largest = 0.0;
+        for (size_t t = 0; t < volume_.size(); ++t) largest = std::max(largest, frequency_squared_of(t));
+        stable_step_ = stable_step_at(largest);
+        stable_step_known_ = true;
+    }
+    return stable_step_;
+}
 
 double FemBody::stable_step_at(double omega2) const {
     const double omega = std::sqrt(omega2);
@@ -401,7 +415,7 @@ double FemBody::stable_step_at(double omega2) const {
 
 double FemBody::stable_step_of(const int32_t* tets, size_t count) const {
     double largest = 0.0;
-    for (size_t k = 0; k < count; ++k) largest = std::max(largest, element_omega2_[static_cast<size_t>(tets[k])]);
+    for (size_t k = 0; k < count; ++k) largest = std::max(largest, frequency_squared_of(static_cast<size_t>(tets[k])));
     return stable_step_at(largest);
 }
 

@@ -32,12 +32,9 @@ public:
     /// Rest volume of tet t (m^3).
     double rest_volume(size_t t) const { return volume_[t]; }
 
-    /// Squared largest frequency of tet t alone at rest (1/s^2): stable_step is 2/omega over the
-    /// largest of them.
-    double element_frequency_squared(size_t t) const { return element_omega2_[t]; }
-
-    /// The largest element_frequency_squared when the body's materials were last set (at
-    /// creation or by set_material): cuts keep every piece's frequency within a bound of it, so
+    /// The largest squared frequency of a tet alone at rest (1/s^2; stable_step is 2/omega
+    /// over the largest) when the body's materials were last set (at creation or by
+    /// set_material): cuts keep every piece's frequency within a bound of it, so
     /// that the critical step never falls far below the uncut body's however often it is cut.
     double reference_frequency_squared() const { return reference_omega2_; }
 
@@ -129,6 +126,8 @@ private:
     /// Writes one lane from a tet's Bm, rest volume, material and nodes.
     static void fill_lane_from(const double* bm, double v0, const sh_material& m, const int32_t nodes[4], bool used,
                                TetBlock& b, int lane);
+    /// element_omega2_[t], computed first if unknown.
+    double frequency_squared_of(size_t t) const;
     /// 2/omega with the stiffness damping, for omega^2 = omega2 (1/s^2).
     double stable_step_at(double omega2) const;
 
@@ -138,9 +137,12 @@ private:
     vec<sh_material> materials_; ///< per tet
     vec<TetBlock> blocks_[SH_MATERIAL_COUNT];  ///< per sh_material_model
     double damping_stiffness_;
-    double stable_step_ = 0.0;   ///< 2/omega_max at rest, with stiffness damping
+    mutable double stable_step_ = 0.0;       ///< 2/omega_max at rest, with stiffness damping
+    mutable bool stable_step_known_ = false; ///< false after a local change, until asked for
     double reference_omega2_ = 0.0;  ///< see reference_frequency_squared
-    vec<double> element_omega2_; ///< per tet: its largest squared frequency (Irons-Treharne)
+    /// per tet: its largest squared frequency (Irons-Treharne); negative until asked for, for
+    /// a piece a local change made (an implicit body never asks)
+    mutable vec<double> element_omega2_;
     mutable int32_t inverted_elements_ = 0;  ///< most elements with det F <= 0 at one evaluation
     vec<int32_t> lane_of_;       ///< per tet: block * kLanes + lane in its model's blocks
     size_t vacant_lanes_ = 0;    ///< lanes emptied by local changes since blocks were last built

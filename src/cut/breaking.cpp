@@ -42,12 +42,16 @@ Engagement engage(const Body& body, const Collider& tool) {
     double a[3], b[3];
     tool.start.to_world(tool.cutting.edge[0], a);
     tool.start.to_world(tool.cutting.edge[1], b);
-    int first = -1, last = -1;
+    double samples[3 * kSamples];
     for (int s = 0; s < kSamples; ++s) {
         const double u = static_cast<double>(s) / (kSamples - 1);
-        double p[3];
-        for (int k = 0; k < 3; ++k) p[k] = (1.0 - u) * a[k] + u * b[k];
-        if (rest_point(body, p).inside < -kSlitSlack) continue;
+        for (int k = 0; k < 3; ++k) samples[3 * s + k] = (1.0 - u) * a[k] + u * b[k];
+    }
+    RestPoint mapped[kSamples];
+    rest_points(body, samples, kSamples, mapped);
+    int first = -1, last = -1;
+    for (int s = 0; s < kSamples; ++s) {
+        if (mapped[s].inside < -kSlitSlack) continue;
         if (first < 0) first = s;
         last = s;
     }
@@ -148,10 +152,11 @@ bool break_at_rest(const Body& body, const Collider& tool, const BreakState& sta
     double a[3], b[3], across[3], distance = 0.0;
     if (!blade_frame(tool, a, b, across, distance)) return false;
     double ra[3], rb[3], forward[3], direction[3];
-    to_rest(body, a, ra);
-    to_rest(body, b, rb);
     for (int k = 0; k < 3; ++k) forward[k] = a[k] + advance * across[k];
-    to_rest(body, forward, direction);
+    const double world[9] = {a[0], a[1], a[2], b[0], b[1], b[2], forward[0], forward[1], forward[2]};
+    double rest_of[9];
+    to_rest_all(body, world, 3, rest_of);
+    for (int k = 0; k < 3; ++k) ra[k] = rest_of[k], rb[k] = rest_of[3 + k], direction[k] = rest_of[6 + k];
     sub3(direction, ra, direction);
     const double length = norm3(direction);
     if (!(length > 0.0)) return false;

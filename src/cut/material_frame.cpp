@@ -1,29 +1,38 @@
 #include "cut/material_frame.hpp"
 
+#include "core/memory.hpp"
 #include "core/vec3.hpp"
 #include "model/body.hpp"
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
 
 namespace sh {
 namespace {
 
-/// Barycentric weights of p in tet (a, b, c, d) at positions x; false for a flat tet.
-bool weights_in(const double* x, const int32_t* tet, const double p[3], double w[4]) {
-    Eigen::Matrix3d m;
-    Eigen::Vector3d r;
-    for (int i = 0; i < 3; ++i) {
-        for (int a = 0; a < 3; ++a) m(i, a) = at(x, tet[a + 1])[i] - at(x, tet[0])[i];
-        r(i) = p[i] - at(x, tet[0])[i];
+/// The map from world points to barycentric weights in tet (a, b, c, d) at positions x: the
+/// inverse edge matrix and the first corner; false for a flat tet.
+struct TetMap {
+    Eigen::Matrix3d inverse;
+    Eigen::Vector3d origin;
+    bool form(const double* x, const int32_t* tet) {
+        Eigen::Matrix3d m;
+        for (int i = 0; i < 3; ++i) {
+            for (int a = 0; a < 3; ++a) m(i, a) = at(x, tet[a + 1])[i] - at(x, tet[0])[i];
+            origin(i) = at(x, tet[0])[i];
+        }
+        const double det = m.determinant();
+        if (!(std::fabs(det) > 0.0)) return false;
+        inverse = m.inverse();
+        return true;
     }
-    const double det = m.determinant();
-    if (!(std::fabs(det) > 0.0)) return false;
-    const Eigen::Vector3d u = m.inverse() * r;
-    w[0] = 1.0 - u.sum(), w[1] = u(0), w[2] = u(1), w[3] = u(2);
-    return true;
-}
+    void weights(const double p[3], double w[4]) const {
+        const Eigen::Vector3d u = inverse * (Eigen::Vector3d(p[0], p[1], p[2]) - origin);
+        w[0] = 1.0 - u.sum(), w[1] = u(0), w[2] = u(1), w[3] = u(2);
+    }
+};
 
 void nearest_node_offset(const Body& body, const double p[3], double out[3]) {
     double best = INFINITY;
@@ -40,37 +49,53 @@ void nearest_node_offset(const Body& body, const double p[3], double out[3]) {
 
 RestPoint rest_point(const Body& body, const double p[3]) {
     RestPoint found;
-    if (body.nodes_per_element() != 4 || body.element_count() == 0) {
-        nearest_node_offset(body, p, found.position);
-        return found;
-    }
-    double best_w[4] = {0, 0, 0, 0};
-    found.inside = -INFINITY;
-    for (int32_t t = 0; t < body.element_count(); ++t) {
-        const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(t);
-        double w[4];
-        if (!weights_in(body.x.data(), tet, p, w)) continue;
-        const double inside = std::fmin(std::fmin(w[0], w[1]), std::fmin(w[2], w[3]));  // >= 0 inside
-        if (inside <= found.inside) continue;
-        found.inside = inside, found.tet = t;
-        for (int a = 0; a < 4; ++a) best_w[a] = w[a];
-        if (inside >= 0.0) break;
-    }
-    if (found.tet < 0) {
-        nearest_node_offset(body, p, found.position);
-        return found;
-    }
-    const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(found.tet);
-    for (int k = 0; k < 3; ++k) {
-        found.position[k] = 0.0;
-        for (int a = 0; a < 4; ++a) found.position[k] += best_w[a] * at(body.rest.data(), tet[a])[k];
-    }
+    rest_points(body, p, 1, &found);
     return found;
 }
 
-void to_rest(const Body& body, const double p[3], double out[3]) {
-    const RestPoint found = rest_point(body, p);
-    for (int k = 0; k < 3; ++k) out[k] = found.position[k];
+void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
+    if (body.nodes_per_element() != 4 || body.element_count() == 0) {
+        for (int i = 0; i < count; ++i) out[i] = RestPoint{}, nearest_node_offset(body, &p[3 * i], out[i].position);
+        return;
+    }
+    // Per point: the first tet that contains it, else the one it is least outside of.
+    vec<double> best_w(4 * static_cast<size_t>(count), 0.0);
+    for (int i = 0; i < count; ++i) out[i] = RestPoint{}, out[i].inside = -INFINITY;
+    int found_inside = 0;
+    TetMap map;
+    for (int32_t t = 0; t < body.element_count() && found_inside < count; ++t) {
+        if (!map.form(body.x.data(), body.element_nodes() + 4 * static_cast<size_t>(t))) continue;
+        for (int i = 0; i < count; ++i) {
+            if (out[i].inside >= 0.0) continue;
+            double w[4];
+            map.weights(&p[3 * i], w);
+            const double inside = std::fmin(std::fmin(w[0], w[1]), std::fmin(w[2], w[3]));  // >= 0 inside
+            if (inside <= out[i].inside) continue;
+            out[i].inside = inside, out[i].tet = t;
+            std::copy(w, w + 4, &best_w[4 * static_cast<size_t>(i)]);
+            found_inside += inside >= 0.0 ? 1 : 0;
+        }
+    }
+    for (int i = 0; i < count; ++i) {
+        if (out[i].tet < 0) {
+            nearest_node_offset(body, &p[3 * i], out[i].position);
+            continue;
+        }
+        const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(out[i].tet);
+        for (int k = 0; k < 3; ++k) {
+            out[i].position[k] = 0.0;
+            for (int a = 0; a < 4; ++a) out[i].position[k] += best_w[4 * static_cast<size_t>(i) + a] * at(body.rest.data(), tet[a])[k];
+        }
+    }
+}
+
+void to_rest(const Body& body, const double p[3], double out[3]) { to_rest_all(body, p, 1, out); }
+
+void to_rest_all(const Body& body, const double* p, int count, double* out) {
+    vec<RestPoint> found(static_cast<size_t>(count));
+    rest_points(body, p, count, found.data());
+    for (int i = 0; i < count; ++i)
+        for (int k = 0; k < 3; ++k) out[3 * i + k] = found[static_cast<size_t>(i)].position[k];
 }
 
 }  // namespace sh

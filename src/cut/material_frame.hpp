@@ -20,7 +20,14 @@ struct RestPoint {
 /// outside of: an extrapolation); for a body without tets, p's offset from the nearest node.
 RestPoint rest_point(const Body& body, const double p[3]);
 
+/// rest_point of each of the count points p (3 each) into out[count], in one pass over the
+/// tets (each tet's map is formed once for all the points).
+void rest_points(const Body& body, const double* p, int count, RestPoint* out);
+
 /// rest_point's position alone.
 void to_rest(const Body& body, const double p[3], double out[3]);
+
+/// to_rest of each of the count points p (3 each) into out (3 each), in one pass.
+void to_rest_all(const Body& body, const double* p, int count, double* out);
 
 }  // namespace sh

@@ -186,7 +186,7 @@ private:
         }
         if (sweep.breaking.held.empty()) {
             // Refine before holding, so that nodes lie within reach ahead of the edge.
-            for (int c = 0; c < 6; ++c) to_rest(body, &ahead[3 * c], &rest[3 * c]);
+            to_rest_all(body, ahead, 6, rest);
             refine_body_near(world, body_id, quad_sides(rest).data(), 4, advance, &sweep.on_nodes);
         }
         hold_ahead(held, tool, advance, sweep.on_nodes, sweep.breaking);
@@ -198,7 +198,7 @@ private:
     /// separated.
     int32_t cut_along(World& world, Sweep& sweep, Id body_id, const Body& body, const double triangles[18], double edge_length) {
         double rest[18];
-        for (int c = 0; c < 6; ++c) to_rest(body, &triangles[3 * c], &rest[3 * c]);
+        to_rest_all(body, triangles, 6, rest);
         return cut_along_rest(world, sweep, body_id, rest, edge_length);
     }
 

@@ -46,6 +46,26 @@ def test_empty_world_steps_and_reports():
             report.no_such_field
 
 
+def test_step_without_a_report_steps_the_same():
+    # report=False returns None and leaves out only the report: two worlds stepped alike, one
+    # with reports and one without, hold bit-identical states (a falling, deforming tet).
+    states = []
+    for report in (True, False):
+        with softhap.World() as world:
+            body = tet_body(world, integrator="implicit_euler")
+            body.fix_nodes([0])
+            returned = [world.step(0.01, report=report) for _ in range(20)]
+            assert all((r is None) != report for r in returned)
+            states.append((body.positions, body.velocities))
+    np.testing.assert_array_equal(states[0][0], states[1][0])
+    np.testing.assert_array_equal(states[0][1], states[1][1])
+    assert np.abs(states[0][0] - UNIT_TET).max() > 1e-6  # it moved
+    with softhap.World() as world:
+        with pytest.raises(softhap.Error) as info:
+            world.step(-1.0, report=False)
+        assert info.value.status == softhap.Status.SH_ERR_INVALID_ARGUMENT and info.value.report is None
+
+
 @pytest.mark.parametrize("dt", [-1.0, math.nan, math.inf])
 def test_bad_time_step_is_invalid_argument(dt):
     with softhap.World() as world:

@@ -92,7 +92,7 @@ class World(WorldContacts):
         check(lib.sh_world_get_warnings(handle, counters), "sh_world_get_warnings")
         return {kind.name: int(counters[int(kind)]) for kind in WarningKind}
 
-    def step(self, dt: float) -> StepReport:
+    def step(self, dt: float, report: bool = True) -> Optional[StepReport]:
         """Advance every body by dt seconds and return the StepReport (a dict with attribute
         access: wall_seconds, substeps, dt_critical, kinetic_energy, elastic_energy,
         potential_energy, warnings (set of names), warning_bits, unstable_body_count, ...;
@@ -106,8 +106,15 @@ class World(WorldContacts):
         SH_ERR_SOLVER or SH_ERR_NOT_CONVERGED) that body is as before and the other bodies still
         advanced; the raised softhap.Error then carries the step's report as ``err.report``
         (None when nothing was stepped, e.g. for an invalid dt).
+
+        With report=False the step returns None and skips what only the report needs: the
+        library then sums no energies (a pass over every element of every body) and Python
+        builds no report; the step itself is the same. A failure's err.report is then None.
         """
         handle = self._require_handle("sh_world_step")
+        if not report:
+            check(lib.sh_world_step(handle, float(dt), None), "sh_world_step")
+            return None
         raw = sh_step_report()
         raw.substeps = 0  # sentinel: the library writes >= 1 when it stepped the bodies
         status = lib.sh_world_step(handle, float(dt), ctypes.byref(raw))

@@ -122,7 +122,6 @@ void Body::adopt_nodes(const GrownNodes& g) noexcept {
     kinematic.insert(kinematic.end(), g.kinematic.begin(), g.kinematic.end());
     node_parent.resize(g.first, -1);  // the body's own nodes have none until a cut appends some
     node_parent.insert(node_parent.end(), g.parent.begin(), g.parent.end());
-    update_inverse_mass();
 }
 
 void Body::set_node_damping(const double* coefficients) {

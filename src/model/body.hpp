@@ -135,8 +135,9 @@ public:
     /// std::bad_alloc.
     GrownNodes grow_nodes(const NodeOrigin* origins, size_t count);
 
-    /// Appends grown's nodes (allocation-free after grow_nodes), with zero mass (the body's
-    /// elements give it) and no external force, and recomputes inverse_mass.
+    /// Appends grown's nodes (allocation-free after grow_nodes), with zero mass and inverse
+    /// mass and no external force: the caller gives them their masses from the elements, then
+    /// calls update_inverse_mass.
     void adopt_nodes(const GrownNodes& grown) noexcept;
 
     /// The node each node was made from by a cut (-1 for nodes the body was created with).

@@ -43,9 +43,6 @@ public:
     void update(const vec<int32_t>& triangles, const TetChange& change, size_t node_count, vec<int32_t>& out_triangles,
                 SurfaceIndex& out) const;
 
-    /// Boundary triangles indexed.
-    size_t size() const { return faces_.size(); }
-
     /// Exchanges the contents with other (never allocates).
     void swap(SurfaceIndex& other) noexcept {
         faces_.swap(other.faces_);

@@ -55,13 +55,40 @@ public:
     bool is_direct() const override { return true; }
 
 protected:
-    void do_analyze(const SparseSystem& a) override {
+    void do_analyze(const SparseSystem& a, const EliminationOrder* suggested) override {
         free_all();
         cholmod_sparse matrix = wrap(a);
+        const double nodes = static_cast<double>(a.dof_count() / 3);
+        if (suggested) factor_ = analyze_in_order(matrix, *suggested);
+        if (factor_) {
+            fill_per_node_ = suggested->fill_per_node;
+            flops_per_node_ = suggested->flops_per_node;
+            return;
+        }
         factor_ = cholmod_analyze(&matrix, &common_);
         check(factor_ != nullptr, "symbolic analysis");
+        fill_per_node_ = common_.lnz / nodes;
+        flops_per_node_ = common_.fl / nodes;
     }
 
+    bool do_elimination_order(EliminationOrder& out) const override {
+        // AMD orders a node's three DOFs together (they have the same neighbours), so the
+        // node order is the order of each node's first DOF.
+        const size_t nodes = factor_->n / 3;
+        const int* perm = static_cast<const int*>(factor_->Perm);
+        vec<int32_t> order;
+        order.reserve(nodes);
+        vec<uint8_t> seen(nodes, 0);
+        for (size_t k = 0; k < factor_->n; ++k) {
+            const size_t node = static_cast<size_t>(perm[k]) / 3;
+            if (!seen[node]) order.push_back(static_cast<int32_t>(node));
+            seen[node] = 1;
+        }
+        out.nodes.swap(order);
+        out.fill_per_node = fill_per_node_;
+        out.flops_per_node = flops_per_node_;
+        return true;
+    }
     void do_factorize(const SparseSystem& a) override {
         cholmod_sparse matrix = wrap(a);
         const int ok = cholmod_factorize(&matrix, factor_, &common_);
@@ -119,6 +146,29 @@ protected:
     }
 
 private:
+    // The symbolic analysis of matrix in the suggested node order (each node's DOFs together),
+    // or null if that order's fill or flops exceed what kSuggestedOrderTolerance allows: a fresh
+    // ordering then pays for itself within a few factorisations.
+    cholmod_factor* analyze_in_order(cholmod_sparse& matrix, const EliminationOrder& order) {
+        const size_t nodes = order.nodes.size();
+        vec<int32_t> perm(3 * nodes);
+        for (size_t k = 0; k < nodes; ++k)
+            for (int32_t c = 0; c < 3; ++c) perm[3 * k + static_cast<size_t>(c)] = 3 * order.nodes[k] + c;
+        const int methods = common_.nmethods;
+        const int ordering = common_.method[0].ordering;
+        common_.nmethods = 1;
+        common_.method[0].ordering = CHOLMOD_GIVEN;
+        cholmod_factor* factor = cholmod_analyze_p(&matrix, perm.data(), nullptr, 0, &common_);
+        common_.nmethods = methods;
+        common_.method[0].ordering = ordering;
+        check(factor != nullptr, "symbolic analysis in a given order");
+        const double allowed = kSuggestedOrderTolerance * static_cast<double>(nodes);
+        const bool fills = order.fill_per_node > 0.0 && common_.lnz > allowed * order.fill_per_node;
+        const bool slows = order.flops_per_node > 0.0 && common_.fl > allowed * order.flops_per_node;
+        if (fills || slows) cholmod_free_factor(&factor, &common_);
+        return factor;
+    }
+
     // The system's upper triangle as a packed, sorted, stype = 1 CHOLMOD matrix over its arrays.
     // CHOLMOD only reads an input matrix, so the const_casts are safe.
     static cholmod_sparse wrap(const SparseSystem& a) {
@@ -158,6 +208,8 @@ private:
 
     cholmod_common common_;
     cholmod_factor* factor_ = nullptr;
+    double fill_per_node_ = 0.0;   // the last fresh ordering's factor entries per node (CHOLMOD's lnz)
+    double flops_per_node_ = 0.0;  // and its factorisation's floating-point operations (CHOLMOD's fl)
     cholmod_dense* solution_ = nullptr;
     cholmod_dense* work_y_ = nullptr;
     cholmod_dense* work_e_ = nullptr;

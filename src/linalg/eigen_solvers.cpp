@@ -33,7 +33,7 @@ public:
     bool is_direct() const override { return true; }
 
 protected:
-    void do_analyze(const SparseSystem& a) override {
+    void do_analyze(const SparseSystem& a, const EliminationOrder*) override {
         ldlt_.analyzePattern(map_of(a));
         SH_REQUIRE(ldlt_.info() == Eigen::Success, SH_ERR_SOLVER, "eigen-ldlt: symbolic analysis failed");
         work_.assign(static_cast<size_t>(a.dof_count()), 0.0);
@@ -96,7 +96,7 @@ public:
     bool is_direct() const override { return false; }
 
 protected:
-    void do_analyze(const SparseSystem& a) override {
+    void do_analyze(const SparseSystem& a, const EliminationOrder*) override {
         cg_.analyzePattern(map_of(a));
         SH_REQUIRE(cg_.info() == Eigen::Success, SH_ERR_SOLVER, "%s: preconditioner analysis failed", name());
     }

@@ -53,11 +53,20 @@ void require_finite_solution(const SparseSystem& a, const double* x, const char*
 
 }  // namespace
 
-void LinearSolver::analyze(const SparseSystem& a) {
+void LinearSolver::analyze(const SparseSystem& a, const EliminationOrder* suggested) {
     analysed_id_ = 0;
     factorized_ = false;
-    if (a.dof_count() > 0) do_analyze(a);
+    SH_REQUIRE(!suggested || suggested->nodes.size() * 3 == static_cast<size_t>(a.dof_count()), SH_ERR_INTERNAL,
+               "%s: suggested order of %zu nodes for %d DOFs", name(), suggested ? suggested->nodes.size() : 0,
+               a.dof_count());
+    analysed_dofs_ = 0;
+    if (a.dof_count() > 0) do_analyze(a, suggested);
     analysed_id_ = a.pattern_id();
+    analysed_dofs_ = a.dof_count();
+}
+
+bool LinearSolver::elimination_order(EliminationOrder& out) const {
+    return analysed_id_ != 0 && analysed_dofs_ > 0 && do_elimination_order(out);
 }
 
 void LinearSolver::factorize(const SparseSystem& a) {

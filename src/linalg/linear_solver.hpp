@@ -12,6 +12,16 @@ namespace sh {
 
 enum class LinearSolverKind { Cholmod, Ldlt, ConjugateGradient };
 
+/// A fill-reducing elimination order of a system's free nodes (free DOF d belongs to free node
+/// d / 3), as an earlier analysis chose it or as a caller derives it from one, with the cost of
+/// the last order computed afresh: an order carried over from it may cost at most
+/// kSuggestedOrderTolerance times that per node, so that many small changes cannot drift far.
+struct EliminationOrder {
+    vec<int32_t> nodes;           ///< the nodes in elimination order (a solver's: a permutation of [0, dof_count / 3))
+    double fill_per_node = 0.0;   ///< the factor's stored entries per free node (0: unknown)
+    double flops_per_node = 0.0;  ///< the factorisation's floating-point operations per free node (0: unknown)
+};
+
 /// Solves A x = b for a SparseSystem A (symmetric positive definite expected).
 ///
 /// Every method works on the SparseSystem it is given; factorize and solve require that system's
@@ -22,7 +32,16 @@ class LinearSolver {
 public:
     virtual ~LinearSolver() = default;
     /// Symbolic analysis for A's pattern; call again only when the pattern changes (reused otherwise).
-    void analyze(const SparseSystem& a);
+    /// suggested (optional, a permutation of A's free nodes): an ordering to start from instead
+    /// of computing one, e.g. the last pattern's order extended to nodes a cut added. A backend
+    /// that takes it falls back to its own ordering if its fill or flops per node exceed
+    /// kSuggestedOrderTolerance times the suggestion's; the others ignore it.
+    void analyze(const SparseSystem& a, const EliminationOrder* suggested = nullptr);
+    /// The elimination order the last analysis chose, with the per-node cost of the last fresh
+    /// ordering it comes from (its own, or the suggestion's if it kept that), into out (allocates).
+    /// Returns false, leaving out as it was, if nothing was analysed, the system was empty or the
+    /// backend does not order by nodes (CG, LDL^T).
+    bool elimination_order(EliminationOrder& out) const;
     /// Numeric factorisation of A's current values (CG: builds its preconditioner). Throws
     /// sh::Error(SH_ERR_SOLVER, "...not positive definite at column N..." or similar) on failure,
     /// also for a non-finite value in A (naming its column).
@@ -43,12 +62,18 @@ public:
 protected:
     /// The backend's steps, called with a non-empty system: do_factorize with finite values and
     /// the analysed pattern, do_solve after a successful factorize.
-    virtual void do_analyze(const SparseSystem& a) = 0;
+    virtual void do_analyze(const SparseSystem& a, const EliminationOrder* suggested) = 0;
     virtual void do_factorize(const SparseSystem& a) = 0;
     virtual int do_solve(const SparseSystem& a, const double* b, double* x) = 0;
+    /// The last analysis' order (a non-empty system was analysed); false if the backend has none.
+    virtual bool do_elimination_order(EliminationOrder& out) const {
+        (void)out;
+        return false;
+    }
 
 private:
     uint64_t analysed_id_ = 0;
+    int32_t analysed_dofs_ = 0;
     bool factorized_ = false;
 };
 
@@ -68,6 +93,12 @@ LinearSolverPtr make_linear_solver(LinearSolverKind kind, double cg_tolerance, i
 LinearSolverPtr make_cholmod_solver();
 LinearSolverPtr make_ldlt_solver();
 LinearSolverPtr make_cg_solver(double tolerance, int max_iterations);
+
+/// How much more fill or flops per node than the suggestion's own a suggested order may give
+/// before the analysis computes a fresh ordering instead. A fresh ordering costs about a tenth
+/// of a factorisation (raptor, 19k tets), so a suggestion that slows every later factorisation
+/// by more than a few percent is not worth keeping.
+constexpr double kSuggestedOrderTolerance = 1.05;
 
 namespace solver_detail {
 /// Throws SH_ERR_SOLVER "<backend>: matrix not positive definite at column N (free DOF ..)".

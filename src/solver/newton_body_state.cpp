@@ -5,6 +5,50 @@
 #include <utility>
 
 namespace sh {
+namespace {
+
+// The elimination order the body's last analysis chose (as body nodes), carried over to the
+// free nodes of index: a node keeps its place, a node added since (a cut's copy) follows its
+// oldest ancestor in the order, and any other node goes last. false if there is no order.
+bool carried_order(const Body& body, const EliminationOrder& last, const vec<int32_t>& index, int32_t free_count,
+                   EliminationOrder& out) {
+    const vec<int32_t>& elimination_nodes = last.nodes;
+    if (elimination_nodes.empty()) return false;
+    const int32_t n = body.node_count();
+    vec<int32_t> rank(static_cast<size_t>(n), -1);
+    for (size_t p = 0; p < elimination_nodes.size(); ++p)
+        if (elimination_nodes[p] < n) rank[static_cast<size_t>(elimination_nodes[p])] = static_cast<int32_t>(p);
+    int32_t ranks = static_cast<int32_t>(elimination_nodes.size());
+    for (int32_t i = 0; i < n; ++i) {
+        int32_t& r = rank[static_cast<size_t>(i)];
+        const int32_t parent = body.parent_of(i);
+        if (r < 0) r = parent >= 0 && parent < i ? rank[static_cast<size_t>(parent)] : ranks++;
+    }
+    // Counting sort of the free nodes by rank; equal ranks (a node and its copies) by index.
+    vec<int32_t> start(static_cast<size_t>(ranks) + 1, 0);
+    for (int32_t i = 0; i < n; ++i)
+        if (index[static_cast<size_t>(i)] >= 0) ++start[static_cast<size_t>(rank[static_cast<size_t>(i)]) + 1];
+    for (size_t r = 0; r < static_cast<size_t>(ranks); ++r) start[r + 1] += start[r];
+    out.nodes.resize(static_cast<size_t>(free_count));
+    for (int32_t i = 0; i < n; ++i)
+        if (index[static_cast<size_t>(i)] >= 0)
+            out.nodes[static_cast<size_t>(start[static_cast<size_t>(rank[static_cast<size_t>(i)])]++)] =
+                index[static_cast<size_t>(i)];
+    out.fill_per_node = last.fill_per_node;
+    out.flops_per_node = last.flops_per_node;
+    return true;
+}
+
+// solver's elimination order over pattern's free nodes as body nodes, into out (left as it
+// was if the solver has none).
+void chosen_order(const LinearSolver* solver, const SparseSystem& pattern, EliminationOrder& out) {
+    EliminationOrder order;
+    if (!solver || !solver->elimination_order(order)) return;
+    for (int32_t& f : order.nodes) f = pattern.dof_to_global()[3 * static_cast<size_t>(f)] / 3;
+    std::swap(out, order);
+}
+
+}  // namespace
 
 int32_t NewtonBodyState::prepare(const Body& body, const sh_implicit_settings& s, bool own_solver) {
     const int32_t n = body.node_count();
@@ -23,12 +67,17 @@ int32_t NewtonBodyState::prepare(const Body& body, const sh_implicit_settings& s
     SparseSystem pattern;
     pattern.build_pattern(body.element_nodes(), static_cast<size_t>(body.element_count()), body.nodes_per_element(),
                           index.data(), n, count);
-    LinearSolverPtr solver = own_solver ? make_analysed_solver(pattern, s) : nullptr;
+    EliminationOrder suggested;
+    const bool suggest = own_solver && carried_order(body, elimination, index, count, suggested);
+    LinearSolverPtr solver = own_solver ? make_analysed_solver(pattern, s, suggest ? &suggested : nullptr) : nullptr;
+    EliminationOrder order = elimination;
+    chosen_order(solver.get(), pattern, order);
     vec<double> diag(3 * static_cast<size_t>(count));
     // Commit only once everything is built (reset changes nothing if it throws).
     matrix.reset(std::move(pattern), std::move(solver));
     free_index.swap(index);
     diagonal.swap(diag);
+    std::swap(elimination, order);
     free_count = count;
     return 3 * count;
 }

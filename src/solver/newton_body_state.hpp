@@ -2,7 +2,8 @@
 // solves): which of its nodes are free and in what order (its free-node index map), and its own
 // matrix over their DOFs, assembled from its elements, its field and its mass. A body solved
 // alone factorises that matrix; a body solved together with others (NewtonProblem::prepare) has
-// it assembled and then added into their joint matrix.
+// it assembled and then added into their joint matrix. Its solver's elimination order outlives a
+// topology change, so that the analysis after a cut extends it instead of ordering afresh.
 #pragma once
 
 #include "core/memory.hpp"
@@ -22,11 +23,19 @@ struct NewtonBodyState {
     int32_t free_count = -1;  ///< free nodes of the body; -1: not prepared yet
     NewtonMatrix matrix;      ///< the body's own matrix over its free DOFs (3 per free node)
     vec<double> diagonal;     ///< per free DOF: the diagonal added to the tangent (scratch)
+    EliminationOrder elimination;  ///< its solver's elimination order, as the body's node indices (empty: none)
 
     /// Rebuilds free_index and the matrix's pattern (and, with own_solver, its solver and
     /// symbolic analysis) if body's free nodes changed since the last call; makes the solver if
     /// own_solver and there is none yet. Returns the number of free DOFs.
     int32_t prepare(const Body& body, const sh_implicit_settings& settings, bool own_solver = true);
+
+    /// The body's topology changed: the next prepare rebuilds the pattern and the analysis,
+    /// suggesting the last elimination order with each added node placed after its parent.
+    void forget_pattern() noexcept {
+        free_count = -1;
+        matrix.kept.valid = false;
+    }
 
     /// Clears the matrix and adds stiffness_scale K + damping_scale D of body at (body.x, v)
     /// (v null: at rest) from its elements and its field, then add_diagonal (per free DOF) if

@@ -32,9 +32,10 @@ void NewtonMatrix::reset(SparseSystem&& pattern, LinearSolverPtr new_solver) {
     kept.valid = false;
 }
 
-LinearSolverPtr make_analysed_solver(const SparseSystem& system, const sh_implicit_settings& s) {
+LinearSolverPtr make_analysed_solver(const SparseSystem& system, const sh_implicit_settings& s,
+                                     const EliminationOrder* suggested) {
     LinearSolverPtr solver = make_linear_solver(solver_kind(s.linear_solver), s.cg_tolerance, s.cg_max_iterations);
-    solver->analyze(system);
+    solver->analyze(system, suggested);
     return solver;
 }
 

@@ -40,8 +40,9 @@ struct NewtonMatrix {
 };
 
 /// The linear solver settings name (DEFAULT: CHOLMOD when built in, else LDL^T), made and
-/// analysed for system.
-LinearSolverPtr make_analysed_solver(const SparseSystem& system, const sh_implicit_settings& settings);
+/// analysed for system, starting from the suggested elimination order if one is given.
+LinearSolverPtr make_analysed_solver(const SparseSystem& system, const sh_implicit_settings& settings,
+                                     const EliminationOrder* suggested = nullptr);
 
 /// Round-off level of internal forces computed at positions x: they come from position
 /// differences that carry about eps |x|, which a stiffness turns into eps |x| K_dd per DOF.

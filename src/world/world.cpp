@@ -124,8 +124,8 @@ void World::topology_changed(Id id, TopologyScratch& prepared) noexcept {
     std::swap(slot.doubling, prepared.doubling);
     sh::destroy(slot.contacts);  // rebuilt over the new surface on the next step with contact
     slot.contacts = nullptr;
-    sh::destroy(slot.stepped->newton);  // its pattern and symbolic analysis follow the elements
-    slot.stepped->newton = nullptr;
+    // Its pattern and symbolic analysis follow the elements; the elimination order carries over.
+    if (slot.stepped->newton) slot.stepped->newton->forget_pattern();
     sh::destroy(islands_);  // joint systems are rebuilt on the next step with body contact
     islands_ = nullptr;
     for (StepHook* hook : hooks_) hook->topology_changed(*this, id);

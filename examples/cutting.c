@@ -11,7 +11,8 @@
  * The scalpel: a thin capsule (radius 0.5 mm) standing upright, whose blade edge is the
  * segment from its tip up 3 cm (tool frame). It comes down 2.5 cm into the tissue at the start
  * of a path across the top (the path liver_scene_find_path picks), draws 5 cm along it, and
- * lifts out. At every step the blade's swept surface cuts the liver (sh_tool_set_cutting).
+ * lifts out. At every step the blade's swept surface cuts the liver (sh_tool_set_cutting),
+ * refined to kResolution around the blade.
  *
  * Trace columns: t (s), the tool's reaction force fx, fy, fz (N), faces the step cut, the
  * step's topology time (ms) and wall time (ms), node and tet counts. A summary goes to stderr. */
@@ -25,6 +26,11 @@ static const char* kProgram = "cutting";
 static const double kDepth = 0.025;     /* m below the touching height */
 static const double kLength = 0.05;     /* m along the path */
 static const double kDt = 1.0 / 60.0;   /* s */
+/* m: the edge length the cut refines the liver to around the blade. This liver's elements are
+ * 2.2 cm on average; the default (a quarter of the 3 cm blade, 7.5 mm) follows the blade more
+ * closely but triples the tet count along a 5 cm incision and the step's cost with it (README,
+ * "Cutting"). */
+static const double kResolution = 0.015;
 
 /* Where the scalpel's tip is at time t: down over 0.5 s, along the path over 2 s, up over
  * 0.5 s. */
@@ -48,6 +54,7 @@ static int create_scalpel(const liver_scene* scene, const liver_path* path, sh_t
     sh_cut_def_default(&cut);
     cut.edge[0][2] = -0.015;
     cut.edge[1][2] = 0.015;
+    cut.resolution = kResolution;
     if (example_failed(kProgram, "sh_tool_create", sh_tool_create(scene->world, &def, out))) return 1;
     return example_failed(kProgram, "sh_tool_set_cutting", sh_tool_set_cutting(scene->world, *out, &cut));
 }
@@ -61,7 +68,7 @@ static int write_frame(const liver_scene* scene, int k) {
 
 /* Runs the incision, printing the trace; returns 0 on success. */
 static int incise(liver_scene* scene, sh_tool_id tool, const liver_path* path) {
-    int cut_faces = 0, steps = 0;
+    int cut_faces = 0, steps = 0, tets_after = 0;
     double topology_ms = 0.0, wall_ms = 0.0;
     printf("t,fx,fy,fz,cut_faces,topology_ms,wall_ms,nodes,tets\n");
     for (int k = 0; k * kDt <= 3.2; ++k, ++steps) {
@@ -78,12 +85,14 @@ static int incise(liver_scene* scene, sh_tool_id tool, const liver_path* path) {
         printf("%.4f,%.5f,%.5f,%.5f,%d,%.3f,%.3f,%d,%d\n", (k + 1) * kDt, force[0], force[1], force[2], report.cut_faces,
                1e3 * report.topology_seconds, 1e3 * report.wall_seconds, info.node_count, info.element_count);
         cut_faces += report.cut_faces;
+        tets_after = info.element_count;
         topology_ms += 1e3 * report.topology_seconds;
         wall_ms += 1e3 * report.wall_seconds;
         if (k % 12 == 0 && write_frame(scene, k / 12) != 0) return 1;
     }
     fprintf(stderr, "%s: %d steps of %.1f ms: %d faces cut, topology %.2f ms and step %.2f ms per step on average\n",
             kProgram, steps, 1e3 * kDt, cut_faces, topology_ms / steps, wall_ms / steps);
+    fprintf(stderr, "%s: liver of %d tets after the incision\n", kProgram, tets_after);
     return 0;
 }
 
@@ -103,7 +112,8 @@ int main(int argc, char** argv) {
     if (liver_scene_create(&scene_def, &scene) != 0) goto done;
     if (liver_scene_find_path(&scene, 0.0005, kLength, &path) != 0) goto done;
     if (create_scalpel(&scene, &path, &tool) != 0) goto done;
-    fprintf(stderr, "%s: liver of %d tets before the incision\n", kProgram, scene.tet_count);
+    fprintf(stderr, "%s: liver of %d tets before the incision, cut at a resolution of %.1f mm\n", kProgram,
+            scene.tet_count, 1e3 * kResolution);
     exit_code = incise(&scene, tool, &path);
 done:
     liver_scene_destroy(&scene);

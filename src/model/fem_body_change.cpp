@@ -67,10 +67,7 @@ void FemBody::move_masses(const vec<int32_t>& changed, const ElementSet& fresh) 
 void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source, const vec<int32_t>& changed) {
     const size_t old_count = volume_.size(), new_count = tets.size() / 4;
     const ElementSet fresh = fresh_elements(grown, tets, source, changed);  // in changed's order
-    vec<int32_t> surface;
-    SurfaceIndex index;
-    surface_index_.update(surface_triangles, TetChange{tets_.data(), old_count, tets.data(), new_count, changed}, grown.node_count(),
-                          surface, index);
+    const SurfaceEdit surface = surface_index_.plan(TetChange{tets_.data(), old_count, tets.data(), new_count, changed});
     vec<TetBlock> added[SH_MATERIAL_COUNT];  // after each model's own blocks
     vec<int32_t> lanes;
     fill_new_blocks(fresh, added, lanes);
@@ -80,12 +77,12 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
     reserve_growing(materials_, new_count), reserve_growing(element_omega2_, new_count), reserve_growing(lane_of_, new_count);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
         reserve_growing(blocks_[model], blocks_[model].size() + added[model].size());
+    surface_index_.reserve(surface_triangles, surface, grown.node_count());
 
     // Commit: nothing below allocates.
     adopt_nodes(grown);
     move_masses(changed, fresh);
-    surface_triangles.swap(surface);
-    surface_index_.swap(index);
+    surface_index_.apply(surface_triangles, surface, grown.node_count());
     ++topology_version;
     for (const int32_t t : changed)
         if (static_cast<size_t>(t) < old_count) vacate_lane(static_cast<size_t>(t));

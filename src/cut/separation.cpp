@@ -61,30 +61,34 @@ struct Separation {
         }
     }
 
+    // split_star's scratch, kept between stars so that each star allocates nothing.
+    vec<int32_t> star_parent, star_members, star_number;
+    vec<std::pair<Face, int32_t>> star_faces;
+
     // Copies node (whose star is star[begin, end)) once per extra connected piece of its star.
     void split_star(size_t begin, size_t end) {
         const int32_t node = star[begin].first;
         const int32_t size = static_cast<int32_t>(end - begin);
-        vec<int32_t> parent(static_cast<size_t>(size));
-        std::iota(parent.begin(), parent.end(), 0);
-        vec<std::pair<Face, int32_t>> faces;
+        star_parent.resize(static_cast<size_t>(size));
+        std::iota(star_parent.begin(), star_parent.end(), 0);
+        star_faces.clear();
         for (int32_t i = 0; i < size; ++i)
             for (int f = 0; f < 4; ++f) {
                 const Face face = sorted_face(tet(static_cast<size_t>(star[begin + static_cast<size_t>(i)].second)), f);
-                if (std::find(face.begin(), face.end(), node) != face.end()) faces.push_back({face, i});
+                if (std::find(face.begin(), face.end(), node) != face.end()) star_faces.push_back({face, i});
             }
-        std::sort(faces.begin(), faces.end());
-        for (size_t i = 0; i + 1 < faces.size(); ++i)
-            if (faces[i].first == faces[i + 1].first && !std::binary_search(cut_faces.begin(), cut_faces.end(), faces[i].first))
-                parent[static_cast<size_t>(root(parent, faces[i].second))] = root(parent, faces[i + 1].second);
+        std::sort(star_faces.begin(), star_faces.end());
+        for (size_t i = 0; i + 1 < star_faces.size(); ++i)
+            if (star_faces[i].first == star_faces[i + 1].first && !std::binary_search(cut_faces.begin(), cut_faces.end(), star_faces[i].first))
+                star_parent[static_cast<size_t>(root(star_parent, star_faces[i].second))] = root(star_parent, star_faces[i + 1].second);
         // The largest piece keeps the node; every other piece gets a copy.
-        vec<int32_t> members(static_cast<size_t>(size), 0);
-        for (int32_t i = 0; i < size; ++i) ++members[static_cast<size_t>(root(parent, i))];
-        const int32_t keeper = static_cast<int32_t>(std::max_element(members.begin(), members.end()) - members.begin());
-        vec<int32_t> number(static_cast<size_t>(size), -1);
-        number[static_cast<size_t>(keeper)] = node;
+        star_members.assign(static_cast<size_t>(size), 0);
+        for (int32_t i = 0; i < size; ++i) ++star_members[static_cast<size_t>(root(star_parent, i))];
+        const int32_t keeper = static_cast<int32_t>(std::max_element(star_members.begin(), star_members.end()) - star_members.begin());
+        star_number.assign(static_cast<size_t>(size), -1);
+        star_number[static_cast<size_t>(keeper)] = node;
         for (int32_t i = 0; i < size; ++i) {
-            int32_t& n = number[static_cast<size_t>(root(parent, i))];
+            int32_t& n = star_number[static_cast<size_t>(root(star_parent, i))];
             if (n < 0) {
                 n = node_count + static_cast<int32_t>(cut.origins.size() + copies.size());
                 copies.push_back(NodeOrigin{node, node, 0.0});
@@ -220,7 +224,7 @@ struct Separation {
 }  // namespace
 
 int32_t separate(TetCut& cut, int32_t node_count) {
-    Separation s{cut, node_count, {}, {}, {}, {}, {}};
+    Separation s{cut, node_count, {}, {}, {}, {}, {}, {}, {}, {}, {}};
     s.build_star();
     s.find_cut_faces();
     do s.split_stars();

@@ -2,10 +2,9 @@
 // of the system per step). One cholmod_common per solver; the symbolic analysis (ordering,
 // elimination tree, supernodes) is kept in the cholmod_factor and reused by every factorize until
 // the pattern changes; solves reuse CHOLMOD's solution and workspace (cholmod_solve2).
-// CHOLMOD picks supernodal LL^T for 3D tet meshes of a few thousand nodes and up. Note for
-// real-time hosts: Debian's CHOLMOD 3 runs OpenMP parallel regions in the supernodal
-// factorisation (OMP_THREAD_LIMIT=1 keeps it on the calling thread) and uses the system BLAS
-// (OpenBLAS is about 2.5x faster there than the reference BLAS).
+// CHOLMOD picks supernodal LL^T for 3D tet meshes of a few thousand nodes and up; it uses the
+// system BLAS (OpenBLAS is about 2.5x faster there than the reference BLAS). Its OpenMP loops
+// run on the calling thread (CallingThreadOnly below).
 #if SOFTHAP_WITH_CHOLMOD
 
 #include "linalg/linear_solver.hpp"
@@ -13,6 +12,7 @@
 #include "core/error.hpp"
 
 #include <cholmod.h>
+#include <dlfcn.h>
 
 #include <cstring>
 
@@ -32,6 +32,56 @@ const char* cholmod_status_text(int status) {
         default: return "unknown status";
     }
 }
+
+// Debian's CHOLMOD 3 runs the supernodal factorisation's loops in OpenMP regions with a fixed
+// num_threads(4) clause, which OMP_NUM_THREADS cannot lower; on 2 cores the threads spin against
+// each other and the sim thread's neighbours (raptor, 19 k tets, StVK: 87 ms per factorisation
+// with them, 37-40 ms on one thread). For the scope of a CHOLMOD call this turns on the calling
+// thread's dynamic adjustment with a thread count of 1, under which the OpenMP runtime gives such
+// regions a single thread, and restores both after: the host's own OpenMP settings (per thread)
+// are untouched. The runtime's functions are looked up in whatever OpenMP runtime CHOLMOD
+// loaded; without one this does nothing.
+class CallingThreadOnly {
+public:
+    CallingThreadOnly() {
+        const Runtime& omp = runtime();
+        if (!omp.available) return;
+        dynamic_ = omp.get_dynamic();
+        threads_ = omp.get_max_threads();
+        omp.set_dynamic(1);
+        omp.set_num_threads(1);
+    }
+    ~CallingThreadOnly() {
+        const Runtime& omp = runtime();
+        if (!omp.available) return;
+        omp.set_num_threads(threads_);
+        omp.set_dynamic(dynamic_);
+    }
+    CallingThreadOnly(const CallingThreadOnly&) = delete;             ///< a scope guard
+    CallingThreadOnly& operator=(const CallingThreadOnly&) = delete;  ///< a scope guard
+
+private:
+    struct Runtime {
+        int (*get_dynamic)() = nullptr;
+        int (*get_max_threads)() = nullptr;
+        void (*set_dynamic)(int) = nullptr;
+        void (*set_num_threads)(int) = nullptr;
+        bool available = false;
+    };
+    static const Runtime& runtime() {
+        static const Runtime found = [] {
+            Runtime r;
+            r.get_dynamic = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_dynamic"));
+            r.get_max_threads = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_threads"));
+            r.set_dynamic = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_dynamic"));
+            r.set_num_threads = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_num_threads"));
+            r.available = r.get_dynamic && r.get_max_threads && r.set_dynamic && r.set_num_threads;
+            return r;
+        }();
+        return found;
+    }
+    int dynamic_ = 0, threads_ = 1;
+};
 
 class CholmodSolver final : public LinearSolver {
 public:
@@ -90,6 +140,7 @@ protected:
         return true;
     }
     void do_factorize(const SparseSystem& a) override {
+        const CallingThreadOnly serial;
         cholmod_sparse matrix = wrap(a);
         const int ok = cholmod_factorize(&matrix, factor_, &common_);
         size_t minor = factor_->minor;
@@ -118,6 +169,7 @@ protected:
     }
 
     int do_solve(const SparseSystem& a, const double* b, double* x) override {
+        const CallingThreadOnly serial;
         const size_t n = static_cast<size_t>(a.dof_count());
         // b wrapped in place; X, Y and E are kept between calls, so after the first solve
         // cholmod_solve2 allocates nothing.

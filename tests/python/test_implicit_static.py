@@ -1,7 +1,11 @@
 """The implicit (backward) Euler integrator and static equilibrium, against exact discrete
 recursions, closed forms and a textbook linear-tetrahedron stiffness matrix."""
 
+import ctypes
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -276,3 +280,42 @@ def test_step_doubling_error_estimate():
             else:
                 assert report.error_estimate == -1.0 and report.error_estimate_seconds == 0.0
             assert body.positions[1, 0] == pytest.approx(1.0 + full, abs=1e-14)
+
+
+_THREADS_SCRIPT = """
+import ctypes, os, sys
+import numpy as np
+import softhap
+gomp = ctypes.CDLL("libgomp.so.1")
+gomp.omp_set_num_threads(3)
+gomp.omp_set_dynamic(0)
+mesh = softhap.Mesh.load(sys.argv[1]).transform(0.1)
+with softhap.World(gravity=(0.0, 0.0, -9.81)) as world:
+    body = world.add_fem_body(mesh, model="stvk", young=3e4, poisson=0.45, integrator="implicit_euler",
+                              linear_solver="cholmod")
+    x = body.positions
+    body.fix_nodes(np.where(x[:, 2] < x[:, 2].min() + 0.1 * np.ptp(x[:, 2]))[0])
+    before = len(os.listdir("/proc/self/task"))
+    for _ in range(3):
+        world.step(0.01)
+    after = len(os.listdir("/proc/self/task"))
+print(before, after, gomp.omp_get_max_threads(), gomp.omp_get_dynamic())
+"""
+
+
+def test_cholmod_runs_on_the_calling_thread_and_keeps_the_hosts_openmp_settings(meshes):
+    """CHOLMOD's OpenMP loops (a fixed num_threads(4) in Debian's CHOLMOD 3) run on the
+    calling thread: an implicit liver2 step starts no thread (/proc/self/task), in a fresh
+    process so that no earlier test's thread pool hides one, and the host's own OpenMP settings
+    on that thread (3 threads, dynamic off) are as it set them afterwards."""
+    if "SH_FEATURE_CHOLMOD" not in softhap.build_features():
+        pytest.skip("built without CHOLMOD")
+    try:
+        ctypes.CDLL("libgomp.so.1")
+    except OSError:
+        pytest.skip("no libgomp here")
+    out = subprocess.run([sys.executable, "-c", _THREADS_SCRIPT, str(meshes / "liver2.msh")], check=True,
+                         capture_output=True, text=True, env=dict(os.environ)).stdout.split()
+    before, after, threads, dynamic = (int(v) for v in out)
+    assert after == before
+    assert (threads, dynamic) == (3, 0)

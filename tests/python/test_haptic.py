@@ -259,3 +259,29 @@ def test_nodes_on_a_table_stay_with_the_full_model():
     assert result.buffer_tets == 6 * 6 * 3 * 6
     assert tool.force[2] > 0.02
     assert result.raw_force[2] == pytest.approx(tool.force[2], rel=0.1)
+
+
+def test_result_holds_every_output_field_and_owns_its_arrays():
+    """HapticResult is built field by field for speed: it must still carry every field of
+    sh_haptic_output under its C name, equal to what the C call wrote (read back through
+    ctypes), and its arrays must be its own (the next step does not change them)."""
+    from softhap._lib import sh_haptic_output
+
+    world, _, tool = pressed_block()
+    haptic = world.add_haptic(tool, radius=0.005, ramp_time=0.0, stale_after=100.0)
+    first = haptic.step((0.01, 0.01, TOP + RADIUS - 7e-4))
+    raw = haptic._output  # what the C call wrote for this step
+    names = {field[0] for field in sh_haptic_output._fields_}
+    assert set(first) == names | {"fault_bits", "warning_bits"}
+    for name in ("force", "torque", "raw_force"):
+        assert list(first[name]) == list(getattr(raw, name))
+    for name in ("buffer_tets", "buffer_nodes", "substeps", "data_age"):
+        assert first[name] == getattr(raw, name)
+    assert first.contact is bool(raw.contact) and first.contact
+    assert (first.fault_bits, first.warning_bits) == (raw.faults, raw.warnings)
+    kept = first.force.copy()
+    second = haptic.step((0.01, 0.01, TOP + RADIUS - 9e-4))
+    assert second.raw_force[2] > kept[2]
+    assert np.array_equal(first.force, kept)
+    faulty = haptic.step((math.nan, 0.0, 0.0))
+    assert faulty.faults == frozenset({"SH_HAPTIC_FAULT_POSE"}) and faulty.fault_bits != 0

@@ -4,6 +4,7 @@ report.substeps). Used for mesh info, body info and step reports."""
 from __future__ import annotations
 
 import ctypes
+import functools
 from typing import Any, FrozenSet, Type, TypeVar
 
 import numpy as np
@@ -84,8 +85,10 @@ class StaticReport(Record):
     residual after each iteration) and wall_seconds (s)."""
 
 
+@functools.lru_cache(maxsize=256)
 def warning_names(bits: int) -> FrozenSet[str]:
-    """The names of the sh_warning kinds whose bit (1 << kind) is set in bits."""
+    """The names of the sh_warning kinds whose bit (1 << kind) is set in bits (cached: a step
+    loop sees few distinct patterns)."""
     return frozenset(kind.name for kind in WarningKind if bits & (1 << int(kind)))
 
 

@@ -16,12 +16,24 @@ struct NormalForce {
     double damping = 0.0;    ///< dF/dx' (N s/m)
 };
 
+/// x^n for x > 0: the usual exponents (1, 1.5, 2, 2.5, 3) by multiplications and a square
+/// root (correctly rounded, so within an ulp or two of std::pow), any other by std::pow, which
+/// costs several times more and is called for every contact evaluation.
+inline double depth_power(double x, double n) {
+    if (n == 1.0) return x;
+    if (n == 1.5) return x * std::sqrt(x);
+    if (n == 2.0) return x * x;
+    if (n == 2.5) return x * x * std::sqrt(x);
+    if (n == 3.0) return x * x * x;
+    return std::pow(x, n);
+}
+
 /// F = max(0, lambda x^n + mu x' x^n), mu = 3/2 alpha lambda, at depth x (m) and depth rate
 /// x' (m/s, > 0 going deeper). Zero for x <= 0 and wherever the damping would pull.
 inline NormalForce hunt_crossley(const sh_contact_params& p, double x, double rate) {
     NormalForce out;
     if (!(x > 0.0)) return out;
-    const double xn = p.exponent == 1.0 ? x : std::pow(x, p.exponent);
+    const double xn = depth_power(x, p.exponent);
     const double mu = 1.5 * p.damping * p.stiffness;
     const double factor = 1.0 + 1.5 * p.damping * rate;  // (lambda + mu x') / lambda
     if (!(factor > 0.0)) return out;
@@ -56,7 +68,7 @@ inline StepLaw hunt_crossley_step_law(const sh_contact_params& p, double x_start
 inline NormalForce hunt_crossley_step(const sh_contact_params& p, const StepLaw& law, double x) {
     NormalForce out;
     if (!(x > law.lower) || !(x > 0.0)) return out;
-    const double xn = p.exponent == 1.0 ? x : std::pow(x, p.exponent);
+    const double xn = depth_power(x, p.exponent);
     const double factor = law.a + law.b * x;
     out.force = xn * factor;
     out.stiffness = p.exponent * xn / x * factor + law.b * xn;
@@ -69,7 +81,7 @@ inline double hunt_crossley_step_energy(const sh_contact_params& p, const StepLa
     const double n = p.exponent;
     const auto primitive = [&](double s) {
         if (!(s > 0.0)) return 0.0;
-        const double s1 = std::pow(s, n + 1.0);
+        const double s1 = depth_power(s, n + 1.0);
         return law.a * s1 / (n + 1.0) + law.b * s1 * s / (n + 2.0);
     };
     return primitive(x) - primitive(law.lower);

@@ -19,6 +19,7 @@ struct WorkingArrays {
     int32_t* id[2];
     double* force;
     double* contact;
+    double* reach;
     double* saved_x;
     double* saved_v;
     double* path_x;
@@ -37,6 +38,7 @@ void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3
     }
     w.force = arena.take<double>(3 * n);
     w.contact = arena.take<double>(3 * n);
+    w.reach = arena.take<double>(2 * n);
     w.saved_x = arena.take<double>(3 * n);
     w.saved_v = arena.take<double>(3 * n);
     w.path_x = arena.take<double>(3 * n);
@@ -101,6 +103,7 @@ HapticContext::HapticContext(World& world, const sh_haptic_def& def)
     }
     force_ = w.force;
     contact_ = w.contact;
+    reach_ = w.reach;
     saved_x_ = w.saved_x;
     saved_v_ = w.saved_v;
     path_x_ = w.path_x;

@@ -97,7 +97,8 @@ private:
     void record_node_friction(const Buffer& b, const double* x, const double* v);
     void apply_friction_impulses(const Buffer& b, double h, double* x, double* v, double force[3], double torque[3]);
     bool proxy_force(const Buffer& b, double force[3], double torque[3]) const;
-    double substep_limit(const Buffer& b, const double* x, const double* v, double dt);
+    double substep_limit(const Buffer& b) const;
+    void integrate(const Buffer& b, double h, double* x, double* v) const;
 
     sh_haptic_def def_;
     World* world_;
@@ -121,6 +122,7 @@ private:
     Id state_body_ = kNullId;
     double* force_ = nullptr;  ///< 3 per node
     double* contact_ = nullptr;  ///< 3 per node: the sub-step's contact force on it
+    double* reach_ = nullptr;    ///< 2 per node: the sub-step's contact stiffness and damping on it (lumped)
     double* saved_x_ = nullptr;
     double* saved_v_ = nullptr;
     double* path_x_ = nullptr;  ///< where each boundary node's path starts: the haptic side's

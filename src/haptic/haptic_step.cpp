@@ -199,46 +199,44 @@ void HapticContext::adopt(const Buffer& b) {
         if (b.warnings & (1u << k)) warnings_[k].fetch_add(1, std::memory_order_relaxed);
 }
 
-double HapticContext::substep_limit(const Buffer& b, const double* x, const double* v, double dt) {
-    // How far the tool and the surface may close in on each other within the step: the tool's
-    // travel and turn, and the fastest interior node's travel.
-    double lo[3], hi[3], extent[3];
-    tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
-    sub3(hi, lo, extent);
-    double fastest = 0.0;
-    for (int32_t i = 0; i < b.node_count; ++i)
-        if (b.inverse_mass[i] > 0.0) fastest = std::max(fastest, dot3(at(v, i), at(v, i)));
-    const double closing =
-        dt * (norm3(tool_.velocity) + 0.5 * norm3(extent) * norm3(tool_.angular) + std::sqrt(fastest));
-    tool_.shape.bounds(tool_.pose, closing, lo, hi);
-    // Per node: the contact stiffness it may feel in the step, at the depth each of its terms
-    // has now plus the closing distance (weights are at most 1). force_ holds the stiffness
-    // (x) and damping (y) until the step's forces overwrite it.
-    for (int32_t i = 0; i < b.node_count; ++i) at(force_, i)[0] = at(force_, i)[1] = 0.0;
-    const sh_contact_params& law = tool_.params;
-    // A node feels its own term and the excess terms of every edge and face around it, each
-    // at most the law's stiffness there: their sum bounds its contact stiffness.
-    auto reach = [&](const int32_t* nodes, int count, bool touching, double depth) {
-        const NormalForce fn = hunt_crossley(law, (touching ? depth : 0.0) + closing, 0.0);
-        for (int a = 0; a < count; ++a) {
-            double* k = at(force_, nodes[a]);
-            k[0] += fn.stiffness;
-            k[1] += fn.damping;
-        }
-    };
-    visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
-        ContactPoint p;
-        const bool touching = term_contact(tool_, x, nodes, count, size, p);
-        reach(nodes, count, touching, p.depth);
-    });
+double HapticContext::substep_limit(const Buffer& b) const {
+    // The elastic forces are explicit: the buffer's critical step, with room for the implicit
+    // contact's share (with the contact's stiffness taken implicitly, symplectic Euler is
+    // stable up to sqrt(3) instead of 2 over the elastic frequency). The contact does not
+    // limit it: integrate() takes it implicitly.
     const double omega_fem = b.dt_stable > 0.0 && std::isfinite(b.dt_stable) ? 2.0 / b.dt_stable : 0.0;
-    double step = omega_fem > 0.0 ? 2.0 / omega_fem : INFINITY;
+    return omega_fem > 0.0 ? kSafety * std::sqrt(3.0) / omega_fem : INFINITY;
+}
+
+void HapticContext::integrate(const Buffer& b, double h, double* x, double* v) const {
+    // Symplectic Euler with the mass damping implicit, and each contacted node's contact
+    // stiffness k and damping c (reach_: its terms' tangent, lumped onto it) implicit along its
+    // push n, linearised: (m + (h^2 k + h c) n n^T) v' = m v + h f + h c n (n . v), solved by
+    // Sherman-Morrison. At rest (v = 0, f = 0) it stays at rest: the equilibrium, and the force
+    // there, are the explicit step's; a stiff tool no longer needs sub-steps below its
+    // contact's critical step.
+    const double damping = 1.0 / (1.0 + h * b.damping_mass);
     for (int32_t i = 0; i < b.node_count; ++i) {
-        if (b.inverse_mass[i] == 0.0) continue;
-        const double m = b.mass[i], k = at(force_, i)[0], c = at(force_, i)[1];
-        if (k > 0.0 || c > 0.0) step = std::min(step, damped_stable_step(m * omega_fem * omega_fem + k, c, m));
+        const double w = b.inverse_mass[i];
+        if (w == 0.0) continue;
+        double r[3];
+        for (int k = 0; k < 3; ++k) r[k] = at(v, i)[k] + h * w * at(force_, i)[k];
+        const double push = norm3(at(contact_, i));
+        if (push > 0.0) {
+            const double k_node = reach_[2 * i], c_node = reach_[2 * i + 1];
+            double n[3];
+            for (int k = 0; k < 3; ++k) n[k] = at(contact_, i)[k] / push;
+            const double vn = dot3(n, at(v, i));
+            for (int k = 0; k < 3; ++k) r[k] += w * h * c_node * vn * n[k];
+            const double a = w * (h * h * k_node + h * c_node);
+            const double rn = dot3(n, r) * a / (1.0 + a);
+            for (int k = 0; k < 3; ++k) r[k] -= rn * n[k];
+        }
+        for (int k = 0; k < 3; ++k) {
+            at(v, i)[k] = r[k] * damping;
+            at(x, i)[k] += h * at(v, i)[k];
+        }
     }
-    return kSafety * step;
 }
 
 void HapticContext::add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double force[3],
@@ -246,10 +244,8 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
     double lo[3], hi[3];
     tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
     const sh_contact_params& law = tool_.params;
-    for (int32_t s = 0; s < b.surface_node_count; ++s) {
-        double* push = at(contact_, b.surface_nodes[s]);
-        push[0] = push[1] = push[2] = 0.0;
-    }
+    std::memset(contact_, 0, 3 * static_cast<size_t>(b.node_count) * sizeof(double));
+    std::memset(reach_, 0, 2 * static_cast<size_t>(b.node_count) * sizeof(double));
     visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
         ContactPoint p;
         if (!term_contact(tool_, x, nodes, count, size, p)) return;
@@ -257,11 +253,19 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         velocity_against_collider(tool_, p, v, vrel);
         if (p.count == 1) apply_normal_law(law, vrel, p);
         else apply_excess_damping(law, vrel, p);
-        for (int a = 0; a < p.count; ++a)
+        // The term's tangent k g g^T (g: its gradients), row sums lumped onto its nodes:
+        // a diagonal that bounds it (positive weights), for integrate().
+        double spread = 0.0;
+        for (int a = 0; a < p.count; ++a) spread += norm3(p.gradient[a]);
+        for (int a = 0; a < p.count; ++a) {
+            const double share = norm3(p.gradient[a]) * spread;
+            reach_[2 * p.nodes[a]] += std::fabs(p.stiffness) * share;
+            reach_[2 * p.nodes[a] + 1] += std::fabs(p.damping) * share;
             for (int k = 0; k < 3; ++k) {
                 at(f, p.nodes[a])[k] += p.node_force[a][k];
                 at(contact_, p.nodes[a])[k] += p.node_force[a][k];
             }
+        }
         add_reaction(p, x, tool_.pose.p, force, torque);
         contact = true;
     });
@@ -311,7 +315,7 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
     std::memcpy(saved_x_, x, n3 * sizeof(double));
     std::memcpy(saved_v_, v, n3 * sizeof(double));
     tool_.pose = tool_.start;
-    const double limit = substep_limit(b, x, v, dt);
+    const double limit = substep_limit(b);
     // A limit that is not positive (NaN too: a runaway state) needs the cap.
     const SubstepCount count = substep_count(dt, limit > 0.0 ? limit : 0.0, kMaxHapticSubsteps);
     substeps = count.count;
@@ -337,17 +341,7 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
         bool touching = false;
         add_contact_forces(b, x, v, force_, f_tool, t_tool, touching);
         contact = touching;
-        // Symplectic Euler, mass damping implicit.
-        const double damping = 1.0 / (1.0 + h * b.damping_mass);
-        for (int32_t i = 0; i < b.node_count; ++i) {
-            const double w = b.inverse_mass[i];
-            if (w == 0.0) continue;
-            for (int k = 0; k < 3; ++k) {
-                double& vi = at(v, i)[k];
-                vi = (vi + h * w * at(force_, i)[k]) * damping;
-                at(x, i)[k] += h * vi;
-            }
-        }
+        integrate(b, h, x, v);
         apply_friction_impulses(b, h, x, v, f_tool, t_tool);
         for (int k = 0; k < 3; ++k) {  // the step's mean wrench
             force[k] += f_tool[k] / substeps;

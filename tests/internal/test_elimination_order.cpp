@@ -114,31 +114,33 @@ void assert_same_solution(const std::vector<double>& x, const std::vector<double
 }
 
 #if SOFTHAP_WITH_CHOLMOD
+// A CHOLMOD solver analysed for a (from suggested, if given); the order it chose into order.
+sh::LinearSolverPtr analysed(const sh::SparseSystem& a, sh::EliminationOrder& order,
+                             const sh::EliminationOrder* suggested = nullptr) {
+    sh::LinearSolverPtr solver = sh::make_cholmod_solver();
+    solver->analyze(a, suggested);
+    assert_true(solver->elimination_order(order));
+    return solver;
+}
+
 void test_carried_order_is_kept_and_solves_the_same(void**) {
     Block block;
     sh::SparseSystem uncut_system;
     block.assemble(uncut_system);
-    sh::LinearSolverPtr first = sh::make_cholmod_solver();
-    first->analyze(uncut_system);
     sh::EliminationOrder uncut;
-    assert_true(first->elimination_order(uncut));
+    analysed(uncut_system, uncut);
     assert_int_equal(uncut.nodes.size(), block.node_count);
     assert_true(uncut.fill_per_node > 1.0 && uncut.flops_per_node > 1.0);
 
     block.cut();
     sh::SparseSystem cut_system;
     block.assemble(cut_system);
-    sh::LinearSolverPtr fresh = sh::make_cholmod_solver();
-    fresh->analyze(cut_system);
-    sh::EliminationOrder fresh_order;
-    assert_true(fresh->elimination_order(fresh_order));
+    sh::EliminationOrder fresh_order, kept;
+    sh::LinearSolverPtr fresh = analysed(cut_system, fresh_order);
     assert_true(fresh_order.fill_per_node != uncut.fill_per_node);  // else keeping proves nothing
 
     const sh::EliminationOrder suggestion = carried(uncut, block);
-    sh::LinearSolverPtr given = sh::make_cholmod_solver();
-    given->analyze(cut_system, &suggestion);
-    sh::EliminationOrder kept;
-    assert_true(given->elimination_order(kept));
+    sh::LinearSolverPtr given = analysed(cut_system, kept, &suggestion);
     assert_true(kept.fill_per_node == uncut.fill_per_node);  // the suggestion's baseline: it was kept
     assert_true(kept.flops_per_node == uncut.flops_per_node);
     std::vector<bool> seen(static_cast<size_t>(block.node_count), false);
@@ -151,17 +153,12 @@ void test_poor_suggestion_is_dropped_for_a_fresh_order(void**) {
     Block block;
     sh::SparseSystem system;
     block.assemble(system);
-    sh::LinearSolverPtr fresh = sh::make_cholmod_solver();
-    fresh->analyze(system);
-    sh::EliminationOrder good;
-    assert_true(fresh->elimination_order(good));
+    sh::EliminationOrder good, chosen;
+    sh::LinearSolverPtr fresh = analysed(system, good);
     // The reverse of a minimum-degree order eliminates the separators first: much more fill.
     sh::EliminationOrder reversed = good;
     for (size_t k = 0; k < good.nodes.size(); ++k) reversed.nodes[k] = good.nodes[good.nodes.size() - 1 - k];
-    sh::LinearSolverPtr given = sh::make_cholmod_solver();
-    given->analyze(system, &reversed);
-    sh::EliminationOrder chosen;
-    assert_true(given->elimination_order(chosen));
+    sh::LinearSolverPtr given = analysed(system, chosen, &reversed);
     assert_true(chosen.fill_per_node == good.fill_per_node);
     assert_true(chosen.nodes == good.nodes);
     assert_same_solution(solve(*given, system), solve(*fresh, system));

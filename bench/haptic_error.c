@@ -53,16 +53,17 @@ static void print_reference(const tissue* liver, const double pressed[3], const 
             report->converged ? "converged" : "NOT converged", report->iterations);
 }
 
-/* The reference: the full model solved statically (to 1e-9) with the tool pressed kErrorDepth
- * below touch; the tool's force into force. A solve that stops short of the tolerance is still
- * the best reference there is: it says so in its line. */
+/* The reference: the full model solved statically with the tool pressed kErrorDepth below
+ * touch; the tool's force into force. The tolerance is 1e-7: on liver2 the Newton iteration of
+ * the contact potential stalls near 3e-8, and a solve that stops short of its tolerance leaves
+ * the state as it was, so the force would read 0. Its line gives the residual reached. */
 static void error_reference(const tissue* liver, const double touch[3], double force[3]) {
     scene s = scene_create(liver, SH_MATERIAL_COROTATIONAL, SH_INTEGRATOR_SYMPLECTIC_EULER, 0.0, touch);
     const double pressed[3] = {touch[0], touch[1], touch[2] - kErrorDepth};
     CHECK(sh_tool_set_pose(s.world, s.tool, pressed, kIdentity));
     sh_static_def def;
     sh_static_def_default(&def);
-    def.tolerance = 1e-9;
+    def.tolerance = 1e-7;
     sh_static_report report;
     const double t0 = now_ns();
     const sh_status st = sh_world_solve_static(s.world, &def, &report);

@@ -134,8 +134,8 @@ def cost_section(rows, out, folder):
             out.append(f"Goals at {GOAL_TETS} tets: median <= {GOAL_MEDIAN_US:g} us: "
                        f"{fmt_us(r['median_us'])} us, {verdict(r['median_us'] <= GOAL_MEDIAN_US)}; p99.9 <= "
                        f"{GOAL_P999_US:g} us: {fmt_us(r['p999_us'])} us, {verdict(r['p999_us'] <= GOAL_P999_US)}. The "
-                       f"step takes {r['substeps_median']:g} explicit sub-steps of the buffer per 1 ms (its critical "
-                       f"step with the contact's stiffness); per tet and sub-step it costs "
+                       f"step takes {r['substeps_median']:g} explicit sub-steps of the buffer per 1 ms (the critical "
+                       f"step of its elements; the contact is implicit); per tet and sub-step it costs "
                        f"{r['ns_per_tet_substep']:.0f} ns. The peers' columns are the quoted fixed + per-tet "
                        "costs, evaluated at the same tet counts (not measured here, and not necessarily at the same "
                        "number of sub-steps).")

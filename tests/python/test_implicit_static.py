@@ -3,15 +3,13 @@ recursions, closed forms and a textbook linear-tetrahedron stiffness matrix."""
 
 import ctypes
 import math
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import softhap
 
+from conftest import run_python
 from textbook import G, UNIT_TET, linear_tet_stiffness
 
 
@@ -283,7 +281,7 @@ def test_step_doubling_error_estimate():
 
 
 _THREADS_SCRIPT = """
-import ctypes, os, sys
+import ctypes, os
 import numpy as np
 import softhap
 gomp = ctypes.CDLL("libgomp.so.1")
@@ -314,8 +312,8 @@ def test_cholmod_runs_on_the_calling_thread_and_keeps_the_hosts_openmp_settings(
         ctypes.CDLL("libgomp.so.1")
     except OSError:
         pytest.skip("no libgomp here")
-    out = subprocess.run([sys.executable, "-c", _THREADS_SCRIPT, str(meshes / "liver2.msh")], check=True,
-                         capture_output=True, text=True, env=dict(os.environ)).stdout.split()
-    before, after, threads, dynamic = (int(v) for v in out)
+    result = run_python(_THREADS_SCRIPT.replace("sys.argv[1]", repr(str(meshes / "liver2.msh"))))
+    assert result.returncode == 0, result.stderr
+    before, after, threads, dynamic = (int(v) for v in result.stdout.split())
     assert after == before
     assert (threads, dynamic) == (3, 0)

@@ -213,8 +213,8 @@ void HapticContext::integrate(const Buffer& b, double h, double* x, double* v) c
     // stiffness k and damping c (reach_: its terms' tangent, lumped onto it) implicit along its
     // push n, linearised: (m + (h^2 k + h c) n n^T) v' = m v + h f + h c n (n . v), solved by
     // Sherman-Morrison. At rest (v = 0, f = 0) it stays at rest: the equilibrium, and the force
-    // there, are the explicit step's; a stiff tool no longer needs sub-steps below its
-    // contact's critical step.
+    // there, are the explicit step's; and a stiff tool needs no more sub-steps than the
+    // elements do.
     const double damping = 1.0 / (1.0 + h * b.damping_mass);
     for (int32_t i = 0; i < b.node_count; ++i) {
         const double w = b.inverse_mass[i];

@@ -10,6 +10,11 @@ namespace {
 // det F below this (relative to |F|^3) goes through the SVD path.
 constexpr double kSvdThreshold = 1e-3;
 
+// The iteration converges quadratically: an update that changes R by d (Frobenius) leaves it
+// about d^2 / 2 from the polar factor, so a squared change below 1e-20 (d < 1e-10) returns R
+// to about 1e-20, far below round-off, without one more update to confirm it.
+constexpr double kConvergedChange2 = 1e-20;
+
 Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& f) {
     Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
     Eigen::Matrix3d u = svd.matrixU();
@@ -58,12 +63,13 @@ Mat3L polar_rotation(const Mat3L& F) {
                 change += diff * diff;
             }
         R = next;
-        // Converged when no lane changed by 1e-28 or more (NaN lanes do not hold the others up).
+        // Converged when no lane's squared change reaches kConvergedChange2 (NaN lanes do not
+        // hold the others up).
         bool moving = false;
 #if defined(__AVX512F__)
-        moving = _mm512_cmp_pd_mask(change, _mm512_set1_pd(1e-28), _CMP_GE_OQ) != 0;
+        moving = _mm512_cmp_pd_mask(change, _mm512_set1_pd(kConvergedChange2), _CMP_GE_OQ) != 0;
 #else
-        for (int l = 0; l < kLanes; ++l) moving |= change[l] >= 1e-28;
+        for (int l = 0; l < kLanes; ++l) moving |= change[l] >= kConvergedChange2;
 #endif
         if (!moving) break;
     }

@@ -3,7 +3,8 @@
  *
  *   softhap_bench [FILTER] [--steps N] [--meshes DIR]      FEM materials and springs
  *   softhap_bench integrators [FILTER] [--steps N]          forward/symplectic Euler, RK2, RK4
- *   softhap_bench implicit [FILTER] [--steps N]             implicit Euler step, direct vs CG
+ *   softhap_bench implicit [FILTER] [--steps N]             implicit Euler step, direct vs CG;
+ *                                                           and on a 20 k-tet cube (stand, droop)
  *   softhap_bench contact [FILTER] [--steps N]              collision and contact time per step
  *   softhap_bench accuracy [--quick] [--jobs N]             error against run time (accuracy.c)
  *   softhap_bench haptic [FILTER] [--steps N]               haptic step cost vs buffer size (haptic.c)
@@ -30,6 +31,7 @@
 #include <softhap/softhap.h>
 
 #include "accuracy.h"
+#include "box_mesh.h"
 #include "bench_util.h"
 #include "cut.h"
 #include "haptic.h"
@@ -413,6 +415,93 @@ static void run_implicit(const char* filter) {
     free_mesh(&m);
 }
 
+/* The implicit step on the issue's cube: 0.1 m, 15 x 15 x 15 Kuhn-split cells (20,250 tets),
+ * 1 kg (1000 kg/m^3), E 1e4 Pa, nu 0.45, default implicit settings (CHOLMOD), gravity -z.
+ * "stand": its bottom face fixed (it sags under its weight); "droop": its x = 0 face fixed (it
+ * bends over, a large rotation). dt 1/240 s and 1/60 s. pybullet's implicit deformable solver
+ * ran the same scenes for the issue (274-531 ms per step). */
+static const double kCubeSize = 0.1;  /* m */
+enum { kCubeCells = 15 };
+
+/* The cube's mesh and the nodes fixed in scene (their count in *fixed_count). */
+static sh_mesh* cube_mesh(const char* scene, int32_t** fixed, int32_t* fixed_count) {
+    double* nodes = NULL;
+    int32_t *tets = NULL, node_count = 0, tet_count = 0;
+    sh_test_box_arrays(kCubeSize, kCubeSize, kCubeSize, kCubeCells, kCubeCells, kCubeCells, &nodes, &node_count, &tets,
+                       &tet_count);
+    if (!nodes || !tets) {
+        fprintf(stderr, "softhap_bench: out of memory\n");
+        exit(1);
+    }
+    sh_mesh* mesh = NULL;
+    CHECK(sh_mesh_create(nodes, node_count, tets, tet_count, &mesh));
+    const int axis = strcmp(scene, "stand") == 0 ? 2 : 0;
+    *fixed = (int32_t*)xmalloc(sizeof(int32_t) * (size_t)node_count);
+    *fixed_count = 0;
+    for (int32_t i = 0; i < node_count; ++i)
+        if (nodes[3 * i + axis] < 1e-9) (*fixed)[(*fixed_count)++] = i;
+    free(nodes);
+    free(tets);
+    return mesh;
+}
+
+/* One cube case: steps timed steps of dt after a first (the solver's analysis, kept apart). */
+static void cube_case(const char* scene, const body_kind* kind, double dt, const char* name, int steps) {
+    int32_t* fixed = NULL;
+    int32_t fixed_count = 0;
+    sh_mesh* mesh = cube_mesh(scene, &fixed, &fixed_count);
+    sh_world* world = bench_world_create(1);
+    sh_fem_body_def def = bench_fem_body_def(mesh, (sh_material_model)kind->model, 1e4, 0.45, 1000.0);
+    def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+    def.implicit = implicit_settings(SH_LINEAR_SOLVER_CHOLMOD);
+    sh_body_id body;
+    CHECK(sh_fem_body_create(world, &def, &body));
+    CHECK(sh_body_fix_nodes(world, body, fixed, fixed_count));
+    double* wall = (double*)xmalloc(sizeof(double) * (size_t)steps);
+    sh_step_report report;
+    int failed = 0;
+    long factorizations = 0, newton = 0;
+    for (int s = -1; s < steps; ++s) {
+        const double t0 = now_ns();
+        failed += sh_world_step(world, dt, &report) != SH_OK;
+        if (s < 0) continue;
+        wall[s] = now_ns() - t0;
+        factorizations += report.factorizations;
+        newton += report.newton_iterations;
+    }
+    const stats t = summarize(wall, steps);
+    printf("{\"case\":\"%s\",\"tets\":%d,\"dt\":%g,\"median_ms\":%.3f,\"p99_ms\":%.3f,\"max_ms\":%.3f,"
+           "\"mean_ms\":%.3f,\"factorizations_per_step\":%.2f,\"newton_per_step\":%.2f,\"steps\":%d,"
+           "\"failed_steps\":%d}\n",
+           name, 6 * kCubeCells * kCubeCells * kCubeCells, dt, t.median * 1e-6, t.p99 * 1e-6, t.max * 1e-6,
+           t.mean * 1e-6, (double)factorizations / steps, (double)newton / steps, steps, failed);
+    fflush(stdout);
+    free(wall);
+    free(fixed);
+    CHECK(sh_world_destroy(world));
+    CHECK(sh_mesh_destroy(mesh));
+}
+
+/* Every wanted cube scene, step and material (CHOLMOD only: the issue's comparison). */
+static void run_cube(const char* filter) {
+    static const char* const kScenes[] = {"stand", "droop"};
+    static const struct {
+        const char* name;
+        double dt;
+    } kSteps[] = {{"240hz", 1.0 / 240.0}, {"60hz", 1.0 / 60.0}};
+    const int steps = g_steps > 0 ? g_steps : 30;
+    if (!(sh_build_features() & SH_FEATURE_CHOLMOD)) return;
+    for (size_t c = 0; c < 2; ++c)
+        for (size_t d = 0; d < 2; ++d)
+            for (size_t j = 0; j < sizeof kKinds / sizeof kKinds[0]; ++j) {
+                if (kKinds[j].model < 0) continue;  /* springs: not in the comparison */
+                char name[256];
+                snprintf(name, sizeof name, "implicit/cube-%s/%s/%s/cholmod/cube_20250", kScenes[c], kSteps[d].name,
+                         kKinds[j].name);
+                if (name_matches(name, filter)) cube_case(kScenes[c], &kKinds[j], kSteps[d].dt, name, steps);
+            }
+}
+
 /* Collision detection and contact forces per step against mesh size. Each mesh (scaled so its
  * largest extent is kMeshSize, lowest point at z = 0) is a free StVK body (no fixed nodes) on a
  * plane obstacle through z = kContactTablePress (so the nodes of its lowest kContactTablePress
@@ -622,6 +711,7 @@ int main(int argc, char** argv) {
     }
     if (implicit) {
         run_implicit(filter);
+        run_cube(filter);
         return 0;
     }
     if (contact) {

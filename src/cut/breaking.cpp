@@ -59,10 +59,9 @@ Engagement engage(const Body& body, const Collider& tool) {
     double d[3];
     sub3(b, a, d);
     found.length = norm3(d) * static_cast<double>(last - first) / (kSamples - 1);
-    double middle[3];
-    const double u = 0.5 * (first + last) / (kSamples - 1);
-    for (int k = 0; k < 3; ++k) middle[k] = (1.0 - u) * a[k] + u * b[k];
-    const RestPoint at_middle = rest_point(body, middle);
+    // The material at the sample nearest the middle of the engaged part (already mapped: no
+    // second pass over the tets for the exact middle).
+    const RestPoint& at_middle = mapped[(first + last) / 2];
     if (at_middle.tet >= 0) found.toughness = static_cast<const FemBody&>(body).material(static_cast<size_t>(at_middle.tet)).toughness;
     return found;
 }

@@ -47,12 +47,6 @@ void nearest_node_offset(const Body& body, const double p[3], double out[3]) {
 
 }  // namespace
 
-RestPoint rest_point(const Body& body, const double p[3]) {
-    RestPoint found;
-    rest_points(body, p, 1, &found);
-    return found;
-}
-
 void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
     if (body.nodes_per_element() != 4 || body.element_count() == 0) {
         for (int i = 0; i < count; ++i) out[i] = RestPoint{}, nearest_node_offset(body, &p[3 * i], out[i].position);
@@ -88,8 +82,6 @@ void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
         }
     }
 }
-
-void to_rest(const Body& body, const double p[3], double out[3]) { to_rest_all(body, p, 1, out); }
 
 void to_rest_all(const Body& body, const double* p, int count, double* out) {
     vec<RestPoint> found(static_cast<size_t>(count));

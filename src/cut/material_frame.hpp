@@ -15,19 +15,14 @@ struct RestPoint {
                             ///< about minus its distance outside over the tet's size
 };
 
-/// The rest-shape position of world point p in body: through the affine map of the tet that
-/// contains p in the current configuration (or, outside the body, of the tet p is least
-/// outside of: an extrapolation); for a body without tets, p's offset from the nearest node.
-RestPoint rest_point(const Body& body, const double p[3]);
-
-/// rest_point of each of the count points p (3 each) into out[count], in one pass over the
-/// tets (each tet's map is formed once for all the points).
+/// The rest-shape positions of the count world points p (3 each) in body, into out[count]:
+/// each through the affine map of the tet that contains it in the current configuration (or,
+/// outside the body, of the tet it is least outside of: an extrapolation); for a body without
+/// tets, its offset from the nearest node. One pass over the tets (each tet's map is formed
+/// once for all the points).
 void rest_points(const Body& body, const double* p, int count, RestPoint* out);
 
-/// rest_point's position alone.
-void to_rest(const Body& body, const double p[3], double out[3]);
-
-/// to_rest of each of the count points p (3 each) into out (3 each), in one pass.
+/// rest_points' positions alone, into out (3 each).
 void to_rest_all(const Body& body, const double* p, int count, double* out);
 
 }  // namespace sh

@@ -19,8 +19,7 @@ Body::Body(vec<double> rest_positions, double alpha) : damping_mass(alpha), x(st
 }
 
 void Body::update_inverse_mass() {
-    for (size_t i = 0; i < mass.size(); ++i)
-        inverse_mass[i] = (mass[i] > 0.0 && !kinematic[i]) ? 1.0 / mass[i] : 0.0;
+    for (size_t i = 0; i < mass.size(); ++i) update_inverse_mass_of(i);
 }
 
 void Body::set_positions(const double* positions) {

@@ -97,6 +97,12 @@ public:
     /// Recomputes inverse_mass from mass and kinematic.
     void update_inverse_mass();
 
+    /// Recomputes node i's inverse_mass from its mass and kinematic flag (a local change
+    /// touches a few nodes).
+    void update_inverse_mass_of(size_t i) noexcept {
+        inverse_mass[i] = (mass[i] > 0.0 && !kinematic[i]) ? 1.0 / mass[i] : 0.0;
+    }
+
     /// Moves every node to positions (3 per node); fixed and prescribed nodes stay held where
     /// they are put.
     void set_positions(const double* positions);

@@ -54,14 +54,20 @@ void FemBody::fill_new_blocks(const ElementSet& fresh, vec<TetBlock> (&added)[SH
 }
 
 void FemBody::move_masses(const vec<int32_t>& changed, const ElementSet& fresh) noexcept {
-    // The changed tets' shares move from their old nodes to their new ones.
+    // The changed tets' shares move from their old nodes to their new ones; only those nodes'
+    // inverse masses change (appended nodes with no tet keep the zero adopt_nodes gave them).
     for (size_t k = 0; k < changed.size(); ++k) {
         const size_t t = static_cast<size_t>(changed[k]);
         if (t < volume_.size())
             for (int a = 0; a < 4; ++a) mass[static_cast<size_t>(tets_[4 * t + a])] -= materials_[t].density * volume_[t] / 4.0;
         for (int a = 0; a < 4; ++a) mass[static_cast<size_t>(fresh.tets[4 * k + a])] += fresh.materials[k].density * fresh.volume[k] / 4.0;
     }
-    update_inverse_mass();
+    for (size_t k = 0; k < changed.size(); ++k) {
+        const size_t t = static_cast<size_t>(changed[k]);
+        if (t < volume_.size())
+            for (int a = 0; a < 4; ++a) update_inverse_mass_of(static_cast<size_t>(tets_[4 * t + a]));
+        for (int a = 0; a < 4; ++a) update_inverse_mass_of(static_cast<size_t>(fresh.tets[4 * k + a]));
+    }
 }
 
 void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source, const vec<int32_t>& changed) {

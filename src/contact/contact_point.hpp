@@ -34,4 +34,13 @@ struct ContactPoint {
                              ///< side); their gradients are these times the normal
 };
 
+/// The weight of p's normal tangent, g_a g_b^T per pair of its nodes, in a matrix
+/// stiffness_scale K + damping_scale D: a subtracted term (an edge's excess, whose stiffness is
+/// negative) is left out, so that the tangent stays positive semi-definite (and bounds the
+/// potential's Hessian from above).
+inline double normal_tangent_scale(const ContactPoint& p, double stiffness_scale, double damping_scale) {
+    const double scale = stiffness_scale * p.stiffness + damping_scale * p.damping;
+    return scale > 0.0 ? scale : 0.0;
+}
+
 }  // namespace sh

@@ -26,7 +26,7 @@ public:
         : p_(p),
           // A subtracted term (an edge's excess) is left out: the tangent stays positive
           // semi-definite, and the line search takes care of the rest.
-          normal_scale_(std::max(0.0, stiffness_scale * p.stiffness + damping_scale * p.damping)),
+          normal_scale_(normal_tangent_scale(p, stiffness_scale, damping_scale)),
           damping_scale_(damping_scale) {
         if (p.friction_normal > 0.0) {
             const double vn = dot3(p.relative_velocity, p.normal);

@@ -253,14 +253,15 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         velocity_against_collider(tool_, p, v, vrel);
         if (p.count == 1) apply_normal_law(law, vrel, p);
         else apply_excess_damping(law, vrel, p);
-        // The term's tangent k g g^T (g: its gradients), row sums lumped onto its nodes:
-        // a diagonal that bounds it (positive weights), for integrate().
+        // The term's normal tangent (the full model's, contact_tangent.cpp), k g g^T with g its
+        // gradients, row sums lumped onto its nodes: a diagonal that bounds it, for integrate().
+        const double k = normal_tangent_scale(p, 1.0, 0.0), c = normal_tangent_scale(p, 0.0, 1.0);
         double spread = 0.0;
         for (int a = 0; a < p.count; ++a) spread += norm3(p.gradient[a]);
         for (int a = 0; a < p.count; ++a) {
             const double share = norm3(p.gradient[a]) * spread;
-            reach_[2 * p.nodes[a]] += std::fabs(p.stiffness) * share;
-            reach_[2 * p.nodes[a] + 1] += std::fabs(p.damping) * share;
+            reach_[2 * p.nodes[a]] += k * share;
+            reach_[2 * p.nodes[a] + 1] += c * share;
             for (int k = 0; k < 3; ++k) {
                 at(f, p.nodes[a])[k] += p.node_force[a][k];
                 at(contact_, p.nodes[a])[k] += p.node_force[a][k];

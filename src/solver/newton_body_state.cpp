@@ -39,13 +39,12 @@ bool carried_order(const Body& body, const EliminationOrder& last, const vec<int
     return true;
 }
 
-// solver's elimination order over pattern's free nodes as body nodes, into out (left as it
-// was if the solver has none).
-void chosen_order(const LinearSolver* solver, const SparseSystem& pattern, EliminationOrder& out) {
-    EliminationOrder order;
-    if (!solver || !solver->elimination_order(order)) return;
-    for (int32_t& f : order.nodes) f = pattern.dof_to_global()[3 * static_cast<size_t>(f)] / 3;
-    std::swap(out, order);
+// solver's elimination order over pattern's free nodes, as body nodes, into out; false if the
+// solver has none.
+bool chosen_order(const LinearSolver* solver, const SparseSystem& pattern, EliminationOrder& out) {
+    if (!solver || !solver->elimination_order(out)) return false;
+    for (int32_t& f : out.nodes) f = pattern.dof_to_global()[3 * static_cast<size_t>(f)] / 3;
+    return true;
 }
 
 }  // namespace
@@ -70,14 +69,14 @@ int32_t NewtonBodyState::prepare(const Body& body, const sh_implicit_settings& s
     EliminationOrder suggested;
     const bool suggest = own_solver && carried_order(body, elimination, index, count, suggested);
     LinearSolverPtr solver = own_solver ? make_analysed_solver(pattern, s, suggest ? &suggested : nullptr) : nullptr;
-    EliminationOrder order = elimination;
-    chosen_order(solver.get(), pattern, order);
+    EliminationOrder chosen;
+    const bool ordered = chosen_order(solver.get(), pattern, chosen);
     vec<double> diag(3 * static_cast<size_t>(count));
     // Commit only once everything is built (reset changes nothing if it throws).
     matrix.reset(std::move(pattern), std::move(solver));
     free_index.swap(index);
     diagonal.swap(diag);
-    std::swap(elimination, order);
+    if (ordered) std::swap(elimination, chosen);  // else the last order stays for the next analysis
     free_count = count;
     return 3 * count;
 }

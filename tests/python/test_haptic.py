@@ -287,28 +287,39 @@ def test_result_holds_every_output_field_and_owns_its_arrays():
     assert faulty.faults == frozenset({"SH_HAPTIC_FAULT_POSE"}) and faulty.fault_bits != 0
 
 
-def _resting_press(stiffness):
-    """A 1.5 mm sphere of the given stiffness (n = 1.5) pressed 1 mm into the middle of a 1 cm
-    face at 1 kHz and held: (the most sub-steps of any tick, the force at the end)."""
+def _press_scene(stiffness, damping_mass):
+    """A 1.5 mm sphere of the given stiffness (n = 1.5) above the middle of a 1 cm face of a
+    linear 4 x 4 x 2 cm block: (world, tool, where it touches)."""
     world = softhap.World(gravity=(0.0, 0.0, 0.0))
     body = world.add_fem_body(box_mesh((0.04, 0.04, 0.02), (4, 4, 2)), model="linear", young=5e3, poisson=0.3,
-                              damping_mass=20.0)
+                              damping_mass=damping_mass)
     body.fix_nodes(np.flatnonzero(np.abs(body.positions[:, 2]) < 1e-12))
-    radius, at = 0.0015, (0.013, 0.007)
-    tool = world.add_tool("sphere", radius=radius, position=(*at, 0.02 + radius), stiffness=stiffness,
-                          exponent=1.5, damping=0.0)
+    radius, at = 0.0015, (0.013, 0.007, 0.02 + 0.0015)
+    tool = world.add_tool("sphere", radius=radius, position=at, stiffness=stiffness, exponent=1.5, damping=0.0)
+    return world, tool, at
+
+
+def _resting_press(stiffness):
+    """The sphere pressed 1 mm in at 1 kHz through a whole-block buffer and held: (the most
+    sub-steps of any tick, the force at the end, the full model's static force at that pose)."""
+    world, tool, at = _press_scene(stiffness, 20.0)
     haptic = world.add_haptic(tool, radius=1.0, ramp_time=0.0, stale_after=100.0, max_force=100.0, max_force_rate=1e6)
-    results = [haptic.step((*at, 0.02 + radius - 1e-3 * min(1.0, (i + 1) / 100))) for i in range(1500)]
-    return max(r.substeps for r in results), results[-1].raw_force[2]
+    results = [haptic.step((at[0], at[1], at[2] - 1e-3 * min(1.0, (i + 1) / 100))) for i in range(1500)]
+    reference, reference_tool, _ = _press_scene(stiffness, 0.0)
+    reference_tool.set_pose((at[0], at[1], at[2] - 1e-3))
+    reference.solve_static(tolerance=1e-9, max_iterations=400)
+    return max(r.substeps for r in results), results[-1].raw_force[2], reference_tool.force[2]
 
 
 def test_stiff_tool_needs_no_more_sub_steps_than_a_soft_one():
     # The contact is implicit along each contacted node's push: the sub-steps follow the
     # elements' critical step alone, whatever the tool's stiffness (an explicit contact needs
     # about sqrt(200) = 14 times more sub-steps for a 200 times stiffer law). At rest the force
-    # is the material's reaction to the imposed indentation, which a stiffer tool makes nearly
-    # that of a rigid one: the stiffer tool's force is the larger, and both are finite.
-    soft_substeps, soft_force = _resting_press(1e3)
-    stiff_substeps, stiff_force = _resting_press(2e5)
+    # is the full model's static solve's at the same pose (an independent computation: Newton
+    # on the whole block's potential), soft or stiff.
+    soft_substeps, soft_force, soft_static = _resting_press(1e3)
+    stiff_substeps, stiff_force, stiff_static = _resting_press(2e5)
     assert stiff_substeps == soft_substeps
-    assert 0.0 < soft_force < stiff_force < 1.0
+    assert soft_static > 0.005 and stiff_static > 2.0 * soft_static
+    assert soft_force == pytest.approx(soft_static, rel=1e-5)
+    assert stiff_force == pytest.approx(stiff_static, rel=1e-5)

@@ -19,7 +19,9 @@ struct WorkingArrays {
     int32_t* id[2];
     double* force;
     double* contact;
-    double* reach;
+    double* contact_tangent;
+    int32_t* contacted;
+    uint8_t* in_contact;
     double* saved_x;
     double* saved_v;
     double* path_x;
@@ -38,7 +40,9 @@ void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3
     }
     w.force = arena.take<double>(3 * n);
     w.contact = arena.take<double>(3 * n);
-    w.reach = arena.take<double>(2 * n);
+    w.contact_tangent = arena.take<double>(18 * n);
+    w.contacted = arena.take<int32_t>(n);
+    w.in_contact = arena.take<uint8_t>(n);
     w.saved_x = arena.take<double>(3 * n);
     w.saved_v = arena.take<double>(3 * n);
     w.path_x = arena.take<double>(3 * n);
@@ -103,7 +107,9 @@ HapticContext::HapticContext(World& world, const sh_haptic_def& def)
     }
     force_ = w.force;
     contact_ = w.contact;
-    reach_ = w.reach;
+    contact_tangent_ = w.contact_tangent;
+    contacted_ = w.contacted;
+    in_contact_ = w.in_contact;
     saved_x_ = w.saved_x;
     saved_v_ = w.saved_v;
     path_x_ = w.path_x;

@@ -98,7 +98,9 @@ private:
     void apply_friction_impulses(const Buffer& b, double h, double* x, double* v, double force[3], double torque[3]);
     bool proxy_force(const Buffer& b, double force[3], double torque[3]) const;
     double substep_limit(const Buffer& b) const;
-    void integrate(const Buffer& b, double h, double* x, double* v) const;
+    void clear_contact();
+    void add_contact_tangent(int32_t node, const double direction[3], double stiffness, double damping);
+    void integrate(const Buffer& b, double h, double* x, double* v, double force[3], double torque[3]) const;
 
     sh_haptic_def def_;
     World* world_;
@@ -122,7 +124,11 @@ private:
     Id state_body_ = kNullId;
     double* force_ = nullptr;  ///< 3 per node
     double* contact_ = nullptr;  ///< 3 per node: the sub-step's contact force on it
-    double* reach_ = nullptr;    ///< 2 per node: the sub-step's contact stiffness and damping on it (lumped)
+    double* contact_tangent_ = nullptr;  ///< 18 per node: the sub-step's contact stiffness (3x3, N/m) and
+                                         ///< damping (3x3, N s/m) on it, lumped (integrate())
+    int32_t* contacted_ = nullptr;       ///< the nodes the sub-step's contact acts on
+    int32_t contacted_count_ = 0;
+    uint8_t* in_contact_ = nullptr;      ///< 1 per node: 1 if on contacted_
     double* saved_x_ = nullptr;
     double* saved_v_ = nullptr;
     double* path_x_ = nullptr;  ///< where each boundary node's path starts: the haptic side's

@@ -9,6 +9,9 @@
 #include "model/fem_kernel.hpp"
 #include "solver/substeps.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -208,35 +211,68 @@ double HapticContext::substep_limit(const Buffer& b) const {
     return omega_fem > 0.0 ? kSafety * std::sqrt(3.0) / omega_fem : INFINITY;
 }
 
-void HapticContext::integrate(const Buffer& b, double h, double* x, double* v) const {
+void HapticContext::integrate(const Buffer& b, double h, double* x, double* v, double force[3],
+                               double torque[3]) const {
     // Symplectic Euler with the mass damping implicit, and each contacted node's contact
-    // stiffness k and damping c (reach_: its terms' tangent, lumped onto it) implicit along its
-    // push n, linearised: (m + (h^2 k + h c) n n^T) v' = m v + h f + h c n (n . v), solved by
-    // Sherman-Morrison. At rest (v = 0, f = 0) it stays at rest: the equilibrium, and the force
-    // there, are the explicit step's; and a stiff tool needs no more sub-steps than the
-    // elements do.
+    // stiffness K and damping C (contact_tangent_: its terms' tangents, lumped onto it)
+    // implicit, linearised: (m + h^2 K + h C) v' = m v + h f + h C v. At rest (v = 0, f = 0)
+    // it stays at rest: the equilibrium, and the force there, are the explicit step's; and a
+    // stiff tool needs no more sub-steps than the elements do. The tool feels the contact
+    // force the node received, f_c - h K v' - C (v' - v), so that what the tool gives the
+    // buffer is what the device feels (momentum is conserved between the two).
     const double damping = 1.0 / (1.0 + h * b.damping_mass);
     for (int32_t i = 0; i < b.node_count; ++i) {
         const double w = b.inverse_mass[i];
         if (w == 0.0) continue;
-        double r[3];
-        for (int k = 0; k < 3; ++k) r[k] = at(v, i)[k] + h * w * at(force_, i)[k];
-        const double push = norm3(at(contact_, i));
-        if (push > 0.0) {
-            const double k_node = reach_[2 * i], c_node = reach_[2 * i + 1];
-            double n[3];
-            for (int k = 0; k < 3; ++k) n[k] = at(contact_, i)[k] / push;
-            const double vn = dot3(n, at(v, i));
-            for (int k = 0; k < 3; ++k) r[k] += w * h * c_node * vn * n[k];
-            const double a = w * (h * h * k_node + h * c_node);
-            const double rn = dot3(n, r) * a / (1.0 + a);
-            for (int k = 0; k < 3; ++k) r[k] -= rn * n[k];
+        double* vi = at(v, i);
+        if (in_contact_[i]) {
+            const Eigen::Map<const Eigen::Matrix3d> k(contact_tangent_ + 18 * static_cast<size_t>(i));
+            const Eigen::Map<const Eigen::Matrix3d> c(contact_tangent_ + 18 * static_cast<size_t>(i) + 9);
+            const Eigen::Map<const Eigen::Vector3d> v0(vi), f(at(force_, i));
+            const Eigen::Matrix3d a = Eigen::Matrix3d::Identity() + w * (h * h * k + h * c);
+            const Eigen::Vector3d v1 = a.llt().solve(v0 + w * h * (f + c * v0));
+            const Eigen::Vector3d received = -(h * k * v1 + c * (v1 - v0));
+            double arm[3], t[3];
+            sub3(at(x, i), tool_.pose.p, arm);
+            cross3(arm, received.data(), t);
+            for (int k = 0; k < 3; ++k) {
+                force[k] -= received[k];
+                torque[k] -= t[k];
+                vi[k] = v1[k];
+            }
+        } else {
+            for (int k = 0; k < 3; ++k) vi[k] += h * w * at(force_, i)[k];
         }
         for (int k = 0; k < 3; ++k) {
-            at(v, i)[k] = r[k] * damping;
-            at(x, i)[k] += h * at(v, i)[k];
+            vi[k] *= damping;
+            at(x, i)[k] += h * vi[k];
         }
     }
+}
+
+void HapticContext::clear_contact() {
+    // Only the nodes the last sub-step touched hold contact data.
+    for (int32_t j = 0; j < contacted_count_; ++j) {
+        const int32_t i = contacted_[j];
+        in_contact_[i] = 0;
+        std::memset(at(contact_, i), 0, 3 * sizeof(double));
+    }
+    contacted_count_ = 0;
+}
+
+void HapticContext::add_contact_tangent(int32_t node, const double direction[3], double stiffness, double damping) {
+    double* tangent = contact_tangent_ + 18 * static_cast<size_t>(node);
+    if (!in_contact_[node]) {
+        in_contact_[node] = 1;
+        contacted_[contacted_count_++] = node;
+        std::memset(tangent, 0, 18 * sizeof(double));
+    }
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+            const double outer = direction[r] * direction[c];
+            tangent[3 * c + r] += stiffness * outer;
+            tangent[9 + 3 * c + r] += damping * outer;
+        }
 }
 
 void HapticContext::add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double force[3],
@@ -244,8 +280,7 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
     double lo[3], hi[3];
     tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
     const sh_contact_params& law = tool_.params;
-    std::memset(contact_, 0, 3 * static_cast<size_t>(b.node_count) * sizeof(double));
-    std::memset(reach_, 0, 2 * static_cast<size_t>(b.node_count) * sizeof(double));
+    clear_contact();
     visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
         ContactPoint p;
         if (!term_contact(tool_, x, nodes, count, size, p)) return;
@@ -254,14 +289,17 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         if (p.count == 1) apply_normal_law(law, vrel, p);
         else apply_excess_damping(law, vrel, p);
         // The term's normal tangent (the full model's, contact_tangent.cpp), k g g^T with g its
-        // gradients, row sums lumped onto its nodes: a diagonal that bounds it, for integrate().
+        // gradients, bounded by a block diagonal: node a gets k |g_a| (sum_b |g_b|) along g_a
+        // (Cauchy-Schwarz), for integrate().
         const double k = normal_tangent_scale(p, 1.0, 0.0), c = normal_tangent_scale(p, 0.0, 1.0);
         double spread = 0.0;
         for (int a = 0; a < p.count; ++a) spread += norm3(p.gradient[a]);
         for (int a = 0; a < p.count; ++a) {
-            const double share = norm3(p.gradient[a]) * spread;
-            reach_[2 * p.nodes[a]] += k * share;
-            reach_[2 * p.nodes[a] + 1] += c * share;
+            const double length = norm3(p.gradient[a]);
+            double direction[3] = {0.0, 0.0, 0.0};
+            if (length > 0.0)
+                for (int k = 0; k < 3; ++k) direction[k] = p.gradient[a][k] / length;
+            add_contact_tangent(p.nodes[a], direction, k * length * spread, c * length * spread);
             for (int k = 0; k < 3; ++k) {
                 at(f, p.nodes[a])[k] += p.node_force[a][k];
                 at(contact_, p.nodes[a])[k] += p.node_force[a][k];
@@ -342,7 +380,7 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
         bool touching = false;
         add_contact_forces(b, x, v, force_, f_tool, t_tool, touching);
         contact = touching;
-        integrate(b, h, x, v);
+        integrate(b, h, x, v, f_tool, t_tool);
         apply_friction_impulses(b, h, x, v, f_tool, t_tool);
         for (int k = 0; k < 3; ++k) {  // the step's mean wrench
             force[k] += f_tool[k] / substeps;

@@ -87,6 +87,10 @@ typedef struct {
 scene scene_create(const tissue* t, sh_material_model model, sh_integrator integrator, double damping,
                    const double tool_position[3]);
 
+/* scene_create with the tool tool (a collider def) instead of the default sphere. */
+scene scene_create_with_tool(const tissue* t, sh_material_model model, sh_integrator integrator, double damping,
+                             const sh_collider_def* tool);
+
 /* Destroys the scene's world and everything in it. */
 void scene_destroy(scene* s);
 
@@ -95,7 +99,8 @@ void scene_destroy(scene* s);
 int world_step(sh_world* world);
 
 /* A haptic def for the scene's tool: a buffer of radius (m) and at most capacity_tets tets;
- * exact: no clamp, rate limit nor ramp, so that the output is the raw force. */
+ * exact: no clamp, rate limit nor ramp, so that the output is the raw force. The nominal step is
+ * kHapticDt. */
 sh_haptic_def haptic_def_for(const scene* s, double radius, int32_t capacity_tets, int exact);
 
 /* ------------------------------------------------------------------------------------------ */
@@ -121,10 +126,10 @@ void tick_log_alloc(tick_log* log, int count);
 /* Frees what tick_log_alloc allocated. */
 void tick_log_free(tick_log* log);
 
-/* Steps haptic from tick `first` for count ticks along path; paced: one tick per kHapticDt of
- * wall time. Timed ticks (if log->ns) are recorded, and calls of the allocator from this thread
- * during the loop counted. */
-void run_ticks(sh_haptic* haptic, path_fn path, const void* ctx, long first, long count, int paced,
+/* Steps haptic by dt (s) from tick `first` for count ticks along path; paced: one tick per dt
+ * of wall time. Timed ticks (if log->ns) are recorded, and calls of the allocator from this
+ * thread during the loop counted. */
+void run_ticks(sh_haptic* haptic, path_fn path, const void* ctx, long first, long count, double dt, int paced,
                tick_log* log);
 
 /* Prints "<prefix>median_us":..,... (median, p99, p99.9, max, mean) for times in ns. */

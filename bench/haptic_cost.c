@@ -11,10 +11,19 @@
 
 static const int kCostSizes[] = {50, 100, 200, 500, 1000, 2000};
 static const int kConcurrentSizes[] = {50, 200, 500, 2000};
+/* The rate cases: buffer sizes, device rates (Hz), and the tools' Hunt-Crossley stiffness
+ * (N/m^1.5): the default sphere and one 20 times stiffer (as examples/haptic_loop uses). */
+static const int kRateSizes[] = {50, 200, 500, 2000};
+static const int kRates[] = {1000, 10000};
+static const struct {
+    const char* name;
+    double stiffness;
+} kRateTools[] = {{"soft", 1e4}, {"stiff", 2e5}};
 static const double kCostDepth = 0.003;  /* m */
 static const double kCostCircle = 0.001; /* m, once a second */
 static const double kCostDamping = 5.0;  /* 1/s */
-static const int kPressTicks = 300, kWarmupTicks = 2000, kPacedTicks = 5000;
+static const double kPressTime = 0.3, kWarmupTime = 2.0; /* s */
+static const int kWarmupTicks = 2000, kPacedTicks = 5000;
 /* Timed ticks: corotational (the headline), the other materials (for their kernels' cost). */
 static const int kTimedTicks = 20000, kOtherTimedTicks = 5000;
 enum { kBatch = 100, kBatches = 200, kClockReads = 2000 };
@@ -25,14 +34,16 @@ enum { kSimCapacity = 4096 }; /* sim step times kept */
 
 typedef struct {
     double touch[3];
+    double dt; /* s per tick */
 } cost_path;
 
-/* Pressed kCostDepth over kPressTicks, then a circle of kCostCircle once a second: the contact
+/* Pressed kCostDepth over kPressTime, then a circle of kCostCircle once a second: the contact
  * keeps moving, so every step solves a changing contact. */
 static void cost_pose(const void* ctx, long tick, double out[3]) {
     const cost_path* c = (const cost_path*)ctx;
-    const double press = fmin(1.0, (tick + 1.0) / kPressTicks);
-    const double a = tick > kPressTicks ? 2.0 * kPi * (tick - kPressTicks) * kHapticDt : 0.0;
+    const double t = (tick + 1.0) * c->dt;
+    const double press = fmin(1.0, t / kPressTime);
+    const double a = t > kPressTime ? 2.0 * kPi * (t - kPressTime) : 0.0;
     out[0] = c->touch[0] + kCostCircle * (cos(a) - 1.0);
     out[1] = c->touch[1] + kCostCircle * sin(a);
     out[2] = c->touch[2] - kCostDepth * press;
@@ -97,12 +108,23 @@ static void sim_stop(sim_runner* sim) {
 /* ------------------------------------------------------------------------------------------ */
 /* One buffer size                                                                              */
 
+/* One cost case: the buffer's material and capacity, with or without the sim thread, the
+ * device's step and the tool's stiffness. */
+typedef struct {
+    char name[128];
+    sh_material_model model;
+    int capacity;
+    int with_sim;
+    double dt;        /* s */
+    double stiffness; /* the tool's Hunt-Crossley stiffness (N/m^1.5) */
+} cost_setup;
+
 /* How many ticks a cost case times: --steps N (a quarter of it paced beside the sim thread),
  * else the case's default. */
-static int cost_ticks(const haptic_options* options, sh_material_model model, int with_sim) {
-    if (with_sim) return options->steps > 0 ? options->steps / 4 : kPacedTicks;
+static int cost_ticks(const haptic_options* options, const cost_setup* c) {
+    if (c->with_sim) return options->steps > 0 ? options->steps / 4 : kPacedTicks;
     if (options->steps > 0) return options->steps;
-    return model == SH_MATERIAL_COROTATIONAL ? kTimedTicks : kOtherTimedTicks;
+    return c->model == SH_MATERIAL_COROTATIONAL && c->dt == kHapticDt ? kTimedTicks : kOtherTimedTicks;
 }
 
 /* The sim thread's fields of a concurrent case's JSON line. */
@@ -116,61 +138,94 @@ static void print_sim_fields(const sim_runner* sim, double wall, long fresh) {
 
 /* A cost case's JSON line (sorts the log's samples; sim NULL: frozen) and its summary on
  * stderr. */
-static void print_cost(const char* name, const tissue* block, sh_material_model model, int capacity,
-                       tick_log* log, const sim_runner* sim, double wall, int rt) {
+static void print_cost(const cost_setup* c, const tissue* block, tick_log* log, const sim_runner* sim, double wall,
+                       int rt) {
     const stats sub = summarize(log->substeps, log->timed);
     const stats t = summarize(log->ns, log->timed);
     const int tets = log->last.buffer_tets;
     printf("{\"study\":\"haptic_cost\",\"case\":\"%s\",\"material\":\"%s\",\"sim\":\"%s\",\"capacity_tets\":%d,"
            "\"buffer_tets\":%d,\"buffer_nodes\":%d,\"mesh_tets\":%d,\"steps\":%d,",
-           name, material_name(model), sim ? "sim" : "frozen", capacity, tets, log->last.buffer_nodes,
+           c->name, material_name(c->model), sim ? "sim" : "frozen", c->capacity, tets, log->last.buffer_nodes,
            block->tet_count, t.count);
     print_times_us("", &t);
     printf(",\"substeps_median\":%g,\"substeps_max\":%g,\"ns_per_tet\":%.2f,\"ns_per_tet_substep\":%.2f,"
-           "\"allocations\":%ld,\"contact_ticks\":%ld,\"faults\":%u,\"dt\":%g,\"depth_m\":%g,\"rt\":%d",
+           "\"allocations\":%ld,\"contact_ticks\":%ld,\"faults\":%u,\"dt\":%g,\"tool_stiffness\":%g,"
+           "\"depth_m\":%g,\"rt\":%d",
            sub.median, sub.max, tets > 0 ? t.median / tets : 0.0,
            tets > 0 && sub.median > 0 ? t.median / (tets * sub.median) : 0.0, log->allocations, log->contact,
-           log->faults, kHapticDt, kCostDepth, rt);
+           log->faults, c->dt, c->stiffness, kCostDepth, rt);
     if (sim) print_sim_fields(sim, wall, log->fresh);
     printf("}\n");
     fflush(stdout);
-    fprintf(stderr, "%s: median %.2f us, p99.9 %.2f us, %d tets, %g sub-steps\n", name, t.median * 1e-3,
+    fprintf(stderr, "%s: median %.2f us, p99.9 %.2f us, %d tets, %g sub-steps\n", c->name, t.median * 1e-3,
             t.p999 * 1e-3, tets, sub.median);
 }
 
-/* One buffer size: the press and a warm-up untimed, then the timed ticks, back to back with
- * the world frozen, or paced at 1 kHz beside the sim thread. */
-static void cost_case(const tissue* block, sh_material_model model, int capacity, int with_sim,
-                      const haptic_options* options) {
-    char name[128];
-    snprintf(name, sizeof name, "haptic/%s/%s/%d", with_sim ? "sim" : "frozen", material_name(model), capacity);
-    if (!name_matches(name, options->filter)) return;
-    cost_path path;
-    touch_point(block, path.touch);
-    scene s = scene_create(block, model, with_sim ? SH_INTEGRATOR_IMPLICIT_EULER : SH_INTEGRATOR_SYMPLECTIC_EULER,
-                           kCostDamping, path.touch);
-    const sh_haptic_def def = haptic_def_for(&s, 1.0, capacity, 0);
-    sh_haptic* haptic = NULL;
-    CHECK(sh_haptic_create(s.world, &def, &haptic));
-    if (with_sim) world_step(s.world); /* the implicit solver's set-up */
+/* The case's scene and haptic context (the tool at the touch point, path->touch). */
+static scene cost_scene(const tissue* block, const cost_setup* c, cost_path* path, sh_haptic** haptic) {
+    touch_point(block, path->touch);
+    path->dt = c->dt;
+    sh_collider_def tool = bench_sphere_def(kToolRadius, path->touch);
+    tool.contact.stiffness = c->stiffness;
+    scene s = scene_create_with_tool(
+        block, c->model, c->with_sim ? SH_INTEGRATOR_IMPLICIT_EULER : SH_INTEGRATOR_SYMPLECTIC_EULER, kCostDamping,
+        &tool);
+    sh_haptic_def def = haptic_def_for(&s, 1.0, c->capacity, 0);
+    def.dt = c->dt;
+    CHECK(sh_haptic_create(s.world, &def, haptic));
+    if (c->with_sim) world_step(s.world); /* the implicit solver's set-up */
+    return s;
+}
 
+/* One case: the press and a warm-up untimed, then the timed ticks, back to back with the world
+ * frozen, or paced at the device's rate beside the sim thread. */
+static void cost_case(const tissue* block, const cost_setup* c, const haptic_options* options) {
+    if (!name_matches(c->name, options->filter)) return;
+    cost_path path;
+    sh_haptic* haptic = NULL;
+    scene s = cost_scene(block, c, &path, &haptic);
     tick_log warm, log;
     memset(&warm, 0, sizeof warm);
-    run_ticks(haptic, cost_pose, &path, 0, kPressTicks + kWarmupTicks, 0, &warm);
-    const int count = cost_ticks(options, model, with_sim);
+    const long untimed = lround((kPressTime + kWarmupTime) / c->dt);
+    run_ticks(haptic, cost_pose, &path, 0, untimed, c->dt, 0, &warm);
+    const int count = cost_ticks(options, c);
     tick_log_alloc(&log, count);
     sim_runner sim;
     memset(&sim, 0, sizeof sim);
-    if (with_sim) sim_start(&sim, s.world, options);
+    if (c->with_sim) sim_start(&sim, s.world, options);
     const double t0 = now_ns();
-    run_ticks(haptic, cost_pose, &path, kPressTicks + kWarmupTicks, count, with_sim, &log);
+    run_ticks(haptic, cost_pose, &path, untimed, count, c->dt, c->with_sim, &log);
     const double wall = (now_ns() - t0) * 1e-9;
-    if (with_sim) sim_stop(&sim);
-    print_cost(name, block, model, capacity, &log, with_sim ? &sim : NULL, wall, options->rt);
-    if (with_sim) free(sim.ns);
+    if (c->with_sim) sim_stop(&sim);
+    print_cost(c, block, &log, c->with_sim ? &sim : NULL, wall, options->rt);
+    if (c->with_sim) free(sim.ns);
     tick_log_free(&log);
     CHECK(sh_haptic_destroy(haptic));
     scene_destroy(&s);
+}
+
+/* The default tool at 1 kHz: "haptic/<frozen|sim>/<material>/<capacity>". */
+static cost_setup material_setup(sh_material_model model, int capacity, int with_sim) {
+    cost_setup c;
+    sh_collider_def tool;
+    sh_collider_def_default(&tool);
+    snprintf(c.name, sizeof c.name, "haptic/%s/%s/%d", with_sim ? "sim" : "frozen", material_name(model), capacity);
+    c.model = model;
+    c.capacity = capacity;
+    c.with_sim = with_sim;
+    c.dt = kHapticDt;
+    c.stiffness = tool.contact.stiffness;
+    return c;
+}
+
+/* Corotational, frozen, at rate_hz under the tool named tool (kRateTools):
+ * "haptic/rate/<rate_hz>hz/<tool>/<capacity>". */
+static cost_setup rate_setup(int rate_hz, int tool, int capacity) {
+    cost_setup c = material_setup(SH_MATERIAL_COROTATIONAL, capacity, 0);
+    snprintf(c.name, sizeof c.name, "haptic/rate/%dhz/%s/%d", rate_hz, kRateTools[tool].name, capacity);
+    c.dt = 1.0 / rate_hz;
+    c.stiffness = kRateTools[tool].stiffness;
+    return c;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -207,16 +262,17 @@ static void overhead_case(const tissue* block, const haptic_options* options) {
     cost_path path;
     touch_point(block, path.touch);
     path.touch[2] += 1.0;
+    path.dt = kHapticDt;
     scene s = scene_create(block, SH_MATERIAL_COROTATIONAL, SH_INTEGRATOR_SYMPLECTIC_EULER, kCostDamping, path.touch);
     const sh_haptic_def def = haptic_def_for(&s, 0.02, 2000, 0);
     sh_haptic* haptic = NULL;
     CHECK(sh_haptic_create(s.world, &def, &haptic));
     tick_log warm, log;
     memset(&warm, 0, sizeof warm);
-    run_ticks(haptic, cost_pose, &path, 0, kWarmupTicks, 0, &warm);
+    run_ticks(haptic, cost_pose, &path, 0, kWarmupTicks, kHapticDt, 0, &warm);
     const int count = options->steps > 0 ? options->steps : kTimedTicks;
     tick_log_alloc(&log, count);
-    run_ticks(haptic, cost_pose, &path, kWarmupTicks, count, 0, &log);
+    run_ticks(haptic, cost_pose, &path, kWarmupTicks, count, kHapticDt, 0, &log);
     const stats t = summarize(log.ns, log.timed);
     double batch[kBatches], p[3];
     cost_pose(&path, kWarmupTicks, p);
@@ -238,8 +294,8 @@ static void overhead_case(const tissue* block, const haptic_options* options) {
 
 /* ------------------------------------------------------------------------------------------ */
 
-/* The overhead, every material at every buffer size frozen, then corotational beside the sim
- * thread. */
+/* The overhead, every material at every buffer size frozen, the rate cases, then corotational
+ * beside the sim thread. */
 int haptic_run_cost(const haptic_options* options) {
     static const sh_material_model kModels[] = {SH_MATERIAL_COROTATIONAL, SH_MATERIAL_LINEAR, SH_MATERIAL_STVK,
                                                  SH_MATERIAL_NEOHOOKEAN};
@@ -249,9 +305,20 @@ int haptic_run_cost(const haptic_options* options) {
             block.node_count, block.fixed_count);
     overhead_case(&block, options);
     for (size_t m = 0; m < sizeof kModels / sizeof kModels[0]; ++m)
-        for (int k = 0; k < sizes; ++k) cost_case(&block, kModels[m], kCostSizes[k], 0, options);
-    for (size_t k = 0; k < sizeof kConcurrentSizes / sizeof kConcurrentSizes[0]; ++k)
-        cost_case(&block, SH_MATERIAL_COROTATIONAL, kConcurrentSizes[k], 1, options);
+        for (int k = 0; k < sizes; ++k) {
+            const cost_setup c = material_setup(kModels[m], kCostSizes[k], 0);
+            cost_case(&block, &c, options);
+        }
+    for (size_t r = 0; r < sizeof kRates / sizeof kRates[0]; ++r)
+        for (int tool = 0; tool < (int)(sizeof kRateTools / sizeof kRateTools[0]); ++tool)
+            for (size_t k = 0; k < sizeof kRateSizes / sizeof kRateSizes[0]; ++k) {
+                const cost_setup c = rate_setup(kRates[r], tool, kRateSizes[k]);
+                cost_case(&block, &c, options);
+            }
+    for (size_t k = 0; k < sizeof kConcurrentSizes / sizeof kConcurrentSizes[0]; ++k) {
+        const cost_setup c = material_setup(SH_MATERIAL_COROTATIONAL, kConcurrentSizes[k], 1);
+        cost_case(&block, &c, options);
+    }
     tissue_free(&block);
     return 0;
 }

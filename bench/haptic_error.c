@@ -99,7 +99,7 @@ static void press_and_hold(sh_haptic* haptic, sh_world* world, int coupled, cons
     long next_sim = 1; /* world step k after tick ceil(k kSimDt / kHapticDt) */
     for (long i = 0; i < ticks; ++i) {
         tick_log* used = i >= timed_from ? &r->log : &r->untimed;
-        run_ticks(haptic, error_pose, path, i, 1, 0, used);
+        run_ticks(haptic, error_pose, path, i, 1, kHapticDt, 0, used);
         if (i + 1 == settle_at)
             for (int k = 0; k < 3; ++k) r->settle_force[k] = used->last.raw_force[k];
         if (coupled && (i + 1) * kHapticDt >= next_sim * kSimDt - 1e-9) {

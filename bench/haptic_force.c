@@ -128,7 +128,7 @@ static void run_trace(sh_haptic* haptic, const scene* s, const slide_path* path,
     double held[3] = {0.0, 0.0, 0.0};
     long next_sim = 1;
     for (long i = 0; i < tr->ticks; ++i) {
-        run_ticks(haptic, trace_pose, path, i, 1, 0, &tr->log);
+        run_ticks(haptic, trace_pose, path, i, 1, kHapticDt, 0, &tr->log);
         record_tick(tr, path, i);
         if ((i + 1) * kHapticDt >= next_sim * kSimDt - 1e-9) {
             const double t0 = now_ns();

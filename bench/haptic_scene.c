@@ -9,6 +9,12 @@ static const double kDensity = 1000.0; /* kg/m^3 */
 
 scene scene_create(const tissue* t, sh_material_model model, sh_integrator integrator, double damping,
                    const double tool_position[3]) {
+    const sh_collider_def tool = bench_sphere_def(kToolRadius, tool_position);
+    return scene_create_with_tool(t, model, integrator, damping, &tool);
+}
+
+scene scene_create_with_tool(const tissue* t, sh_material_model model, sh_integrator integrator, double damping,
+                             const sh_collider_def* tool) {
     scene s;
     /* Gravity off: the press is the only load, so the full model's reference is the press
      * force alone. */
@@ -18,8 +24,7 @@ scene scene_create(const tissue* t, sh_material_model model, sh_integrator integ
     def.damping_mass = damping;
     CHECK(sh_fem_body_create(s.world, &def, &s.body));
     CHECK(sh_body_fix_nodes(s.world, s.body, t->fixed, t->fixed_count));
-    const sh_collider_def tool = bench_sphere_def(kToolRadius, tool_position);
-    CHECK(sh_tool_create(s.world, &tool, &s.tool));
+    CHECK(sh_tool_create(s.world, tool, &s.tool));
     return s;
 }
 

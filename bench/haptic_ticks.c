@@ -17,7 +17,7 @@ void tick_log_free(tick_log* log) {
 }
 
 /* Adds one tick's output (and its time t_ns, if the log keeps times) to the log. */
-static void log_tick(tick_log* log, sh_status status, const sh_haptic_output* out, double t_ns) {
+static void log_tick(tick_log* log, sh_status status, const sh_haptic_output* out, double dt, double t_ns) {
     if (status != SH_OK) log->faults |= 0x80000000u;
     if (log->ns) {
         log->ns[log->timed] = t_ns;
@@ -25,11 +25,11 @@ static void log_tick(tick_log* log, sh_status status, const sh_haptic_output* ou
         ++log->timed;
     }
     log->contact += out->contact;
-    log->fresh += out->data_age <= kHapticDt * 1.000001; /* the buffer adopted at this tick */
+    log->fresh += out->data_age <= dt * 1.000001; /* the buffer adopted at this tick */
     log->faults |= out->faults;
 }
 
-void run_ticks(sh_haptic* haptic, path_fn path, const void* ctx, long first, long count, int paced,
+void run_ticks(sh_haptic* haptic, path_fn path, const void* ctx, long first, long count, double dt, int paced,
                tick_log* log) {
     double deadline = now_ns();
     sh_haptic_output out;
@@ -40,13 +40,13 @@ void run_ticks(sh_haptic* haptic, path_fn path, const void* ctx, long first, lon
         double p[3];
         path(ctx, first + i, p);
         if (paced) {
-            deadline += kHapticDt * 1e9;
+            deadline += dt * 1e9;
             sleep_until(deadline);
         }
         const double t0 = now_ns();
-        const sh_status st = sh_haptic_step(haptic, p, kIdentity, kHapticDt, &out);
+        const sh_status st = sh_haptic_step(haptic, p, kIdentity, dt, &out);
         const double t1 = now_ns();
-        log_tick(log, st, &out, t1 - t0);
+        log_tick(log, st, &out, dt, t1 - t0);
     }
     if (counting) log->allocations += alloc_count_off();
     log->last = out;

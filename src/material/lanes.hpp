@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#if defined(__AVX512F__)
+#if defined(__AVX512F__) || defined(__AVX__)
 #include <immintrin.h>
 #endif
 
@@ -32,6 +32,11 @@ SH_INLINE Lanes lanes_sqrt(Lanes a) {
 #if defined(__AVX512F__)
     static_assert(kLanes == 8, "AVX-512 path assumes 8 double lanes");
     return _mm512_sqrt_pd(a);
+#elif defined(__AVX__)
+    static_assert(kLanes == 8, "AVX path assumes 8 double lanes");
+    const __m256d lo = _mm256_sqrt_pd(__m256d{a[0], a[1], a[2], a[3]});
+    const __m256d hi = _mm256_sqrt_pd(__m256d{a[4], a[5], a[6], a[7]});
+    return Lanes{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
 #else
     for (int l = 0; l < kLanes; ++l) a[l] = std::sqrt(a[l]);
     return a;

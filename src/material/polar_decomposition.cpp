@@ -11,9 +11,9 @@ namespace {
 constexpr double kSvdThreshold = 1e-3;
 
 // The iteration converges quadratically: an update that changes R by d (Frobenius) leaves it
-// about d^2 / 2 from the polar factor, so a squared change below 1e-20 (d < 1e-10) returns R
-// to about 1e-20, far below round-off, without one more update to confirm it.
-constexpr double kConvergedChange2 = 1e-20;
+// about d^2 / 2 from the polar factor, so a squared change below 1e-16 (d < 1e-8) returns R
+// to about 5e-17, round-off, without one more update to confirm it.
+constexpr double kConvergedChange2 = 1e-16;
 
 Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& f) {
     Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);

@@ -4,7 +4,7 @@ PYTHON ?= python3
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-c test-python test-reduced demo cutting palpation haptic-loop tsan asan fuzz bench report report-deps haptic-report press-report cutting-report clean
+.PHONY: all deps build install install-check test test-c test-python test-reduced demo cutting palpation haptic-loop tsan asan fuzz bench report report-deps haptic-report press-report cutting-report clean
 
 all: build
 
@@ -15,6 +15,25 @@ build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DSOFTHAP_BUILD_TESTS=ON \
 	  -DSOFTHAP_BUILD_EXAMPLES=ON -DSOFTHAP_BUILD_BENCH=ON $(CMAKE_FLAGS) > /dev/null
 	cmake --build $(BUILD) -j $(JOBS)
+
+# Install the header, library, CMake package and softhap.pc under PREFIX (default /usr/local).
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
+
+# The installed package as a user's project sees it: install into a scratch prefix, then build
+# examples/minimal.c against it with find_package(softhap) and with pkg-config, and run both.
+INSTALL_CHECK ?= $(abspath $(BUILD))/install-check
+install-check: build
+	rm -rf $(INSTALL_CHECK)
+	cmake --install $(BUILD) --prefix $(INSTALL_CHECK)/prefix > /dev/null
+	cmake -S tests/install -B $(INSTALL_CHECK)/cmake -DCMAKE_PREFIX_PATH=$(INSTALL_CHECK)/prefix > /dev/null
+	cmake --build $(INSTALL_CHECK)/cmake > /dev/null
+	$(INSTALL_CHECK)/cmake/minimal
+	PKG_CONFIG_PATH=$$(dirname $$(find $(INSTALL_CHECK)/prefix -name softhap.pc)) sh -c \
+	  'cc examples/minimal.c $$(pkg-config --cflags --libs softhap) -Wl,-rpath,$$(pkg-config --variable=libdir softhap) \
+	   -o $(INSTALL_CHECK)/minimal-pkg-config'
+	$(INSTALL_CHECK)/minimal-pkg-config
 
 test: build
 	$(MAKE) --no-print-directory test-c test-python

@@ -35,25 +35,10 @@ SCENES = {"stand": 2, "droop": 0}  # the axis whose 0 face is fixed
 STEPS = {"240hz": 1.0 / 240.0, "60hz": 1.0 / 60.0}
 MODELS = ("corotational", "stvk", "neohookean")
 
-# The six tets of a cube's Kuhn split, as corners of the cell (bit k of a corner: +1 along axis k).
-KUHN = ((0, 1, 3, 7), (0, 1, 5, 7), (0, 2, 3, 7), (0, 2, 6, 7), (0, 4, 5, 7), (0, 4, 6, 7))
-
-
 def cube():
-    """Nodes (n x 3) and positively oriented tets (m x 4) of the Kuhn-split cube."""
-    side = CELLS + 1
-    grid = np.stack(np.meshgrid(*(np.arange(side),) * 3, indexing="ij"), -1).reshape(-1, 3)
-    nodes = grid * (SIZE / CELLS)
-    index = lambda i, j, k: (i * side + j) * side + k  # noqa: E731
-    tets = []
-    for i, j, k in np.ndindex(CELLS, CELLS, CELLS):
-        corner = [index(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)) for c in range(8)]
-        tets.extend([corner[a] for a in tet] for tet in KUHN)
-    tets = np.array(tets, dtype=np.int32)
-    e = nodes[tets[:, 1:]] - nodes[tets[:, :1]]
-    flip = np.einsum("ij,ij->i", e[:, 0], np.cross(e[:, 1], e[:, 2])) < 0
-    tets[flip] = tets[flip][:, [0, 2, 1, 3]]
-    return nodes, tets
+    """Nodes (n x 3) and tets (m x 4) of the cube (softhap.Mesh.box: six tets per cell)."""
+    mesh = softhap.Mesh.box((SIZE, SIZE, SIZE), (CELLS, CELLS, CELLS))
+    return mesh.nodes, mesh.tets
 
 
 def corner(nodes):

@@ -22,27 +22,13 @@ needs_ccd = pytest.mark.skipif(
 
 
 def box_mesh(size, cells, origin=(0.0, 0.0, 0.0)):
-    """A box [origin, origin + size] of cells[0] x cells[1] x cells[2] equal cubes (grid_mesh)."""
-    return grid_mesh(*[origin[k] + np.linspace(0.0, size[k], cells[k] + 1) for k in range(3)])
+    """The library's box mesh (softhap.Mesh.box), under the name the tests share."""
+    return softhap.Mesh.box(size, cells, origin)
 
 
 def grid_mesh(xs, ys, zs):
-    """The grid of node planes xs, ys, zs (uneven spacing allowed) split into cubes of six
-    tetrahedra each (Kuhn split along each cube's main diagonal, conforming between cubes);
-    nodes x-major, tets cube by cube."""
-    ny, nz = len(ys) - 1, len(zs) - 1
-    nodes = np.array(np.meshgrid(xs, ys, zs, indexing="ij")).reshape(3, -1).T
-    boxes = [np.arange(len(planes) - 1) for planes in (xs, ys, zs)]
-    cells = np.array(np.meshgrid(*boxes, indexing="ij")).reshape(3, -1)
-    tets = []
-    for path in [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]:
-        corner = cells.copy()
-        tet = [(corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2]]
-        for axis in path:
-            corner[axis] += 1
-            tet.append((corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2])
-        tets.append(np.stack(tet, axis=1))
-    return softhap.Mesh(nodes, np.stack(tets, axis=1).reshape(-1, 4))
+    """The library's grid mesh (softhap.Mesh.grid), under the name the tests share."""
+    return softhap.Mesh.grid(xs, ys, zs)
 
 
 def fixed_point(world, position):

@@ -262,3 +262,24 @@ def test_transform_scales_and_translates(meshes):
     assert info.value.status_name == "SH_ERR_INVALID_ARGUMENT"
     with pytest.raises(ValueError):
         mesh.transform(1.0, (0.0, 0.0))
+
+
+def test_box_is_a_conforming_kuhn_split():
+    """Mesh.box((a, b, c), (2, 3, 4)): (2+1)(3+1)(4+1) nodes, six tets per cube, no tet
+    reoriented (all built positive), volume abc, and a closed surface of two triangles per
+    boundary square (a non-conforming split would leave inner faces on the surface)."""
+    size = (0.02, 0.03, 0.04)
+    mesh = softhap.Mesh.box(size, (2, 3, 4), origin=(1.0, -1.0, 0.5))
+    info = mesh.info
+    assert info["node_count"] == 3 * 4 * 5
+    assert info["tet_count"] == 6 * 2 * 3 * 4
+    assert info["reoriented_tet_count"] == 0
+    assert info["volume"] == pytest.approx(np.prod(size), rel=1e-12)
+    assert info["surface_triangle_count"] == 2 * 2 * (2 * 3 + 3 * 4 + 2 * 4)
+    assert info["bounds_min"] == pytest.approx((1.0, -1.0, 0.5))
+    assert info["bounds_max"] == pytest.approx((1.02, -0.97, 0.54))
+
+
+def test_box_refuses_bad_cells():
+    with pytest.raises(ValueError):
+        softhap.Mesh.box((0.01, 0.01, 0.01), (1, 0, 1))

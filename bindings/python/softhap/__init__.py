@@ -29,6 +29,8 @@ from .haptic import Haptic, HapticResult
 from .mesh import Mesh
 from .body import Body
 from .world import World
+from .series import Series
+from .demo import demo
 
 __version__ = version_string(SH_VERSION)
 
@@ -53,6 +55,7 @@ __all__ = [
     "Body",
     "BodyInfo",
     "ContactState",
+    "Series",
     "CutReport",
     "Error",
     "FeatureKind",
@@ -70,6 +73,7 @@ __all__ = [
     "WarningKind",
     "World",
     "build_features",
+    "demo",
     "library_path",
     "status_name",
     "status_string",

@@ -53,6 +53,41 @@ class Mesh(OwnedHandle):
         self._handle = handle.value
 
     @classmethod
+    def grid(cls, xs: ArrayLike, ys: ArrayLike, zs: ArrayLike) -> Mesh:
+        """The grid of node planes xs, ys, zs (increasing; uneven spacing allowed, m) with each
+        cube split into six positively oriented tets along its main diagonal (Kuhn's split,
+        conforming between cubes). Nodes x-major (node (i, j, k) is (i * len(ys) + j) * len(zs) + k), tets cube by
+        cube."""
+        planes = [np.asarray(p, dtype=float) for p in (xs, ys, zs)]
+        if any(p.ndim != 1 or p.size < 2 for p in planes):
+            raise ValueError("xs, ys and zs must each list at least two planes")
+        ny, nz = planes[1].size - 1, planes[2].size - 1
+        nodes = np.array(np.meshgrid(*planes, indexing="ij")).reshape(3, -1).T
+        cubes = np.array(np.meshgrid(*[np.arange(p.size - 1) for p in planes], indexing="ij")).reshape(3, -1)
+        tets = []
+        for path in [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]:
+            corner = cubes.copy()
+            tet = [(corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2]]
+            for axis in path:  # walk the cube's edges from its lowest to its highest corner
+                corner[axis] += 1
+                tet.append((corner[0] * (ny + 1) + corner[1]) * (nz + 1) + corner[2])
+            if path in [(0, 2, 1), (1, 0, 2), (2, 1, 0)]:  # an odd walk: positive with 2 and 3 swapped
+                tet[2], tet[3] = tet[3], tet[2]
+            tets.append(np.stack(tet, axis=1))
+        return cls(nodes, np.stack(tets, axis=1).reshape(-1, 4))
+
+    @classmethod
+    def box(cls, size: ArrayLike, cells: ArrayLike, origin: ArrayLike = (0.0, 0.0, 0.0)) -> Mesh:
+        """The box [origin, origin + size] (m) of cells[0] x cells[1] x cells[2] equal cubes,
+        each split into six tets (see grid)."""
+        size = _arrays.float_array(size, "size", (3,))
+        origin = _arrays.float_array(origin, "origin", (3,))
+        cells = [int(c) for c in cells]
+        if len(cells) != 3 or min(cells) < 1:
+            raise ValueError("cells must be three counts >= 1")
+        return cls.grid(*[origin[k] + np.linspace(0.0, size[k], cells[k] + 1) for k in range(3)])
+
+    @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> Mesh:
         """Load a tetrahedral mesh file: Gmsh .msh (1, 2.2, 4.1 ASCII), legacy VTK .vtk, VTK XML
         .vtu (ascii) or TetGen .node/.ele. Non-tet elements are skipped (counted in

@@ -4,7 +4,7 @@ PYTHON ?= python3
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build install install-check test test-c test-python test-reduced demo cutting palpation haptic-loop tsan asan fuzz bench report report-deps haptic-report press-report cutting-report clean
+.PHONY: all deps build install install-check pip-check test test-c test-python test-reduced demo cutting palpation haptic-loop tsan asan fuzz bench report report-deps haptic-report press-report cutting-report clean
 
 all: build
 
@@ -34,6 +34,18 @@ install-check: build
 	  'cc examples/minimal.c $$(pkg-config --cflags --libs softhap) -Wl,-rpath,$$(pkg-config --variable=libdir softhap) \
 	   -o $(INSTALL_CHECK)/minimal-pkg-config'
 	$(INSTALL_CHECK)/minimal-pkg-config
+
+# The pip route as a user takes it: a fresh venv, `pip install .` (scikit-build-core builds the
+# library into the package), then from another directory import it without SOFTHAP_LIBRARY and
+# run the demo.
+PIP_CHECK ?= $(abspath $(BUILD))/pip-check
+pip-check: deps
+	rm -rf $(PIP_CHECK) && $(PYTHON) -m venv $(PIP_CHECK)/venv
+	$(PIP_CHECK)/venv/bin/pip install -q . </dev/null
+	cd $(PIP_CHECK) && env -u SOFTHAP_LIBRARY -u PYTHONPATH venv/bin/python -c \
+	  "import softhap, os; p = softhap.library_path; print(p); assert p.startswith(os.path.abspath('venv'))"
+	cd $(PIP_CHECK) && env -u SOFTHAP_LIBRARY -u PYTHONPATH venv/bin/python -m softhap demo --seconds 0.5
+	test -s $(PIP_CHECK)/demo/block.pvd
 
 test: build
 	$(MAKE) --no-print-directory test-c test-python

@@ -25,9 +25,12 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq "${missing[@]}" </dev/null
 fi
 
+# meshio (pure Python, MIT) lets the tests read and write binary meshes through Mesh.load and
+# Mesh.to_meshio; the library itself runs without it. pytetwild (softhap.tetrahedralize) brings
+# pyvista and VTK (~150 MB): optional, its test is skipped without it.
 python=${PYTHON:-python3}
-if ! "$python" -c "import numpy, pytest" 2>/dev/null; then
-  echo "install-deps: installing numpy and pytest with pip"
-  "$python" -m pip install -q numpy pytest </dev/null ||
-    "$python" -m pip install -q --break-system-packages numpy pytest </dev/null
+if ! "$python" -c "import numpy, pytest, meshio" 2>/dev/null; then
+  echo "install-deps: installing numpy, pytest and meshio with pip"
+  "$python" -m pip install -q numpy pytest meshio </dev/null ||
+    "$python" -m pip install -q --break-system-packages numpy pytest meshio </dev/null
 fi

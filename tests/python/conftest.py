@@ -76,3 +76,10 @@ def run_python(code, env_updates=None, remove_env=()):
     return subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=str(REPO_DIR)
     )
+
+
+def pytest_configure(config):
+    """The tests load the shared meshes in their files' units and scale them themselves, which
+    the size check (softhap.UnitsWarning) rightly questions; test_mesh_exchange checks that
+    warning with pytest.warns, which sees it whatever the filters say."""
+    config.addinivalue_line("filterwarnings", "ignore:.*m across")

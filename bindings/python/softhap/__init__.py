@@ -27,10 +27,12 @@ from ._record import BodyInfo, CutReport, MeshInfo, StaticReport, StepReport
 from .contact import ContactState, Obstacle, Tool
 from .haptic import Haptic, HapticResult
 from .mesh import Mesh
+from .mesh_exchange import UnitsWarning
 from .body import Body
 from .world import World
 from .series import Series
 from .demo import demo
+from .tetrahedralize import tetrahedralize
 
 __version__ = version_string(SH_VERSION)
 
@@ -70,6 +72,7 @@ __all__ = [
     "Status",
     "StepReport",
     "Tool",
+    "UnitsWarning",
     "WarningKind",
     "World",
     "build_features",
@@ -77,6 +80,7 @@ __all__ = [
     "library_path",
     "status_name",
     "status_string",
+    "tetrahedralize",
     "version",
     "version_string",
 ]

@@ -4,16 +4,17 @@ from __future__ import annotations
 
 import ctypes
 import os
-from typing import Optional, Union
+from typing import Any, Optional, Union
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _arrays
-from ._lib import sh_mesh_info
+from ._lib import Status, sh_mesh_info
 from ._handle import OwnedHandle
 from ._loaded import check, lib
 from ._record import MeshInfo, record_of
+from .mesh_exchange import read_with_meshio, rotation_matrix, tets_of_meshio, to_meshio_mesh, unit_scale, warn_if_implausible
 
 
 class Mesh(OwnedHandle):
@@ -88,25 +89,61 @@ class Mesh(OwnedHandle):
         return cls.grid(*[origin[k] + np.linspace(0.0, size[k], cells[k] + 1) for k in range(3)])
 
     @classmethod
-    def load(cls, path: Union[str, os.PathLike]) -> Mesh:
-        """Load a tetrahedral mesh file: Gmsh .msh (1, 2.2, 4.1 ASCII), legacy VTK .vtk, VTK XML
-        .vtu (ascii) or TetGen .node/.ele. Non-tet elements are skipped (counted in
-        info["skipped_element_count"]).
+    def load(cls, path: Union[str, os.PathLike], units: str = "m") -> Mesh:
+        """Load a tetrahedral mesh file whose lengths are in units ("m", "cm" or "mm"): Gmsh .msh
+        (1, 2.2, 4.1 ASCII), legacy VTK .vtk, VTK XML .vtu (ascii) or TetGen .node/.ele read by
+        the C library; any other format meshio reads (binary Gmsh, binary or appended VTU,
+        Abaqus, Medit, ...) through meshio if it is installed (pip install meshio). Non-tet
+        elements are skipped (counted in info["skipped_element_count"] by the C readers).
+        Warns (softhap.UnitsWarning) if the mesh, in metres, is under 1 mm or over 2 m across.
 
         Raises softhap.Error: SH_ERR_IO if the file cannot be read, SH_ERR_PARSE (message names
-        the line) if it is malformed, SH_ERR_DEGENERATE_MESH if its data is invalid.
+        the line) if it is malformed, SH_ERR_UNSUPPORTED for a format the C readers do not take
+        (binary data) when meshio is absent or cannot read it either, SH_ERR_DEGENERATE_MESH if
+        its data is invalid; ValueError for unknown units.
         """
+        scale = unit_scale(units)
         handle = ctypes.c_void_p()
-        check(lib.sh_mesh_load(_arrays.path_bytes(path), ctypes.byref(handle)), "sh_mesh_load")
+        status = lib.sh_mesh_load(_arrays.path_bytes(path), ctypes.byref(handle))
+        if status in (Status.SH_ERR_PARSE, Status.SH_ERR_UNSUPPORTED):
+            other = read_with_meshio(path)  # None: meshio absent or it cannot read it either
+            if other is not None:
+                return cls.from_meshio(other, units=units, origin=str(path))
+        check(status, "sh_mesh_load")
         mesh = cls.__new__(cls)
         mesh._handle = handle.value
+        if scale != 1.0:
+            mesh = mesh.transform(scale)
+        info = mesh.info
+        warn_if_implausible(info["bounds_min"], info["bounds_max"], str(path))
         return mesh
 
-    def transform(self, scale: float, translation: Optional[ArrayLike] = None) -> Mesh:
-        """Return a new Mesh whose nodes are scale * x + translation (3 floats, m; None for
-        none), e.g. scale=0.01 for a file in centimetres. scale must be finite and > 0
-        (otherwise softhap.Error SH_ERR_INVALID_ARGUMENT). This mesh is unchanged."""
+    @classmethod
+    def from_meshio(cls, mesh: Any, units: str = "m", origin: str = "the meshio mesh") -> Mesh:
+        """A Mesh from a meshio.Mesh (or any object with .points and .cells as meshio has them:
+        blocks with .type and .data, or (type, data) pairs) whose lengths are in units. Its
+        "tetra" blocks (and the corner nodes of "tetra10" blocks) make the tets; other cells
+        are left out. Warns like load() about implausible sizes; ValueError without tets."""
+        points, tets, _skipped = tets_of_meshio(mesh)
+        points = points * unit_scale(units)
+        warn_if_implausible(points.min(axis=0), points.max(axis=0), origin)
+        return cls(points, tets)
+
+    def to_meshio(self) -> Any:
+        """This mesh as a meshio.Mesh (points in m, one "tetra" block); needs meshio."""
+        return to_meshio_mesh(self.nodes, self.tets)
+
+    def transform(self, scale: float, translation: Optional[ArrayLike] = None,
+                  rotation: Optional[ArrayLike] = None) -> Mesh:
+        """Return a new Mesh whose nodes are scale * R x + translation: scale > 0 (e.g. 0.01
+        for a file in centimetres), R from rotation (a unit quaternion (w, x, y, z) or a 3x3
+        rotation matrix; None for none), translation 3 floats (m; None for none). This mesh is
+        unchanged. A bad scale raises softhap.Error SH_ERR_INVALID_ARGUMENT, a bad rotation
+        ValueError."""
         handle = self._require_handle("sh_mesh_transform")
+        if rotation is not None:
+            turned = self.nodes @ rotation_matrix(rotation).T
+            return Mesh(turned, self.tets).transform(scale, translation)
         if translation is None:
             offset = None
             offset_ptr = None

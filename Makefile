@@ -97,7 +97,7 @@ haptic-loop: build
 # OMP_THREAD_LIMIT=1 keeps CHOLMOD's OpenMP regions on the calling thread: libgomp is not built
 # with TSan, so its barriers are invisible to it and every parallel region would be reported.
 TSAN_BUILD ?= build-tsan
-TSAN_HAPTIC_STEPS ?= 20000
+TSAN_HAPTIC_STEPS ?= 10000
 tsan: deps
 	cmake -S . -B $(TSAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSOFTHAP_TSAN=ON \
 	  -DSOFTHAP_BUILD_TESTS=ON -DSOFTHAP_BUILD_EXAMPLES=OFF -DSOFTHAP_BUILD_BENCH=OFF $(CMAKE_FLAGS) > /dev/null
@@ -156,7 +156,7 @@ asan: deps
 # build-fuzz/fuzz-work/<format>/artifacts/. clang and libFuzzer are installed here on demand
 # (install-deps.sh fuzz): make test does not need them.
 FUZZ_BUILD ?= build-fuzz
-FUZZ_SECONDS ?= 30
+FUZZ_SECONDS ?= 20
 fuzz:
 	@scripts/install-deps.sh fuzz
 	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \

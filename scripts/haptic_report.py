@@ -97,7 +97,8 @@ def verdict(ok):
 
 def cost_section(rows, out, folder):
     frozen = sorted(study(rows, "haptic_cost"), key=lambda r: r["buffer_tets"])
-    main = [r for r in frozen if r["sim"] == "frozen" and r["material"] == "corotational"]
+    rate = [r for r in frozen if "/rate/" in r["case"]]
+    main = [r for r in frozen if r["sim"] == "frozen" and r["material"] == "corotational" and r not in rate]
     sim = [r for r in frozen if r["sim"] == "sim"]
     overhead = study(rows, "haptic_overhead")
     out.append("## Cost against buffer size")
@@ -127,6 +128,18 @@ def cost_section(rows, out, folder):
                        f"| {fmt_us(r['p99_us'])} | {fmt_us(r['p999_us'])} | {fmt_us(r['max_us'])} "
                        f"| {r['substeps_median']:g} | {r['ns_per_tet']:.0f} | {r['ns_per_tet_substep']:.1f} "
                        f"| {r['allocations']} | {peers} |")
+        out.append("")
+    if rate:
+        out.append("### Against the device's rate and the tool's stiffness (corotational, world not stepping)")
+        out.append("")
+        out.append("\"soft\": the default sphere (1e4 N/m^1.5); \"stiff\": 2e5 N/m^1.5. The sub-steps follow the "
+                   "elements alone (the contact is implicit in the buffer's step).")
+        out.append("")
+        out.append("| case | buffer tets | steps | median us | p99.9 us | sub-steps | allocations |")
+        out.append("|---|---|---|---|---|---|---|")
+        for r in sorted(rate, key=lambda r: (r["dt"], r["tool_stiffness"], r["buffer_tets"])):
+            out.append(f"| {r['case']} | {r['buffer_tets']} | {r['steps']} | {fmt_us(r['median_us'])} "
+                       f"| {fmt_us(r['p999_us'])} | {r['substeps_median']:g} | {r['allocations']} |")
         out.append("")
         at = [r for r in main if r["buffer_tets"] == GOAL_TETS]
         if at:

@@ -1048,6 +1048,63 @@ SH_API sh_status sh_haptic_get_warnings(const sh_haptic* haptic,
 
 /** @} */
 
+/** @defgroup sh_api_device Device mapping
+ *  From a haptic device's workspace to the world and back, and the rendered force to the
+ *  device: the scale, base pose, tool offset and force scale a host sets up once.
+ *  @{ */
+
+/** How a device's frame and units map to the world: a device pose (p_d, q_d) is the world
+ *  pose p = base_position + scale R_base (p_d + R_d tool_offset), q = q_base q_d. A device in
+ *  mm with y up (OpenHaptics, CHAI3D) in a z-up world in metres: scale 0.001 and base_orientation
+ *  a quarter turn about x, (cos 45 deg, sin 45 deg, 0, 0). Initialise with
+ *  sh_device_mapping_default. */
+typedef struct sh_device_mapping {
+    uint32_t internal_init;     /**< set by sh_device_mapping_default; do not touch */
+    double scale;               /**< world metres per device length unit (0.001: a device in mm;
+                                     times any motion scaling), finite and > 0; default 1 */
+    double base_position[3];    /**< the device frame's origin in the world (m); default 0 */
+    double base_orientation[4]; /**< the device frame's orientation in the world (quaternion
+                                     w, x, y, z; normalised when used, not zero); default
+                                     identity */
+    double tool_offset[3];      /**< the tool point in the device's end-effector frame (device
+                                     units; e.g. a stylus tip); default 0 */
+    double force_scale;         /**< device force per world force (N/N; below 1 softens what the
+                                     hand feels), finite and > 0; default 1 */
+} sh_device_mapping;
+
+/** Fill a mapping with defaults (the identity). Thread: any. Alloc: none. */
+SH_API void sh_device_mapping_default(sh_device_mapping* mapping);
+
+/** Check a mapping once (sim side, before the device loop uses it): SH_ERR_UNINITIALIZED_DEF,
+ *  or SH_ERR_INVALID_ARGUMENT with the field named in sh_last_error_message(). Thread: any.
+ *  Alloc: may (the message). */
+SH_API sh_status sh_device_mapping_check(const sh_device_mapping* mapping);
+
+/** The world pose of the tool for a device pose: position in device units, orientation a
+ *  quaternion (w, x, y, z) in the device frame (normalised here). SH_ERR_INVALID_ARGUMENT if
+ *  a pointer is NULL, the mapping fails sh_device_mapping_check or the pose is not finite (or a
+ *  zero quaternion): the outputs are then untouched. Never allocates, locks or sets the
+ *  last-error message, so a device loop may call it. Thread: any. Alloc: none. */
+SH_API sh_status sh_device_to_world(const sh_device_mapping* mapping, const double device_position[3],
+                                    const double device_orientation[4], double out_position[3],
+                                    double out_orientation[4]);
+
+/** The inverse of sh_device_to_world: the device pose that puts the tool at a world pose.
+ *  Errors and threads as sh_device_to_world. Thread: any. Alloc: none. */
+SH_API sh_status sh_world_to_device(const sh_device_mapping* mapping, const double position[3],
+                                    const double orientation[4], double out_device_position[3],
+                                    double out_device_orientation[4]);
+
+/** What the device renders for a world wrench on the tool (e.g. sh_haptic_output.force and
+ *  torque): the force and torque turned into the device frame and multiplied by force_scale
+ *  (N, N m; device lengths do not enter). Errors and threads as sh_device_to_world.
+ *  Thread: any. Alloc: none. */
+SH_API sh_status sh_device_force(const sh_device_mapping* mapping, const double force[3],
+                                 const double torque[3], double out_device_force[3],
+                                 double out_device_torque[3]);
+
+/** @} */
+
 #ifdef __cplusplus
 }
 #endif

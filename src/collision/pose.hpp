@@ -52,6 +52,14 @@ struct Pose {
     }
 };
 
+/// The quaternion product a b (w, x, y, z): the rotation b, then a.
+inline void quaternion_product(const double a[4], const double b[4], double out[4]) {
+    out[0] = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
+    out[1] = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
+    out[2] = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
+    out[3] = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
+}
+
 /// The pose a fraction s in [0, 1] of the way from a to b: positions linearly, orientations
 /// by normalised linear interpolation along the shorter arc (exact at s = 0 and 1).
 inline Pose interpolate(const Pose& a, const Pose& b, double s) {

@@ -25,6 +25,7 @@ from ._loaded import lib as _c_library
 from ._loaded import status_string
 from ._record import BodyInfo, CutReport, MeshInfo, StaticReport, StepReport
 from .contact import ContactState, Obstacle, Tool
+from .device import DeviceMapping
 from .haptic import Haptic, HapticResult
 from .mesh import Mesh
 from .mesh_exchange import UnitsWarning
@@ -59,6 +60,7 @@ __all__ = [
     "ContactState",
     "Series",
     "CutReport",
+    "DeviceMapping",
     "Error",
     "FeatureKind",
     "Haptic",

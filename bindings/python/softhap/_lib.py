@@ -477,6 +477,19 @@ class HapticFault(enum.IntFlag):
 
 
 # Every struct the header declares that the bindings use, by C name (for the layout test).
+class sh_device_mapping(Structure):
+    """Mirror of struct sh_device_mapping."""
+
+    _fields_ = [
+        ("internal_init", c_uint32),
+        ("scale", c_double),
+        ("base_position", c_double * 3),
+        ("base_orientation", c_double * 4),
+        ("tool_offset", c_double * 3),
+        ("force_scale", c_double),
+    ]
+
+
 STRUCTS = {
     "sh_mesh_info": sh_mesh_info,
     "sh_world_def": sh_world_def,
@@ -496,6 +509,7 @@ STRUCTS = {
     "sh_contact_state": sh_contact_state,
     "sh_haptic_def": sh_haptic_def,
     "sh_haptic_output": sh_haptic_output,
+    "sh_device_mapping": sh_device_mapping,
 }
 
 # ------------------------------------------------------------------------------------------------
@@ -584,6 +598,12 @@ PROTOTYPES = {
     "sh_haptic_destroy": (_status, [_handle]),
     "sh_haptic_step": (_status, [_handle, _pd, _pd, c_double, POINTER(sh_haptic_output)]),
     "sh_haptic_get_warnings": (_status, [_handle, POINTER(c_uint64)]),
+    # device mapping
+    "sh_device_mapping_default": (None, [POINTER(sh_device_mapping)]),
+    "sh_device_mapping_check": (_status, [POINTER(sh_device_mapping)]),
+    "sh_device_to_world": (_status, [POINTER(sh_device_mapping), _pd, _pd, _pd, _pd]),
+    "sh_world_to_device": (_status, [POINTER(sh_device_mapping), _pd, _pd, _pd, _pd]),
+    "sh_device_force": (_status, [POINTER(sh_device_mapping), _pd, _pd, _pd, _pd]),
     "sh_obstacle_create": (
         _status,
         [_handle, POINTER(sh_collider_def), POINTER(sh_obstacle_id)],

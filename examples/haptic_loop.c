@@ -77,6 +77,7 @@
  * Exit status: 0 on success; 1 if a call fails or a force is not finite. */
 #define _GNU_SOURCE
 #include "liver_scene.h"
+#include "simulated_hand.h"
 
 #include <softhap/softhap.h>
 
@@ -214,27 +215,13 @@ typedef struct run {
     char model_message[256];
 } run;
 
-/* The hand holding the device. */
-typedef struct hand {
-    double x[3], v[3];  /* m, m/s */
-    double target[3];   /* where the arm pulls it now (m) */
-} hand;
-
-/* Moves the hand from tick to tick + 1 (of dt seconds) under the arm and the device's force
- * (N), by symplectic Euler. */
-static void move_hand(hand* h, const liver_path* path, long tick, double dt, const double force[3]) {
-    const double damping = 2.0 * sqrt(kHandStiffness * kHandMass); /* critical (N s/m) */
+/* Moves the hand from tick to tick + 1 (of dt seconds) towards the path's next point, under
+ * the device's force (N). */
+static void move_hand(simulated_hand* h, const liver_path* path, long tick, double dt, const double force[3]) {
     double along, below, next[3];
-    int k;
     target_at((tick + 1) * dt, &along, &below);
     liver_path_point(path, along, below, next);
-    for (k = 0; k < 3; ++k) {
-        const double target_velocity = (next[k] - h->target[k]) / dt;
-        const double f = kHandStiffness * (h->target[k] - h->x[k]) + damping * (target_velocity - h->v[k]) + force[k];
-        h->v[k] += dt * f / kHandMass;
-        h->x[k] += dt * h->v[k];
-        h->target[k] = next[k];
-    }
+    simulated_hand_move(h, next, dt, force);
 }
 
 /* Asks for SCHED_FIFO (the error, if refused, goes to r->fifo_error) and a 1 ns timer slack,
@@ -250,7 +237,7 @@ static void enter_realtime(run* r) {
 /* More than two periods late: drops the deadlines passed (counted). The hand moves on through
  * them holding the last force, as a device holds its last command; the next step covers them.
  * Returns the ticks dropped. */
-static long drop_missed(run* r, hand* h, long* tick, int64_t late, double dt, const double force[3]) {
+static long drop_missed(run* r, simulated_hand* h, long* tick, int64_t late, double dt, const double force[3]) {
     long missed, j;
     if (late <= 2 * r->period_ns) return 0;
     missed = (long)(late / r->period_ns);
@@ -262,7 +249,7 @@ static long drop_missed(run* r, hand* h, long* tick, int64_t late, double dt, co
 
 /* Adds the tick's output to the run's statistics: the force, how deep the hand is below the
  * touching height, the buffer, contact and faults. */
-static void add_tick_stats(run* r, long tick, double dt, const hand* h, const sh_haptic_output* out) {
+static void add_tick_stats(run* r, long tick, double dt, const simulated_hand* h, const sh_haptic_output* out) {
     const double magnitude = sqrt(out->force[0] * out->force[0] + out->force[1] * out->force[1] +
                                   out->force[2] * out->force[2]);
     double along, below, touching[3];
@@ -284,7 +271,7 @@ static void add_tick_stats(run* r, long tick, double dt, const hand* h, const sh
 }
 
 /* Keeps the tick as a trace row (written after the run: the device thread never prints). */
-static void add_trace_row(run* r, long tick, double dt, const hand* h, const sh_haptic_output* out) {
+static void add_trace_row(run* r, long tick, double dt, const simulated_hand* h, const sh_haptic_output* out) {
     trace_row* row = &r->rows[r->row_count++];
     int k;
     row->t = tick * dt;
@@ -305,14 +292,14 @@ static void* device_thread(void* arg) {
     const double dt = 1.0 / r->rate, identity[4] = {1.0, 0.0, 0.0, 0.0};
     double force[3] = {0.0, 0.0, 0.0}, along, below;
     long tick = 0, next_row = 0;
-    hand h;
+    simulated_hand h;
+    double start[3];
     int k;
 
     enter_realtime(r);
-    memset(&h, 0, sizeof h);
     target_at(0.0, &along, &below);
-    liver_path_point(r->path, along, below, h.target);
-    for (k = 0; k < 3; ++k) h.x[k] = h.target[k];
+    liver_path_point(r->path, along, below, start);
+    simulated_hand_init(&h, start, kHandMass, kHandStiffness);
     while (tick < r->ticks) {
         const int64_t deadline = r->start_ns + tick * r->period_ns;
         const int64_t woke = wait_for(deadline, kSpinNs);

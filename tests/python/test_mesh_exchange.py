@@ -40,8 +40,10 @@ def test_units_and_the_size_warning(meshes):
         warnings.simplefilter("error")
         in_cm = softhap.Mesh.load(meshes / "liver.msh", units="cm")
     np.testing.assert_allclose(in_cm.nodes, 0.01 * in_metres.nodes, rtol=1e-15)
-    with pytest.raises(ValueError):
-        softhap.Mesh.load(meshes / "liver.msh", units="inch")
+    np.testing.assert_allclose(softhap.Mesh.load(meshes / "liver.msh", units=0.01).nodes, in_cm.nodes, rtol=1e-15)
+    for bad in ("inch", 0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError):
+            softhap.Mesh.load(meshes / "liver.msh", units=bad)
 
 
 def test_rotation_in_transform():

@@ -89,10 +89,10 @@ class Mesh(OwnedHandle):
         return cls.grid(*[origin[k] + np.linspace(0.0, size[k], cells[k] + 1) for k in range(3)])
 
     @classmethod
-    def load(cls, path: Union[str, os.PathLike], units: str = "m") -> Mesh:
-        """Load a tetrahedral mesh file whose lengths are in units ("m", "cm" or "mm"): Gmsh .msh
-        (1, 2.2, 4.1 ASCII), legacy VTK .vtk, VTK XML .vtu (ascii) or TetGen .node/.ele read by
-        the C library; any other format meshio reads (binary Gmsh, binary or appended VTU,
+    def load(cls, path: Union[str, os.PathLike], units: Union[str, float] = "m") -> Mesh:
+        """Load a tetrahedral mesh file whose lengths are in units ("m", "cm", "mm", or metres per
+        file unit as a number): Gmsh .msh (1, 2.2, 4.1 ASCII), legacy VTK .vtk, VTK XML .vtu
+        (ascii) or TetGen .node/.ele read by the C library; any other format meshio reads (binary Gmsh, binary or appended VTU,
         Abaqus, Medit, ...) through meshio if it is installed (pip install meshio). Non-tet
         elements are skipped (counted in info["skipped_element_count"] by the C readers).
         Warns (softhap.UnitsWarning) if the mesh, in metres, is under 1 mm or over 2 m across.
@@ -119,7 +119,7 @@ class Mesh(OwnedHandle):
         return mesh
 
     @classmethod
-    def from_meshio(cls, mesh: Any, units: str = "m", origin: str = "the meshio mesh") -> Mesh:
+    def from_meshio(cls, mesh: Any, units: Union[str, float] = "m", origin: str = "the meshio mesh") -> Mesh:
         """A Mesh from a meshio.Mesh (or any object with .points and .cells as meshio has them:
         blocks with .type and .data, or (type, data) pairs) whose lengths are in units. Its
         "tetra" blocks (and the corner nodes of "tetra10" blocks) make the tets; other cells

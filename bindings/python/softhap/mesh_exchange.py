@@ -4,7 +4,7 @@ check that catches a mesh read in the wrong units."""
 from __future__ import annotations
 
 import warnings
-from typing import Any, Tuple
+from typing import Any, Tuple, Union
 
 import numpy as np
 
@@ -19,12 +19,15 @@ class UnitsWarning(UserWarning):
     """A mesh's size suggests a units mistake (e.g. a file in mm read as m)."""
 
 
-def unit_scale(units: str) -> float:
-    """Metres per unit of units ("m", "cm" or "mm"); ValueError otherwise."""
-    try:
-        return UNITS[units]
-    except KeyError:
-        raise ValueError("units must be one of %s, not %r" % (", ".join(UNITS), units)) from None
+def unit_scale(units: Union[str, float]) -> float:
+    """Metres per unit of units: "m", "cm", "mm", or a number of metres per file unit (finite
+    and > 0, for files in other units); ValueError otherwise."""
+    if isinstance(units, str):
+        if units in UNITS:
+            return UNITS[units]
+    elif isinstance(units, (int, float)) and np.isfinite(units) and units > 0:
+        return float(units)
+    raise ValueError("units must be one of %s or metres per unit (> 0), not %r" % (", ".join(UNITS), units))
 
 
 def warn_if_implausible(bounds_min: Any, bounds_max: Any, origin: str) -> None:

@@ -32,10 +32,10 @@ def read_surface(path: Union[str, os.PathLike]) -> Tuple[np.ndarray, np.ndarray]
     return np.asarray(surface.points, dtype=float), np.concatenate(triangles)
 
 
-def tetrahedralize(surface: Union[str, os.PathLike, Tuple[Any, Any]], units: str = "m",
+def tetrahedralize(surface: Union[str, os.PathLike, Tuple[Any, Any]], units: Union[str, float] = "m",
                    edge_length: Optional[float] = None, quiet: bool = True) -> Mesh:
     """A tet mesh filling the closed triangle surface, which is a file meshio reads (OBJ, STL,
-    ...) or a (vertices (n, 3), triangles (m, 3)) pair, in units ("m", "cm" or "mm").
+    ...) or a (vertices (n, 3), triangles (m, 3)) pair, in units ("m", "cm", "mm" or metres per unit).
 
     edge_length: the tets' target edge length (m); None: 1/20 of the bounding box's diagonal.
     The backend is pytetwild (pip install pytetwild; fTetWild, MPL-2.0), which fills the

@@ -145,6 +145,25 @@ typedef struct sh_allocator {
  *  Thread: sim (with no other softhap call running). Alloc: none. */
 SH_API sh_status sh_set_allocator(const sh_allocator* allocator);
 
+/** Severity of a log message. */
+typedef enum sh_log_level {
+    SH_LOG_DEBUG = 0,   /**< detail for developers */
+    SH_LOG_INFO = 1,    /**< normal but notable: a step split into sub-steps, a mesh repaired */
+    SH_LOG_WARNING = 2, /**< the result may not be what was asked: a step rolled back, an
+                             implicit step that kept its best iterate, a capacity reached */
+    SH_LOG_COUNT = 3    /**< number of levels (not a level) */
+} sh_log_level;
+
+/** Receives one log message (a NUL-terminated line without a newline, valid during the call). */
+typedef void (*sh_log_fn)(sh_log_level level, const char* message, void* user);
+
+/** Install the function that receives the library's messages (NULL: none, the default). Only
+ *  sim-side calls log (sh_world_step, mesh loading, ...); sh_haptic_step never does. Messages
+ *  add detail to what statuses and warning counters already say. Returns SH_ERR_BUSY while any
+ *  softhap object is alive (install it at start-up, like the allocator).
+ *  Thread: sim (with no other softhap call running). Alloc: none. */
+SH_API sh_status sh_set_log_callback(sh_log_fn callback, void* user);
+
 /** @} */
 
 /** @defgroup sh_api_mesh Meshes

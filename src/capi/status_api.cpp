@@ -1,5 +1,6 @@
 // Version, status strings, last-error message and the allocator hook.
 #include "capi/guard.hpp"
+#include "core/log.hpp"
 #include "core/memory.hpp"
 
 #include <cstring>
@@ -65,6 +66,14 @@ SH_API sh_status sh_set_allocator(const sh_allocator* allocator) {
         if (live_object_count() != 0)
             throw Error(SH_ERR_BUSY, format("%d softhap objects are alive; destroy them first", live_object_count()));
         set_allocator(allocator);
+    });
+}
+
+SH_API sh_status sh_set_log_callback(sh_log_fn callback, void* user) {
+    return capi::guard([&] {
+        if (live_object_count() != 0)
+            throw Error(SH_ERR_BUSY, format("%d softhap objects are alive; destroy them first", live_object_count()));
+        set_log_callback(callback, user);
     });
 }
 

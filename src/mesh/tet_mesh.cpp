@@ -1,6 +1,7 @@
 #include "mesh/tet_mesh.hpp"
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 
 #include <algorithm>
 #include <array>
@@ -80,6 +81,22 @@ double signed_tet_volume(const double* a, const double* b, const double* c, cons
             u[2] * (v[0] * w[1] - v[1] * w[0])) / 6.0;
 }
 
+namespace {
+
+// What building the mesh changed or left out, for the host's log.
+void log_repairs(const TetMesh& mesh, const std::string& origin) {
+    if (!logging()) return;
+    if (mesh.reoriented_tet_count > 0)
+        log_message(SH_LOG_INFO, "%s: %d inverted tets reoriented", origin.c_str(), mesh.reoriented_tet_count);
+    if (mesh.skipped_element_count > 0)
+        log_message(SH_LOG_INFO, "%s: %d elements that are not tets skipped", origin.c_str(), mesh.skipped_element_count);
+    if (mesh.orphan_node_count > 0)
+        log_message(SH_LOG_INFO, "%s: %d nodes belong to no tet (they stay, with no mass)", origin.c_str(),
+                    mesh.orphan_node_count);
+}
+
+}  // namespace
+
 TetMesh build_tet_mesh(MeshData data, const std::string& origin) {
     require(data.nodes.size() % 3 == 0 && data.tets.size() % 4 == 0, SH_ERR_INTERNAL,
             origin + ": node or tet array has a partial entry");
@@ -155,6 +172,7 @@ TetMesh build_tet_mesh(MeshData data, const std::string& origin) {
     mesh.tets = std::move(data.tets);
     mesh.surface_triangles = boundary_triangles(mesh.tets.data(), mesh.tets.size() / 4);
     build_edges(mesh);
+    log_repairs(mesh, origin);
     return mesh;
 }
 

@@ -1,10 +1,12 @@
 #include "world/world.hpp"
 
+
 #include "collision/aabb_tree.hpp"
 #include "contact/body_contacts.hpp"
 #include "contact/collider.hpp"
 #include "core/clock.hpp"
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "material/material_params.hpp"
 #include "model/fem_body.hpp"
 #include "solver/explicit_integrator.hpp"
@@ -312,6 +314,25 @@ int32_t World::finish_contacts() {
     return count;
 }
 
+void World::log_step(double dt, const sh_step_report& r) const {
+    // What the step's warnings mean, for the host's log (sh_set_log_callback).
+    if (!logging()) return;
+    const auto raised = [&](sh_warning kind) { return (r.warnings & (1u << kind)) != 0; };
+    if (raised(SH_WARN_SUBSTEPPED))
+        log_message(SH_LOG_INFO, "step of %g s: split into %d sub-steps (critical step %g s)", dt, r.substeps,
+                    r.dt_critical);
+    if (raised(SH_WARN_INVERTED))
+        log_message(SH_LOG_WARNING, "step of %g s: some elements are inverted (det F <= 0)", dt);
+    if (raised(SH_WARN_NOT_CONVERGED))
+        log_message(SH_LOG_WARNING, "step of %g s: an implicit body did not converge within its Newton cap and "
+                    "sub-steps and kept its best iterate", dt);
+    if (raised(SH_WARN_CAPACITY))
+        log_message(SH_LOG_WARNING, "step of %g s: a contact capacity was reached; contacts beyond it were dropped", dt);
+    if (r.unstable_body_count > 0)
+        log_message(SH_LOG_WARNING, "step of %g s: %d body(ies) rolled back (rejected, non-finite or running away)",
+                    dt, r.unstable_body_count);
+}
+
 void World::step(double dt, sh_step_report* report) {
     SH_REQUIRE(std::isfinite(dt) && dt > 0.0, SH_ERR_INVALID_ARGUMENT, "dt = %g s, must be finite and > 0", dt);
     const double start = now_seconds();
@@ -347,6 +368,7 @@ void World::step(double dt, sh_step_report* report) {
     for (const sh_warning kind : {SH_WARN_SUBSTEPPED, SH_WARN_INVERTED, SH_WARN_NOT_CONVERGED})
         if (r.warnings & (1u << kind)) ++warnings[kind];
     warnings[SH_WARN_UNSTABLE] += static_cast<uint64_t>(r.unstable_body_count);
+    log_step(dt, r);
     if (report) {
         add_energies(r);
         r.wall_seconds = now_seconds() - start;

@@ -199,6 +199,7 @@ private:
     void note_result(size_t index, const BodyStepResult& result, sh_step_report& r, vec<uint8_t>& skip);
     /// Kinetic, elastic and gravitational energies of every body into r.
     void add_energies(sh_step_report& r) const;
+    void log_step(double dt, const sh_step_report& r) const;
     /// Groups the bodies of pairs with candidates into islands (only implicit bodies with
     /// implicit_only, none in failed); false if no island has two bodies. Nothing without pairs.
     bool group_islands(bool implicit_only, const vec<uint8_t>* failed);

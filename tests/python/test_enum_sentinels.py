@@ -48,6 +48,7 @@ MIRRORS = {
     "sh_spring_law": ("SH_SPRING_", _lib.SPRING_LAWS),
     "sh_shape_kind": ("SH_SHAPE_", _lib.SHAPE_KINDS),
     "sh_cut_criterion": ("SH_CUT_", _lib.CUT_CRITERIA),
+    "sh_log_level": ("SH_LOG_", _lib.LOG_LEVELS),
 }
 
 

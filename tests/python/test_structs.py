@@ -109,6 +109,7 @@ def _python_constants():
         ("SH_LINEAR_SOLVER_", _lib.LINEAR_SOLVERS),
         ("SH_SHAPE_", _lib.SHAPE_KINDS),
         ("SH_CUT_", _lib.CUT_CRITERIA),
+        ("SH_LOG_", _lib.LOG_LEVELS),
     ]:
         constants.update({prefix + name.upper(): value for name, value in table.items()})
     return constants

@@ -82,6 +82,10 @@ class WarningKind(enum.IntEnum):
 
 SH_WARN_COUNT = 7
 
+#: sh_log_level: the levels of the library's log messages.
+LOG_LEVELS = {"debug": 0, "info": 1, "warning": 2}
+SH_LOG_COUNT = 3
+
 
 class FeatureKind(enum.IntEnum):
     """sh_feature: optional components a build may include (bits of sh_build_features())."""
@@ -598,6 +602,7 @@ PROTOTYPES = {
     "sh_haptic_destroy": (_status, [_handle]),
     "sh_haptic_step": (_status, [_handle, _pd, _pd, c_double, POINTER(sh_haptic_output)]),
     "sh_haptic_get_warnings": (_status, [_handle, POINTER(c_uint64)]),
+    "sh_set_log_callback": (_status, [c_void_p, c_void_p]),
     # device mapping
     "sh_device_mapping_default": (None, [POINTER(sh_device_mapping)]),
     "sh_device_mapping_check": (_status, [POINTER(sh_device_mapping)]),

@@ -2,12 +2,28 @@
 
 from __future__ import annotations
 
+import ctypes
+import logging
 from typing import Any, Callable, Optional
 
 from ._errors import Error
-from ._lib import Status, load_library
+from ._lib import LOG_LEVELS, Status, load_library
 
 lib = load_library()
+
+#: The library's messages (sh_set_log_callback) go to this logger: sh_log_level DEBUG, INFO and
+#: WARNING become logging's levels of the same names.
+logger = logging.getLogger("softhap")
+_LEVELS = {LOG_LEVELS["debug"]: logging.DEBUG, LOG_LEVELS["info"]: logging.INFO, LOG_LEVELS["warning"]: logging.WARNING}
+_LOG_FN = ctypes.CFUNCTYPE(None, ctypes.c_int, ctypes.c_char_p, ctypes.c_void_p)
+
+
+def _forward(level: int, message: bytes, _user: Any) -> None:
+    logger.log(_LEVELS.get(level, logging.WARNING), message.decode("utf-8", errors="replace"))
+
+
+_forward_c = _LOG_FN(_forward)  # kept alive as long as the module: the library holds its address
+lib.sh_set_log_callback(ctypes.cast(_forward_c, ctypes.c_void_p), None)  # at import no object lives
 
 
 def last_error_message() -> str:

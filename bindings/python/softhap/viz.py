@@ -42,14 +42,23 @@ def _require(module: str) -> Any:
 
 def to_pyvista(shape: Shape, rest: Optional[np.ndarray] = None) -> Any:
     """A pyvista.UnstructuredGrid of the tets; with rest (the rest nodes, (n, 3)), point data
-    "displacement" (m, vectors) and "displacement_mm" (its length in mm) to colour by."""
+    "displacement" (m, vectors) and "displacement_mm" (its length in mm) to colour by (a node a
+    cut added shows its oldest ancestor's displacement)."""
     pv = _require("pyvista")
     nodes, tets = _nodes_and_tets(shape)
     cells = np.hstack([np.full((len(tets), 1), 4), tets]).astype(np.int64).ravel()
     grid = pv.UnstructuredGrid(cells, np.full(len(tets), pv.CellType.TETRA, dtype=np.uint8), nodes)
     if rest is not None:
         u = nodes[: len(rest)] - rest
-        u = np.vstack([u, np.zeros((len(nodes) - len(rest), 3))])  # nodes a cut added: not moved
+        if len(nodes) > len(rest):  # nodes a cut added: their oldest ancestor's displacement
+            ancestor = np.arange(len(nodes))
+            parents = shape.node_parents if isinstance(shape, Body) else np.full(len(nodes), -1)
+            for _ in range(64):  # a chain of cuts: follow parents back to the rest nodes
+                up = (ancestor >= len(rest)) & (parents[np.minimum(ancestor, len(parents) - 1)] >= 0)
+                if not up.any():
+                    break
+                ancestor[up] = parents[ancestor[up]]
+            u = np.vstack([u, u[np.minimum(ancestor[len(rest):], len(rest) - 1)]])
         grid.point_data["displacement"] = u
         grid.point_data["displacement_mm"] = 1e3 * np.linalg.norm(u, axis=1)
     return grid

@@ -13,6 +13,21 @@ bool usable(const sh_device_mapping* m, DeviceMapping& out, const char** field) 
     return read_device_mapping(*m, out, field);
 }
 
+// One pose through map (device_to_world or world_to_device); the outputs only on success.
+sh_status map_pose(const sh_device_mapping* mapping, Pose (*map)(const DeviceMapping&, const Pose&) noexcept,
+                   const double position[3], const double orientation[4], double out_position[3],
+                   double out_orientation[4]) noexcept {
+    DeviceMapping m;
+    Pose in;
+    if (!usable(mapping, m, nullptr) || !normalised_pose(position, orientation, in) || !out_position ||
+        !out_orientation)
+        return SH_ERR_INVALID_ARGUMENT;
+    const Pose out = map(m, in);
+    for (int k = 0; k < 3; ++k) out_position[k] = out.p[k];
+    for (int k = 0; k < 4; ++k) out_orientation[k] = out.q[k];
+    return SH_OK;
+}
+
 }  // namespace
 
 extern "C" {
@@ -41,29 +56,13 @@ SH_API sh_status sh_device_mapping_check(const sh_device_mapping* mapping) {
 SH_API sh_status sh_device_to_world(const sh_device_mapping* mapping, const double device_position[3],
                                     const double device_orientation[4], double out_position[3],
                                     double out_orientation[4]) {
-    DeviceMapping m;
-    Pose d;
-    if (!usable(mapping, m, nullptr) || !normalised_pose(device_position, device_orientation, d) || !out_position ||
-        !out_orientation)
-        return SH_ERR_INVALID_ARGUMENT;
-    const Pose w = device_to_world(m, d);
-    for (int k = 0; k < 3; ++k) out_position[k] = w.p[k];
-    for (int k = 0; k < 4; ++k) out_orientation[k] = w.q[k];
-    return SH_OK;
+    return map_pose(mapping, device_to_world, device_position, device_orientation, out_position, out_orientation);
 }
 
 SH_API sh_status sh_world_to_device(const sh_device_mapping* mapping, const double position[3],
                                     const double orientation[4], double out_device_position[3],
                                     double out_device_orientation[4]) {
-    DeviceMapping m;
-    Pose w;
-    if (!usable(mapping, m, nullptr) || !normalised_pose(position, orientation, w) || !out_device_position ||
-        !out_device_orientation)
-        return SH_ERR_INVALID_ARGUMENT;
-    const Pose d = world_to_device(m, w);
-    for (int k = 0; k < 3; ++k) out_device_position[k] = d.p[k];
-    for (int k = 0; k < 4; ++k) out_device_orientation[k] = d.q[k];
-    return SH_OK;
+    return map_pose(mapping, world_to_device, position, orientation, out_device_position, out_device_orientation);
 }
 
 SH_API sh_status sh_device_force(const sh_device_mapping* mapping, const double force[3], const double torque[3],

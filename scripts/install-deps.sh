@@ -2,7 +2,9 @@
 # Installs what softhap needs and is missing: Debian packages and Python packages.
 # Safe to run repeatedly; does nothing when everything is present.
 # `install-deps.sh fuzz` also installs clang and its libFuzzer/sanitizer runtimes (make fuzz only:
-# make test builds with the system's GCC and does not need them).
+# make test builds with the system's GCC and does not need them). `install-deps.sh optional`
+# also installs the optional Python packages whose tests are otherwise skipped (CI runs it):
+# pyvista (softhap.viz; brings VTK, ~150 MB) and pytetwild (softhap.tetrahedralize).
 set -euo pipefail
 
 # libopenblas0-serial: an optimised single-threaded BLAS for CHOLMOD's supernodal factorisation
@@ -26,11 +28,16 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 # meshio (pure Python, MIT) lets the tests read and write binary meshes through Mesh.load and
-# Mesh.to_meshio; the library itself runs without it. pytetwild (softhap.tetrahedralize) brings
-# pyvista and VTK (~150 MB): optional, its test is skipped without it.
+# Mesh.to_meshio; the library itself runs without it.
 python=${PYTHON:-python3}
 if ! "$python" -c "import numpy, pytest, meshio" 2>/dev/null; then
   echo "install-deps: installing numpy, pytest and meshio with pip"
   "$python" -m pip install -q numpy pytest meshio </dev/null ||
     "$python" -m pip install -q --break-system-packages numpy pytest meshio </dev/null
+fi
+
+if [ "${1:-}" = optional ] && ! "$python" -c "import pyvista, pytetwild" 2>/dev/null; then
+  echo "install-deps: installing pyvista and pytetwild with pip"
+  "$python" -m pip install -q pyvista pytetwild </dev/null ||
+    "$python" -m pip install -q --break-system-packages pyvista pytetwild </dev/null
 fi

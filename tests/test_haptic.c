@@ -646,10 +646,19 @@ static long haptic_steps(void) {
     return steps;
 }
 
+/* Log messages, told apart by the thread that logged them: the haptic thread (watched) must
+ * never log; the sim thread's messages show that the callback was live. */
+static atomic_long g_watched_logs, g_other_logs;
+static void count_log(sh_log_level level, const char* message, void* user) {
+    (void)level, (void)message, (void)user;
+    atomic_fetch_add(tl_watched ? &g_watched_logs : &g_other_logs, 1);
+}
+
 static void test_haptic_thread_never_allocates_nor_locks(void** state) {
     (void)state;
     const sh_allocator allocator = {counting_alloc, counting_free, NULL};
     assert_ok(sh_set_allocator(&allocator));
+    assert_ok(sh_set_log_callback(count_log, NULL));
     const double top = kBlock[2] + kRadius;
     scene s = make_scene(40.0, top);
     sh_haptic_def def = haptic_def(&s);
@@ -699,9 +708,14 @@ static void test_haptic_thread_never_allocates_nor_locks(void** state) {
     assert_true(r.largest_force > 0.01);
     assert_int_equal(allocations, 0);
     assert_int_equal(locks, 0);
+    printf("log messages: %ld from the sim thread, %ld from the haptic thread\n", atomic_load(&g_other_logs),
+           atomic_load(&g_watched_logs));
+    assert_int_equal(atomic_load(&g_watched_logs), 0);
+    assert_true(atomic_load(&g_other_logs) > 0);
     assert_ok(sh_haptic_destroy(haptic));
     sh_world_destroy(s.world);
     assert_ok(sh_set_allocator(NULL));
+    assert_ok(sh_set_log_callback(NULL, NULL));
 }
 
 /* A convex tool (a cube hull) in the haptic step: its facet planes, so no allocation either,

@@ -30,6 +30,13 @@ fi
 # meshio (pure Python, MIT) lets the tests read and write binary meshes through Mesh.load and
 # Mesh.to_meshio; the library itself runs without it.
 python=${PYTHON:-python3}
+# make pip-check makes a venv: Debian's python3 needs python3-venv for it (ensurepip).
+if ! "$python" -c "import ensurepip, venv" 2>/dev/null; then
+  echo "install-deps: installing python3-venv"
+  sudo_cmd=()
+  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq python3-venv </dev/null
+fi
 if ! "$python" -c "import numpy, pytest, meshio" 2>/dev/null; then
   echo "install-deps: installing numpy, pytest and meshio with pip"
   "$python" -m pip install -q numpy pytest meshio </dev/null ||

@@ -226,12 +226,12 @@ void HapticContext::integrate(const Buffer& b, double h, double* x, double* v, d
         if (w == 0.0) continue;
         double* vi = at(v, i);
         if (in_contact_[i]) {
-            const Eigen::Map<const Eigen::Matrix3d> k(contact_tangent_ + 18 * static_cast<size_t>(i));
-            const Eigen::Map<const Eigen::Matrix3d> c(contact_tangent_ + 18 * static_cast<size_t>(i) + 9);
+            const Eigen::Map<const Eigen::Matrix3d> stiffness(contact_tangent_ + 18 * static_cast<size_t>(i));
+            const Eigen::Map<const Eigen::Matrix3d> damping_c(contact_tangent_ + 18 * static_cast<size_t>(i) + 9);
             const Eigen::Map<const Eigen::Vector3d> v0(vi), f(at(force_, i));
-            const Eigen::Matrix3d a = Eigen::Matrix3d::Identity() + w * (h * h * k + h * c);
-            const Eigen::Vector3d v1 = a.llt().solve(v0 + w * h * (f + c * v0));
-            const Eigen::Vector3d received = -(h * k * v1 + c * (v1 - v0));
+            const Eigen::Matrix3d a = Eigen::Matrix3d::Identity() + w * (h * h * stiffness + h * damping_c);
+            const Eigen::Vector3d v1 = a.llt().solve(v0 + w * h * (f + damping_c * v0));
+            const Eigen::Vector3d received = -(h * stiffness * v1 + damping_c * (v1 - v0));
             double arm[3], t[3];
             sub3(at(x, i), tool_.pose.p, arm);
             cross3(arm, received.data(), t);
@@ -291,7 +291,7 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         // The term's normal tangent (the full model's, contact_tangent.cpp), k g g^T with g its
         // gradients, bounded by a block diagonal: node a gets k |g_a| (sum_b |g_b|) along g_a
         // (Cauchy-Schwarz), for integrate().
-        const double k = normal_tangent_scale(p, 1.0, 0.0), c = normal_tangent_scale(p, 0.0, 1.0);
+        const double stiffness = normal_tangent_scale(p, 1.0, 0.0), damping = normal_tangent_scale(p, 0.0, 1.0);
         double spread = 0.0;
         for (int a = 0; a < p.count; ++a) spread += norm3(p.gradient[a]);
         for (int a = 0; a < p.count; ++a) {
@@ -299,7 +299,7 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
             double direction[3] = {0.0, 0.0, 0.0};
             if (length > 0.0)
                 for (int k = 0; k < 3; ++k) direction[k] = p.gradient[a][k] / length;
-            add_contact_tangent(p.nodes[a], direction, k * length * spread, c * length * spread);
+            add_contact_tangent(p.nodes[a], direction, stiffness * length * spread, damping * length * spread);
             for (int k = 0; k < 3; ++k) {
                 at(f, p.nodes[a])[k] += p.node_force[a][k];
                 at(contact_, p.nodes[a])[k] += p.node_force[a][k];

@@ -1,6 +1,7 @@
 """softhap.viz: optional, never imported by `import softhap`; with pyvista, a body becomes a
 grid with the right cells and displacements, and renders to a PNG without a display."""
 
+import os
 import subprocess
 import sys
 
@@ -8,11 +9,13 @@ import numpy as np
 import pytest
 
 import softhap
+from conftest import BINDINGS_DIR
 
 
 def test_import_softhap_does_not_import_viewers():
     code = "import softhap, sys; print(sorted(m for m in ('pyvista', 'polyscope', 'softhap.viz', 'meshio') if m in sys.modules))"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(BINDINGS_DIR), os.environ.get("PYTHONPATH")])))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env).stdout
     assert out.strip() == "[]"
 
 

@@ -544,6 +544,15 @@ static void test_first_force_one_tick_after_contact(void** state) {
             assert_int_equal(out.buffer_tets, 0);
             /* One Hunt-Crossley point (n = 1, no damping) at the sphere's depth below the plane. */
             assert_close(out.raw_force[2], 100.0 * 5e-4, 1e-9);
+            /* Up to the sphere's radius below the plane it holds (the law at that depth); past
+             * it the tool has gone through, as it would in the full model: no force. */
+            const double at_radius[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top - 0.999 * kRadius};
+            assert_ok(sh_haptic_step(haptic, at_radius, kIdentity, dt, &out));
+            assert_close(out.raw_force[2], 100.0 * 0.999 * kRadius, 1e-9);
+            const double through[3] = {0.5 * kBlock[0], 0.5 * kBlock[1], top - 3.0 * kRadius};
+            assert_ok(sh_haptic_step(haptic, through, kIdentity, dt, &out));
+            assert_int_equal(out.contact, 0);
+            assert_true(norm3(out.raw_force) == 0.0);
         }
         assert_ok(sh_haptic_destroy(haptic));
         sh_world_destroy(s.world);

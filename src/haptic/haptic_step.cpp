@@ -407,6 +407,10 @@ bool HapticContext::proxy_force(const Buffer& b, double force[3], double torque[
     tool_.shape.support(tool_.target, inward, s);
     sub3(b.proxy_point, s, d);
     const double depth = dot3(d, n);
+    // Deeper than the tool's inner radius, the tool has passed through the surface, as the
+    // full model lets it (its contact potential holds a tool only up to that depth): the
+    // device follows the full model instead of a plane the tool is past.
+    if (!(depth <= tool_.shape.inner_radius())) return false;
     const NormalForce fn = hunt_crossley(tool_.params, depth, -dot3(tool_.velocity, n));
     if (!(fn.force > 0.0)) return false;
     double r[3];

@@ -2,6 +2,7 @@
 
 #include "liver_scene.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -108,9 +109,7 @@ void device_scene_tick(device_scene* s, const double device_position[3], const d
     if (sh_device_force(&s->mapping, out.force, out.torque, out_force, out_torque) != SH_OK) return;
     ++s->ticks;
     s->contact_ticks += out.contact;
-    for (k = 0; k < 3; ++k)
-        if (out_force[k] * out_force[k] > s->largest_force * s->largest_force)
-            s->largest_force = out_force[k] < 0.0 ? -out_force[k] : out_force[k];
+    for (k = 0; k < 3; ++k) s->largest_force = fmax(s->largest_force, fabs(out_force[k]));
 }
 
 int device_scene_finish(device_scene* s) {

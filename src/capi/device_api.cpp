@@ -1,6 +1,7 @@
 // C API: the device mapping. The per-tick transforms never throw nor set the last-error
 // message (a device loop calls them); sh_device_mapping_check says what is wrong, once.
 #include "capi/guard.hpp"
+#include "core/vec3.hpp"
 #include "haptic/device_mapping.hpp"
 
 using namespace sh;
@@ -19,7 +20,7 @@ sh_status map_pose(const sh_device_mapping* mapping, Pose (*map)(const DeviceMap
                    double out_orientation[4]) noexcept {
     DeviceMapping m;
     Pose in;
-    if (!usable(mapping, m, nullptr) || !normalised_pose(position, orientation, in) || !out_position ||
+    if (!usable(mapping, m, nullptr) || !read_pose(position, orientation, in) || !out_position ||
         !out_orientation)
         return SH_ERR_INVALID_ARGUMENT;
     const Pose out = map(m, in);
@@ -68,10 +69,9 @@ SH_API sh_status sh_world_to_device(const sh_device_mapping* mapping, const doub
 SH_API sh_status sh_device_force(const sh_device_mapping* mapping, const double force[3], const double torque[3],
                                  double out_device_force[3], double out_device_torque[3]) {
     DeviceMapping m;
-    if (!usable(mapping, m, nullptr) || !force || !torque || !out_device_force || !out_device_torque)
+    if (!usable(mapping, m, nullptr) || !force || !torque || !out_device_force || !out_device_torque ||
+        !finite3(force) || !finite3(torque))
         return SH_ERR_INVALID_ARGUMENT;
-    for (int k = 0; k < 3; ++k)
-        if (!std::isfinite(force[k]) || !std::isfinite(torque[k])) return SH_ERR_INVALID_ARGUMENT;
     double f[3], t[3];
     device_wrench(m, force, torque, f, t);
     for (int k = 0; k < 3; ++k) out_device_force[k] = f[k], out_device_torque[k] = t[k];

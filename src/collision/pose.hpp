@@ -52,6 +52,19 @@ struct Pose {
     }
 };
 
+/// out = the pose (position, orientation normalised); false, out untouched, if a pointer is
+/// null, the position is not finite or the quaternion is zero or not finite. Never throws.
+inline bool read_pose(const double position[3], const double orientation[4], Pose& out) noexcept {
+    if (!position || !orientation) return false;
+    double norm2 = 0.0;
+    for (int k = 0; k < 4; ++k) norm2 += orientation[k] * orientation[k];
+    if (!(std::isfinite(position[0] + position[1] + position[2]) && std::isfinite(norm2) && norm2 > 0.0)) return false;
+    const double inverse = 1.0 / std::sqrt(norm2);
+    for (int k = 0; k < 3; ++k) out.p[k] = position[k];
+    for (int k = 0; k < 4; ++k) out.q[k] = orientation[k] * inverse;
+    return true;
+}
+
 /// The quaternion product a b (w, x, y, z): the rotation b, then a.
 inline void quaternion_product(const double a[4], const double b[4], double out[4]) {
     out[0] = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];

@@ -1,37 +1,19 @@
 #include "haptic/device_mapping.hpp"
 
+#include "core/vec3.hpp"
+
 #include <cmath>
 
 namespace sh {
-namespace {
-
-bool finite(const double* a, int n) {
-    for (int k = 0; k < n; ++k)
-        if (!std::isfinite(a[k])) return false;
-    return true;
-}
-
-}  // namespace
-
-bool normalised_pose(const double position[3], const double orientation[4], Pose& out) noexcept {
-    if (!position || !orientation || !finite(position, 3) || !finite(orientation, 4)) return false;
-    double norm2 = 0.0;
-    for (int k = 0; k < 4; ++k) norm2 += orientation[k] * orientation[k];
-    if (!(norm2 > 0.0) || !std::isfinite(norm2)) return false;
-    const double inverse = 1.0 / std::sqrt(norm2);
-    for (int k = 0; k < 3; ++k) out.p[k] = position[k];
-    for (int k = 0; k < 4; ++k) out.q[k] = orientation[k] * inverse;
-    return true;
-}
 
 bool read_device_mapping(const sh_device_mapping& m, DeviceMapping& out, const char** field) noexcept {
     const char* bad = nullptr;
     Pose base;
     if (!(std::isfinite(m.scale) && m.scale > 0.0)) bad = "scale";
     else if (!(std::isfinite(m.force_scale) && m.force_scale > 0.0)) bad = "force_scale";
-    else if (!finite(m.tool_offset, 3)) bad = "tool_offset";
-    else if (!finite(m.base_position, 3)) bad = "base_position";
-    else if (!normalised_pose(m.base_position, m.base_orientation, base)) bad = "base_orientation";
+    else if (!finite3(m.tool_offset)) bad = "tool_offset";
+    else if (!finite3(m.base_position)) bad = "base_position";
+    else if (!read_pose(m.base_position, m.base_orientation, base)) bad = "base_orientation";
     if (bad) {
         if (field) *field = bad;
         return false;

@@ -22,9 +22,6 @@ struct DeviceMapping {
 /// it ("scale", "base_orientation", ...; static text). internal_init is the C API's to check.
 bool read_device_mapping(const sh_device_mapping& m, DeviceMapping& out, const char** field) noexcept;
 
-/// A finite pose with a non-zero quaternion, normalised; false if not.
-bool normalised_pose(const double position[3], const double orientation[4], Pose& out) noexcept;
-
 /// The world pose of the tool for device pose d.
 Pose device_to_world(const DeviceMapping& m, const Pose& d) noexcept;
 

@@ -289,17 +289,15 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         if (p.count == 1) apply_normal_law(law, vrel, p);
         else apply_excess_damping(law, vrel, p);
         // The term's normal tangent (the full model's, contact_tangent.cpp), k g g^T with g its
-        // gradients, bounded by a block diagonal: node a gets k |g_a| (sum_b |g_b|) along g_a
-        // (Cauchy-Schwarz), for integrate().
+        // gradients, bounded by a block diagonal: node a gets k |g_a| (sum_b |g_b|) (its
+        // stiffness_share) along g_a (Cauchy-Schwarz), for integrate().
         const double stiffness = normal_tangent_scale(p, 1.0, 0.0), damping = normal_tangent_scale(p, 0.0, 1.0);
-        double spread = 0.0;
-        for (int a = 0; a < p.count; ++a) spread += norm3(p.gradient[a]);
         for (int a = 0; a < p.count; ++a) {
-            const double length = norm3(p.gradient[a]);
+            const double length = norm3(p.gradient[a]), share = stiffness_share(p, a);
             double direction[3] = {0.0, 0.0, 0.0};
             if (length > 0.0)
                 for (int k = 0; k < 3; ++k) direction[k] = p.gradient[a][k] / length;
-            add_contact_tangent(p.nodes[a], direction, stiffness * length * spread, damping * length * spread);
+            add_contact_tangent(p.nodes[a], direction, stiffness * share, damping * share);
             for (int k = 0; k < 3; ++k) {
                 at(f, p.nodes[a])[k] += p.node_force[a][k];
                 at(contact_, p.nodes[a])[k] += p.node_force[a][k];
@@ -432,16 +430,8 @@ sh_status HapticContext::step(const double position[3], const double orientation
     }
     const double step_dt = dt_ok ? dt : def_.dt;  // what the force ramps move by
     Pose pose = pose_;
-    bool pose_ok = position && orientation && finite3(position);
-    double q2 = 0.0;
+    const bool pose_ok = read_pose(position, orientation, pose);
     if (pose_ok) {
-        for (int k = 0; k < 4; ++k) q2 += orientation[k] * orientation[k];
-        pose_ok = std::isfinite(q2) && q2 > 0.0;
-    }
-    if (pose_ok) {
-        const double inv = 1.0 / std::sqrt(q2);
-        for (int k = 0; k < 3; ++k) pose.p[k] = position[k];
-        for (int k = 0; k < 4; ++k) pose.q[k] = orientation[k] * inv;
         DevicePose& d = device_[device_index_.back()];
         d.pose = pose;
         d.valid = true;

@@ -28,11 +28,6 @@ def _nodes_and_tets(shape: Shape) -> Tuple[np.ndarray, np.ndarray]:
     return shape.nodes, shape.tets
 
 
-def _surface(shape: Shape) -> np.ndarray:
-    """The outward surface triangles (cut faces included for a body)."""
-    return shape.surface_triangles
-
-
 def _require(module: str) -> Any:
     try:
         return __import__(module)
@@ -81,7 +76,7 @@ def screenshot(shape: Shape, path: Union[str, os.PathLike], rest: Optional[np.nd
     pv = _require("pyvista")
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     grid = to_pyvista(shape, rest)
-    triangles = _surface(shape)
+    triangles = shape.surface_triangles  # outward; a body's cut faces included
     surface = pv.PolyData(grid.points, np.hstack([np.full((len(triangles), 1), 3), triangles]).ravel())
     surface.point_data.update(grid.point_data)
     options = {"scalars": "displacement_mm", "cmap": "viridis",

@@ -118,6 +118,23 @@ typedef struct scene {
     sh_tool_id tool;
 } scene;
 
+/* The sphere tool of radius kRadius over the block's top centre at height z, with a linear,
+ * undamped contact law of the given stiffness (N/m). */
+static sh_tool_id add_sphere_tool(sh_world* world, double stiffness, double z) {
+    sh_collider_def tool;
+    sh_collider_def_default(&tool);
+    tool.shape.radius = kRadius;
+    tool.contact.stiffness = stiffness;
+    tool.contact.exponent = 1.0;
+    tool.contact.damping = 0.0;
+    tool.position[0] = 0.5 * kBlock[0];
+    tool.position[1] = 0.5 * kBlock[1];
+    tool.position[2] = z;
+    sh_tool_id id;
+    assert_ok(sh_tool_create(world, &tool, &id));
+    return id;
+}
+
 /* The scene with the block stepped by integrator. */
 static scene make_scene_stepped(double damping_mass, double tool_z, sh_integrator integrator) {
     scene s;
@@ -142,17 +159,7 @@ static scene make_scene_stepped(double damping_mass, double tool_z, sh_integrato
     free(x);
     free(base);
     assert_ok(sh_mesh_destroy(mesh));
-
-    sh_collider_def tool;
-    sh_collider_def_default(&tool);
-    tool.shape.radius = kRadius;
-    tool.contact.stiffness = 100.0; /* N/m per contact point */
-    tool.contact.exponent = 1.0;
-    tool.contact.damping = 0.0;
-    tool.position[0] = 0.5 * kBlock[0];
-    tool.position[1] = 0.5 * kBlock[1];
-    tool.position[2] = tool_z;
-    assert_ok(sh_tool_create(s.world, &tool, &s.tool));
+    s.tool = add_sphere_tool(s.world, 100.0, tool_z); /* N/m per contact point */
     return s;
 }
 
@@ -477,16 +484,7 @@ static void test_absurdly_stiff_tool_keeps_the_force_contract(void** state) {
     const double top = kBlock[2] + kRadius, dt = 1e-3;
     scene s = make_scene(0.0, top);
     sh_tool_destroy(s.world, s.tool);
-    sh_collider_def tool;
-    sh_collider_def_default(&tool);
-    tool.shape.radius = kRadius;
-    tool.contact.stiffness = 1e12;
-    tool.contact.exponent = 1.0;
-    tool.contact.damping = 0.0;
-    tool.position[0] = 0.5 * kBlock[0];
-    tool.position[1] = 0.5 * kBlock[1];
-    tool.position[2] = top;
-    assert_ok(sh_tool_create(s.world, &tool, &s.tool));
+    s.tool = add_sphere_tool(s.world, 1e12, top);
     sh_haptic_def def = haptic_def(&s);
     def.radius = 0.008;
     def.stale_after = 1e3;

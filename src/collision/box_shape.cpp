@@ -59,8 +59,9 @@ bool box_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3], 
 
 }  // namespace
 
-// No excess solver: the vertices of a box's facet arrangement make the maximum jump or kink
-// where its maximiser changes, which Newton does not survive; the nodes carry its contact.
-extern const ShapeKind kBoxShape = {SH_SHAPE_BOX, "box", false, box_init, box_bounds, box_support, box_penetrate, no_excess};
+// No balls: a box is no union of balls (the ball inscribed in a cube misses its corners), and
+// an exact excess over its facets' arrangement jumps or kinks where its maximiser changes,
+// which Newton does not survive; the nodes carry its contact.
+extern const ShapeKind kBoxShape = {SH_SHAPE_BOX, "box", false, box_init, box_bounds, box_support, box_penetrate, nullptr, nullptr};
 
 }  // namespace sh

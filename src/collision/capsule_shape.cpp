@@ -17,6 +17,19 @@ void capsule_init(const sh_shape& def, ShapeGeometry& g) {
                "shape.half_length = %g m, must be finite and >= 0", def.half_length);
     g.half_length = def.half_length;
     g.inner_radius = g.radius;
+    // Balls at most half a radius apart from end to end: their union is the capsule but for
+    // scallops of at most 3 % of the radius between them, which no ball's excess sees (each
+    // one's maximiser is at the foot of its own centre).
+    const double intervals = std::ceil(4.0 * g.half_length / g.radius);
+    SH_REQUIRE(intervals < 1e6, SH_ERR_INVALID_ARGUMENT,
+               "shape.half_length = %g m is more than 250,000 times shape.radius = %g m", g.half_length, g.radius);
+    g.ball_count = 1 + static_cast<int>(intervals);
+}
+
+// Ball i's position along the axis (m).
+double ball_axis(const ShapeGeometry& g, int i) {
+    const int intervals = g.ball_count - 1;
+    return intervals > 0 ? g.half_length * (2.0 * i - intervals) / intervals : 0.0;
 }
 
 void capsule_bounds(const ShapeGeometry& g, const Pose& pose, double margin, double lo[3], double hi[3]) {
@@ -56,11 +69,33 @@ bool capsule_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[
     return true;
 }
 
+void capsule_balls_near(const ShapeGeometry& g, const double x[3], double reach, int& first, int& last) {
+    first = 0;
+    last = -1;
+    const double across2 = x[0] * x[0] + x[1] * x[1];
+    if (!(across2 <= reach * reach)) return;
+    const double along = std::sqrt(reach * reach - across2);
+    const int intervals = g.ball_count - 1;
+    if (intervals == 0) {
+        last = std::fabs(x[2]) <= along ? 0 : -1;
+        return;
+    }
+    const double spacing = 2.0 * g.half_length / intervals;
+    const double lo = std::ceil((x[2] - along + g.half_length) / spacing);
+    const double hi = std::floor((x[2] + along + g.half_length) / spacing);
+    first = static_cast<int>(std::min(std::max(lo, 0.0), intervals + 1.0));
+    last = static_cast<int>(std::min(std::max(hi, -1.0), static_cast<double>(intervals)));
+}
+
+void capsule_ball_centre(const ShapeGeometry& g, int i, double centre[3]) {
+    centre[0] = centre[1] = 0.0;
+    centre[2] = ball_axis(g, i);
+}
+
 }  // namespace
 
-// No excess solver: the best ball along the axis makes the maximum kink where its maximiser
-// changes, which Newton does not survive; the nodes carry the capsule's contact.
-extern const ShapeKind kCapsuleShape = {SH_SHAPE_CAPSULE, "capsule", false,         capsule_init, capsule_bounds,
-                                        capsule_support,  capsule_penetrate, no_excess};
+extern const ShapeKind kCapsuleShape = {SH_SHAPE_CAPSULE,   "capsule",          false,
+                                        capsule_init,       capsule_bounds,     capsule_support,
+                                        capsule_penetrate,  capsule_balls_near, capsule_ball_centre};
 
 }  // namespace sh

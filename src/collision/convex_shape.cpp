@@ -60,9 +60,8 @@ bool convex_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3
 
 }  // namespace
 
-// No excess solver: the vertices of a polytope's facet arrangement make the maximum jump or
-// kink where its maximiser changes, which Newton does not survive; the nodes carry its contact.
+// No balls, as for the box: the nodes carry a convex hull's contact.
 extern const ShapeKind kConvexShape = {SH_SHAPE_CONVEX, "convex", false,         convex_init, convex_bounds,
-                                       convex_support,  convex_penetrate, no_excess};
+                                       convex_support,  convex_penetrate, nullptr, nullptr};
 
 }  // namespace sh

@@ -53,9 +53,9 @@ bool plane_penetrate(const ShapeGeometry&, const Pose& pose, const double x[3], 
 
 }  // namespace
 
-// No excess solver: a plane's depth is linear, so its nodes carry all of it.
+// No balls: a plane's depth is linear, so its nodes carry all of it.
 extern const ShapeKind kPlaneShape = {SH_SHAPE_PLANE, "plane", true,         plane_init, plane_bounds,
-                                      plane_support,  plane_penetrate, no_excess};
+                                      plane_support,  plane_penetrate, nullptr, nullptr};
 
 Pose plane_pose(const double point[3], const double normal[3]) {
     double n[3] = {normal[0], normal[1], normal[2]};

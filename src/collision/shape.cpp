@@ -17,8 +17,6 @@ Shape::Shape(const sh_shape& def) : row_(&shape_kind(enum_value(def.kind))), kin
 
 bool Shape::is_half_space() const { return row_->half_space; }
 
-bool Shape::has_excess() const { return row_->excess != no_excess; }
-
 void Shape::bounds(const Pose& pose, double margin, double lo[3], double hi[3]) const {
     row_->bounds(geometry_, pose, margin, lo, hi);
 }
@@ -40,23 +38,19 @@ bool Shape::penetrate_point(const Pose& pose, const double x[3], Penetration& ou
     return true;
 }
 
-bool Shape::deepest_excess(const Pose& pose, const double* const points[3], const double node_energy[3], int count,
-                           const DepthPotential& psi, SimplexExcess& out) const {
-    LocalSimplex s;
-    s.count = count;
-    for (int i = 0; i < count; ++i) {
-        pose.to_local(points[i], s.p[i]);
-        s.energy[i] = node_energy[i];
-    }
-    const LocalExcess e = row_->excess(geometry_, s, psi);
-    if (!(e.value > 0.0) || !std::isfinite(e.value)) return false;
-    out.value = e.value;
-    out.depth = e.depth;
-    for (int k = 0; k < 3; ++k) out.weights[k] = k < count ? e.w[k] : 0.0;
-    pose.to_world(e.x, out.point);
-    pose.rotate(e.n, out.normal);
-    pose.rotate(e.push, out.push);
-    return true;
+void Shape::ball_centre(const Pose& pose, int i, double out[3]) const {
+    double local[3];
+    row_->ball_centre(geometry_, i, local);
+    pose.to_world(local, out);
+}
+
+void Shape::balls_near(const Pose& pose, const double x[3], double reach, int& first, int& last) const {
+    first = 0;
+    last = -1;
+    if (!row_->balls_near) return;
+    double local[3];
+    pose.to_local(x, local);
+    row_->balls_near(geometry_, local, reach, first, last);
 }
 
 double checked_radius(const sh_shape& def) {

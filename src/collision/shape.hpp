@@ -27,18 +27,6 @@ public:
     virtual double stiffness(double depth) const = 0;
 };
 
-/// Where a shape's contact potential exceeds most, over a surface edge or triangle, the linear
-/// interpolant of its nodes' own potentials (Shape::deepest_excess).
-struct SimplexExcess {
-    double value = 0.0;      ///< max over the simplex of psi(depth(x)) - sum_i w_i psi_i (J)
-    double depth = 0.0;      ///< the shape's depth at the maximiser (m)
-    double weights[3] = {};  ///< the maximiser's barycentric weights (count of them used)
-    double point[3] = {};    ///< the maximiser (world)
-    double normal[3] = {};   ///< unit push out of the shape at the maximiser (world)
-    double push[3] = {};     ///< minus the gradient of psi(depth) at the maximiser for the
-                             ///< simplex moved rigidly (N, world): psi' times the normal
-};
-
 struct ShapeKind;
 
 /// A rigid shape in its local frame. Sphere and capsule are centred at the origin, the capsule
@@ -58,8 +46,21 @@ public:
     /// True for an unbounded half-space (a plane; see ShapeKind::half_space).
     bool is_half_space() const;
 
-    /// True if the kind has an excess solver (deepest_excess can be > 0).
-    bool has_excess() const;
+    /// The number of balls whose union the contact potential's excess terms take
+    /// (shape_contact.hpp): 1 for a sphere; for a capsule, balls of its radius along its axis
+    /// from end to end, at most half a radius apart; 0 for kinds whose nodes carry all of
+    /// their contact (box, convex hull, plane).
+    int ball_count() const { return geometry_.ball_count; }
+
+    /// The balls' radius (m).
+    double ball_radius() const { return geometry_.radius; }
+
+    /// The world centre of ball i (0 <= i < ball_count()) at pose.
+    void ball_centre(const Pose& pose, int i, double out[3]) const;
+
+    /// The balls whose centres may lie within reach (m) of world point x at pose: from first
+    /// to last (none if first > last, and for kinds without balls).
+    void balls_near(const Pose& pose, const double x[3], double reach, int& first, int& last) const;
 
     /// Half the thinnest width of the shape (m): a point moving less than this per query
     /// cannot cross it unseen. INFINITY for a plane. For a convex hull it is an estimate (the
@@ -76,13 +77,6 @@ public:
     /// True if world point x lies inside the shape at pose (depth > 0); then out holds the
     /// depth, the outward normal at the nearest surface point and out.point = x.
     bool penetrate_point(const Pose& pose, const double x[3], Penetration& out) const;
-
-    /// Maximises psi(depth(x)) - sum_i w_i node_energy[i] over the simplex of `count` (2 or 3)
-    /// world points, x = sum_i w_i points[i], depth(x) the shape's penetration depth at x.
-    /// True if the maximum is > 0. Each kind has its own solver; the sphere's is exact (see
-    /// ball_excess.hpp); a kind without one gives false, its nodes carrying its contact.
-    bool deepest_excess(const Pose& pose, const double* const points[3], const double node_energy[3], int count,
-                        const DepthPotential& psi, SimplexExcess& out) const;
 
     /// From now on, point queries on a convex hull skip libccd's GJK/EPA, which allocates:
     /// MPR and the sampled directions give the depth (an upper bound, exact along the hull

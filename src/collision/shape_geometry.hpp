@@ -9,7 +9,8 @@ namespace sh {
 /// The fields of sh_shape a kind reads, validated, and what its kind derives from them. Each
 /// kind fills and reads only its own fields.
 struct ShapeGeometry {
-    double radius = 0.0;          ///< sphere, capsule (m)
+    double radius = 0.0;          ///< sphere, capsule (m); their balls' radius
+    int ball_count = 0;           ///< sphere 1, capsule its axis's balls; others 0 (Shape::ball_count)
     double half_length = 0.0;     ///< capsule: half its axis segment, along local z (m)
     double half_extents[3] = {};  ///< box: half widths along the local axes (m)
     ConvexHull hull;              ///< convex

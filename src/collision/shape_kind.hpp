@@ -21,7 +21,7 @@ struct LocalSimplex {
     int count;
 };
 
-/// A candidate maximiser of the excess over a LocalSimplex, in the local frame.
+/// A candidate maximiser of a ball's excess over a LocalSimplex (ball_excess.hpp).
 struct LocalExcess {
     double value = -INFINITY;  ///< J; -INFINITY: none
     double depth = 0.0;        ///< m
@@ -48,15 +48,17 @@ struct ShapeKind {
     /// True if world point x lies inside at pose: then its depth (m, > 0) and the outward
     /// normal (world) at the nearest surface point, which Shape::penetrate_point normalises.
     bool (*penetrate)(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth, double normal[3]);
-    /// The maximiser of psi(depth) minus the nodes' linear interpolant over s (Shape::deepest_excess).
-    LocalExcess (*excess)(const ShapeGeometry& g, const LocalSimplex& s, const DepthPotential& psi);
+    /// The balls (of radius g.radius, g.ball_count of them) whose centres may lie within
+    /// reach (m) of local point x: those from first to last (none if first > last). Null for
+    /// a kind without balls (Shape::ball_count).
+    void (*balls_near)(const ShapeGeometry& g, const double x[3], double reach, int& first, int& last);
+    /// The centre of ball i, in the local frame.
+    void (*ball_centre)(const ShapeGeometry& g, int i, double centre[3]);
 };
 
 /// The row of kind: SH_ERR_INVALID_ARGUMENT if kind is not a sh_shape_kind.
 const ShapeKind& shape_kind(int kind);
 
-/// The excess solver of a kind that has none: its nodes carry all of its contact.
-inline LocalExcess no_excess(const ShapeGeometry&, const LocalSimplex&, const DepthPotential&) { return LocalExcess{}; }
 
 /// Bounds of a shape symmetric about the pose's position: reach[k] (m) on either side along
 /// world axis k, grown by margin.

@@ -1,5 +1,4 @@
 // The sphere kind: radius around the pose's position. A row of the shape table.
-#include "collision/ball_excess.hpp"
 #include "collision/shape_kind.hpp"
 #include "collision/unit_vector.hpp"
 #include "core/vec3.hpp"
@@ -10,6 +9,7 @@ namespace {
 void sphere_init(const sh_shape& def, ShapeGeometry& g) {
     g.radius = checked_radius(def);
     g.inner_radius = g.radius;
+    g.ball_count = 1;
 }
 
 void sphere_bounds(const ShapeGeometry& g, const Pose& pose, double margin, double lo[3], double hi[3]) {
@@ -40,14 +40,16 @@ bool sphere_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3
     return true;
 }
 
-LocalExcess sphere_excess(const ShapeGeometry& g, const LocalSimplex& s, const DepthPotential& psi) {
-    const double centre[3] = {0.0, 0.0, 0.0};
-    return ball_excess(s, psi, centre, g.radius);
+void sphere_balls_near(const ShapeGeometry&, const double x[3], double reach, int& first, int& last) {
+    first = 0;
+    last = norm3(x) <= reach ? 0 : -1;
 }
+
+void sphere_ball_centre(const ShapeGeometry&, int, double centre[3]) { centre[0] = centre[1] = centre[2] = 0.0; }
 
 }  // namespace
 
 extern const ShapeKind kSphereShape = {SH_SHAPE_SPHERE, "sphere", false,       sphere_init,      sphere_bounds,
-                                       sphere_support,  sphere_penetrate, sphere_excess};
+                                       sphere_support,  sphere_penetrate, sphere_balls_near, sphere_ball_centre};
 
 }  // namespace sh

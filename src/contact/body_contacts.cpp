@@ -60,6 +60,21 @@ StepLaw BodyContacts::step_law(const ContactCandidate& c) const {
     return hunt_crossley_step_law(*c.params, c.start_depth, step_);
 }
 
+void BodyContacts::mix_balls(const Group& group, const double* x) const {
+    if (group.end <= group.begin) return;
+    const Collider* collider = candidates_[static_cast<size_t>(group.begin)].collider;
+    if (!collider || collider->shape.ball_count() < 2) return;
+    scratch_.balls.reserve(collider->shape.ball_count());
+    scratch_.balls.begin(*collider);
+    for (int32_t i = group.begin; i < group.end; ++i) {
+        const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
+        if (c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kEdgeShape)
+            scratch_.balls.add(*c.collider, step_law(c), x, c.face, c.kind == ContactCandidate::kFaceShape ? 3 : 2,
+                               c.excess_weight);
+    }
+    scratch_.balls.finish();
+}
+
 bool BodyContacts::touching(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const {
     const sh_contact_params& p = *c.params;
     double vrel[3] = {0.0, 0.0, 0.0};  // velocity of the node side relative to the other side
@@ -74,7 +89,7 @@ bool BodyContacts::touching(const ContactCandidate& c, const double* x, const do
             // The law (with its damping in the depth for implicit steps) is part of the
             // excess's maximisation; explicit bodies scale it by the depth rate after.
             if (!excess_shape_contact(*c.collider, step_law(c), x, c.face, c.kind == ContactCandidate::kFaceShape ? 3 : 2,
-                                      c.excess_weight, out))
+                                      c.excess_weight, &scratch_.balls, out))
                 return false;
             if (!v || implicit_step()) return true;
             velocity_against_collider(*c.collider, out, v, vrel);

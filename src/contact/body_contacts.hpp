@@ -65,6 +65,8 @@ struct ContactScratch {
     bool recording = false;
     /// keep_deepest's sort keys (a candidate's depth).
     vec<double> keys;
+    /// The balls' mix of the collider being evaluated, for colliders of several balls.
+    BallMix balls;
 
     /// Returns evaluation_seconds and restarts it from 0.
     double take_evaluation_seconds() {
@@ -181,6 +183,9 @@ private:
     template <class Emit>
     void evaluate(const double* x, const double* v, Emit&& emit) const;
     bool keep_deepest(Group& group, int32_t capacity);
+    /// If group's collider is made of several balls: sums its excess terms at x into
+    /// scratch_.balls for the group's evaluation (BallMix).
+    void mix_balls(const Group& group, const double* x) const;
     /// Adds p's node forces (a collider's term) to the nodes' net push, listing each node once.
     void add_node_push(const ContactPoint& p) const;
     /// Calls emit(node, push) for each node with a net push since the last call, and clears it.

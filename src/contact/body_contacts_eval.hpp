@@ -18,6 +18,7 @@ void BodyContacts::evaluate_friction(const double* v, Emit&& emit) const {
 template <class Emit>
 void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& emit) const {
     for (const Group& group : groups_) {
+        mix_balls(group, x);
         for (int32_t i = group.begin; i < group.end; ++i) {
             const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
             ContactPoint point;

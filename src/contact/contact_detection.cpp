@@ -168,6 +168,7 @@ bool BodyContacts::keep_deepest(Group& group, int32_t capacity) {
     const int32_t count = group.end - group.begin;
     if (count <= capacity) return false;
     scratch_.keys.resize(static_cast<size_t>(count));
+    mix_balls(group, body_.x.data());
     for (int32_t i = 0; i < count; ++i) {
         ContactPoint point;
         const ContactCandidate& c = candidates_[static_cast<size_t>(group.begin + i)];

@@ -1,5 +1,7 @@
 #include "contact/shape_contact.hpp"
 
+#include "collision/ball_excess.hpp"
+#include "collision/unit_vector.hpp"
 #include "contact/hunt_crossley.hpp"
 #include "core/vec3.hpp"
 
@@ -89,42 +91,70 @@ double excess_weight(const Collider& collider, double size) {
 
 double resolved_band(const Collider& collider) { return 0.02 * collider.shape.inner_radius(); }
 
-bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
-                          int count, double weight, ContactPoint& out) {
-    if (!collider.shape.has_excess() || !(weight > 0.0)) return false;
-    const StepLawPotential psi(collider.params, law);
-    double node_energy[3], node_push[3][3], node_normal[3][3];
-    const double* points[3];
+namespace {
+
+// The feature's bounding sphere: centre and radius (m).
+double feature_bounds(const double* const points[3], int count, double centre[3]) {
+    for (int k = 0; k < 3; ++k) {
+        centre[k] = 0.0;
+        for (int a = 0; a < count; ++a) centre[k] += points[a][k] / count;
+    }
+    double radius = 0.0;
+    for (int a = 0; a < count; ++a) {
+        double d[3];
+        sub3(points[a], centre, d);
+        radius = std::max(radius, norm3(d));
+    }
+    return radius;
+}
+
+// A node's depth (m) in the ball at centre, and its push's direction.
+double ball_depth(const Collider& collider, const double centre[3], const double* p, double normal[3]) {
+    sub3(p, centre, normal);
+    const double dist = norm3(normal);
+    if (dist > 1e-12 * collider.shape.ball_radius()) {
+        for (int k = 0; k < 3; ++k) normal[k] /= dist;
+    } else {  // at the centre: any direction; the collider's local x axis
+        const double ex[3] = {1.0, 0.0, 0.0};
+        collider.pose.rotate(ex, normal);
+    }
+    return collider.shape.ball_radius() - dist;
+}
+
+// The excess term of the ball at centre over the feature (points, nodes, count), as
+// excess_shape_contact describes it for a sphere: its nodes' depths are the ball's.
+bool ball_term(const Collider& collider, const DepthPotential& psi, const double* const points[3], const int32_t* nodes,
+               int count, double weight, const double centre[3], ContactPoint& out) {
+    LocalSimplex s;
+    s.count = count;
+    double node_push[3][3], node_normal[3][3];
     ResolvedFade fade(resolved_band(collider));
     for (int a = 0; a < count; ++a) {
-        points[a] = at(x, nodes[a]);
-        Penetration pen;
-        const bool inside = collider.shape.penetrate_point(collider.pose, points[a], pen);
-        node_energy[a] = inside ? psi.energy(pen.depth) : 0.0;
-        const double force = inside ? psi.force(pen.depth) : 0.0;
+        const double depth = ball_depth(collider, centre, points[a], node_normal[a]);
+        const bool inside = depth > 0.0;
+        s.energy[a] = inside ? psi.energy(depth) : 0.0;
+        const double force = inside ? psi.force(depth) : 0.0;
         for (int k = 0; k < 3; ++k) {
-            node_push[a][k] = force * pen.normal[k];
-            node_normal[a][k] = pen.normal[k];
+            s.p[a][k] = points[a][k];
+            node_push[a][k] = force * node_normal[a][k];
         }
-        fade.add_node(inside ? pen.depth : 0.0);
+        fade.add_node(inside ? depth : 0.0);
     }
     if (!(fade.factor() > 0.0)) return false;
     fade.scale(weight);
-    SimplexExcess e;
-    if (!collider.shape.deepest_excess(collider.pose, points, node_energy, count, psi, e)) return false;
-    Penetration pen;
-    pen.depth = e.depth;
+    const LocalExcess e = ball_excess(s, psi, centre, collider.shape.ball_radius());
+    if (!(e.value > 0.0) || !std::isfinite(e.value)) return false;
+    out.depth = e.depth;
     for (int k = 0; k < 3; ++k) {
-        pen.normal[k] = e.normal[k];
-        pen.point[k] = e.point[k];
+        out.normal[k] = e.n[k];
+        out.point[k] = e.x[k];
     }
-    set_geometry(pen, count, nodes, e.weights, out);
+    set_contact_nodes(count, nodes, e.w, out);
     const double sign = count == 2 ? -1.0 : 1.0;  // faces add, edges subtract
     const double scale = sign * fade.factor();
-    const double force = psi.force(e.depth);
     out.law_scale = sign;
     out.energy = scale * e.value;
-    out.normal_force = scale * force;
+    out.normal_force = scale * psi.force(e.depth);
     // For the tangent: the law's curvature at the maximiser times the excess's share of the
     // law's energy there, which vanishes with the excess (where the law's own curvature does
     // not, as for a linear law at its onset).
@@ -138,17 +168,133 @@ bool excess_shape_contact(const Collider& collider, const StepLaw& law, const do
     for (int a = 0; a < count; ++a) {
         const double fade_slope = sign * e.value * fade.slope(a);
         for (int k = 0; k < 3; ++k) {
-            out.node_force[a][k] = scale * e.weights[a] * (e.push[k] - node_push[a][k]) + fade_slope * node_normal[a][k];
+            out.node_force[a][k] = scale * e.w[a] * (e.push[k] - node_push[a][k]) + fade_slope * node_normal[a][k];
             // For the tangent, stiffness times gradient gradient^T: the law's curvature at the
             // maximiser through its weights (the positive part of the term's Hessian; the
             // nodes' own curvature it subtracts, the maximiser's motion and the fade are left
             // to the line search). Not the node forces over the law's force: that ratio grows
             // without bound where the maximiser is shallow and its nodes deep.
-            out.gradient[a][k] = e.weights[a] * e.normal[k];
             out.net_normal_force += out.node_force[a][k] * out.normal[k];
         }
     }
     return true;
+}
+
+// Calls visit(i, term) for each ball i of the collider with an excess term over the feature.
+template <class Visit>
+void for_each_ball_term(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
+                        double weight, Visit&& visit) {
+    if (collider.shape.ball_count() == 0 || !(weight > 0.0)) return;
+    const StepLawPotential psi(collider.params, law);
+    const double* points[3];
+    for (int a = 0; a < count; ++a) points[a] = at(x, nodes[a]);
+    double centre[3];
+    const double reach = feature_bounds(points, count, centre) + collider.shape.ball_radius();
+    int first = 0, last = -1;
+    collider.shape.balls_near(collider.pose, centre, reach, first, last);
+    for (int i = first; i <= last; ++i) {
+        double ball[3];
+        collider.shape.ball_centre(collider.pose, i, ball);
+        ContactPoint term;
+        if (ball_term(collider, psi, points, nodes, count, weight, ball, term)) visit(i, term);
+    }
+}
+
+// Adds `share` of term's energy and geometry, and `coefficient` of its forces, to out;
+// geometry weighs by |share * energy| (`mass` keeps the sum).
+void mix_term(const ContactPoint& term, double share, double coefficient, ContactPoint& out, double& mass) {
+    const double w = std::fabs(share * term.energy);
+    out.energy += share * term.energy;
+    out.stiffness += share * term.stiffness;
+    out.normal_force += coefficient * term.normal_force;
+    out.net_normal_force += coefficient * term.net_normal_force;
+    out.depth += w * term.depth;
+    for (int k = 0; k < 3; ++k) {
+        out.point[k] += w * term.point[k];
+        out.normal[k] += w * term.normal[k];
+    }
+    for (int a = 0; a < term.count; ++a) {
+        out.weights[a] += w * term.weights[a];
+        for (int k = 0; k < 3; ++k) {
+            out.node_force[a][k] += coefficient * term.node_force[a][k];
+            out.gradient[a][k] += w * term.gradient[a][k];
+        }
+    }
+    mass += w;
+}
+
+// The mixed term of a collider of several balls (see BallMix).
+bool mixed_term(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
+                double weight, const BallMix& mix, ContactPoint& out) {
+    out = ContactPoint{};
+    out.count = count;
+    out.law_scale = count == 2 ? -1.0 : 1.0;
+    for (int a = 0; a < count; ++a) out.nodes[a] = nodes[a];
+    double mass = 0.0;
+    bool any = false;
+    for_each_ball_term(collider, law, x, nodes, count, weight, [&](int i, const ContactPoint& term) {
+        if (mix.share(i) == 0.0 && mix.coefficient(i) == 0.0) return;
+        mix_term(term, mix.share(i), mix.coefficient(i), out, mass);
+        any = true;
+    });
+    if (!any || !(mass > 0.0)) return false;
+    out.depth /= mass;
+    for (int k = 0; k < 3; ++k) out.point[k] /= mass;
+    if (!normalize3(out.normal)) return false;
+    for (int a = 0; a < count; ++a) {
+        out.weights[a] /= mass;
+        for (int k = 0; k < 3; ++k) out.gradient[a][k] /= mass;
+    }
+    return true;
+}
+
+}  // namespace
+
+void BallMix::reserve(int count) {
+    if (mix_.size() < 3 * static_cast<size_t>(count)) mix_.resize(3 * static_cast<size_t>(count));
+}
+
+void BallMix::begin(const Collider& collider) {
+    count_ = collider.shape.ball_count();
+    for (int i = 0; i < count_; ++i) mix_[3 * static_cast<size_t>(i)] = 0.0;
+}
+
+void BallMix::add(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
+                  double weight) {
+    for_each_ball_term(collider, law, x, nodes, count, weight,
+                       [&](int i, const ContactPoint& term) { mix_[3 * static_cast<size_t>(i)] += term.energy; });
+}
+
+void BallMix::finish() {
+    // In units of the largest total, so that the powers stay in range.
+    double largest = 0.0;
+    for (int i = 0; i < count_; ++i) largest = std::max(largest, mix_[3 * static_cast<size_t>(i)]);
+    double sum_p = 0.0, sum_p1 = 0.0;
+    for (int i = 0; i < count_ && largest > 0.0; ++i) {
+        const double u = std::max(mix_[3 * static_cast<size_t>(i)], 0.0) / largest;
+        const double power = std::pow(u, kOrder);
+        sum_p += power;
+        sum_p1 += power * u;
+    }
+    const double mean = sum_p > 0.0 ? sum_p1 / sum_p : 0.0, p = kOrder;
+    for (int i = 0; i < count_; ++i) {
+        double* m = &mix_[3 * static_cast<size_t>(i)];
+        const double u = largest > 0.0 ? std::max(m[0], 0.0) / largest : 0.0;
+        const double power = u > 0.0 ? std::pow(u, kOrder - 1) : 0.0;
+        m[1] = power > 0.0 ? power * u / sum_p : 0.0;
+        m[2] = power > 0.0 ? power * ((p + 1.0) * u - p * mean) / sum_p : 0.0;
+    }
+}
+
+bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
+                          int count, double weight, const BallMix* mix, ContactPoint& out) {
+    if (collider.shape.ball_count() > 1) return mix && mixed_term(collider, law, x, nodes, count, weight, *mix, out);
+    bool found = false;
+    for_each_ball_term(collider, law, x, nodes, count, weight, [&](int, const ContactPoint& term) {
+        out = term;
+        found = true;
+    });
+    return found;
 }
 
 void apply_excess_damping(const sh_contact_params& p, const double vrel[3], ContactPoint& out) {

@@ -95,6 +95,7 @@ HapticContext::HapticContext(World& world, const sh_haptic_def& def)
     : def_(def), world_(&world), tool_(world.collider(def.tool.value, true)), filter_(limits_of(def)) {
     validate_haptic_def(def);
     tool_.shape.use_allocation_free_queries();
+    balls_.reserve(tool_.shape.ball_count());
     arena_bytes_ = memory_bytes(def);
     arena_ = allocate(arena_bytes_, 64);
     Arena arena(arena_, arena_bytes_);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "contact/collider.hpp"
+#include "contact/shape_contact.hpp"
 #include "core/memory.hpp"
 #include "haptic/buffer.hpp"
 #include "haptic/force_filter.hpp"
@@ -106,6 +107,7 @@ private:
     World* world_;
     std::atomic<bool> detached_{false};
     Collider tool_;  ///< the haptic side's own copy of the tool (shape, law, pose)
+    BallMix balls_;  ///< the tool's balls' mix, room reserved at creation (BallMix)
 
     // the arena and what is carved from it
     void* arena_ = nullptr;

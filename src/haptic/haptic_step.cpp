@@ -72,10 +72,10 @@ void visit_terms_in_box(const Buffer& b, const double* x, const double lo[3], co
 // The tool's term of visit_terms_in_box at rest (the buffer is explicit: the depth rate's
 // damping comes after, from the velocities).
 bool term_contact(const Collider& tool, const double* x, const int32_t* nodes, int count, double size,
-                  ContactPoint& out) {
+                  const BallMix& balls, ContactPoint& out) {
     if (count == 1) return node_shape_contact(tool, x, nodes[0], out);
     return excess_shape_contact(tool, hunt_crossley_step_law(tool.params, 0.0, 0.0), x, nodes, count,
-                                excess_weight(tool, size), out);
+                                excess_weight(tool, size), &balls, out);
 }
 
 // How far past the full model's step (in steps) the boundary keeps its end velocity, when the
@@ -281,9 +281,17 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
     tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
     const sh_contact_params& law = tool_.params;
     clear_contact();
+    if (tool_.shape.ball_count() > 1) {  // a tool of several balls: their mix first (BallMix)
+        balls_.begin(tool_);
+        visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
+            if (count > 1)
+                balls_.add(tool_, hunt_crossley_step_law(law, 0.0, 0.0), x, nodes, count, excess_weight(tool_, size));
+        });
+        balls_.finish();
+    }
     visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
         ContactPoint p;
-        if (!term_contact(tool_, x, nodes, count, size, p)) return;
+        if (!term_contact(tool_, x, nodes, count, size, balls_, p)) return;
         double vrel[3];
         velocity_against_collider(tool_, p, v, vrel);
         if (p.count == 1) apply_normal_law(law, vrel, p);

@@ -81,7 +81,10 @@ double surface_height(const Patch& p, double px, double py) {
     return 0.0;
 }
 
-Collider make_collider(sh_shape_kind kind, const double position[3], double size) {
+// A tilted orientation, so that boxes and capsules meet the patch off their axes.
+const double kTilted[4] = {std::cos(0.3), std::sin(0.3) * 0.6, std::sin(0.3) * 0.8, 0.0};
+
+Collider make_collider(sh_shape_kind kind, const double position[3], double size, const double* orientation = kTilted) {
     static const double cube[8][3] = {{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {1, 1, -1},
                                       {-1, -1, 1},  {1, -1, 1},  {-1, 1, 1},  {1, 1, 1}};
     static double points[8][3];
@@ -95,11 +98,7 @@ Collider make_collider(sh_shape_kind kind, const double position[3], double size
     def.shape.points = &points[0][0];
     def.shape.point_count = 8;
     for (int k = 0; k < 3; ++k) def.position[k] = position[k];
-    // A tilted orientation, so that boxes and capsules meet the patch off their axes.
-    const double half = 0.3;
-    def.orientation[0] = std::cos(half);
-    def.orientation[1] = std::sin(half) * 0.6;
-    def.orientation[2] = std::sin(half) * 0.8;
+    for (int k = 0; k < 4; ++k) def.orientation[k] = orientation[k];
     def.contact.stiffness = 1e4;
     def.contact.exponent = 1.5;
     def.contact.damping = 0.0;
@@ -133,13 +132,20 @@ void each_term(const Collider& c, const Patch& p, const double* x, Visit&& visit
         }
         return sh::excess_weight(c, size);
     };
+    // A collider of several balls (a capsule) mixes its balls' terms over the whole patch.
+    sh::BallMix mix;
+    mix.reserve(c.shape.ball_count());
+    mix.begin(c);
+    for (size_t e = 0; e < p.edges.size(); e += 2) mix.add(c, law, x, &p.edges[e], 2, weight(&p.edges[e], 2));
+    for (size_t t = 0; t < p.tris.size(); t += 3) mix.add(c, law, x, &p.tris[t], 3, weight(&p.tris[t], 3));
+    mix.finish();
     for (size_t e = 0; e < p.edges.size(); e += 2) {
         ContactPoint point;
-        if (sh::excess_shape_contact(c, law, x, &p.edges[e], 2, weight(&p.edges[e], 2), point)) visit(point);
+        if (sh::excess_shape_contact(c, law, x, &p.edges[e], 2, weight(&p.edges[e], 2), &mix, point)) visit(point);
     }
     for (size_t t = 0; t < p.tris.size(); t += 3) {
         ContactPoint point;
-        if (sh::excess_shape_contact(c, law, x, &p.tris[t], 3, weight(&p.tris[t], 3), point)) visit(point);
+        if (sh::excess_shape_contact(c, law, x, &p.tris[t], 3, weight(&p.tris[t], 3), &mix, point)) visit(point);
     }
 }
 
@@ -329,6 +335,144 @@ void test_potential_is_smooth_along_paths(void**) {
         }
 }
 
+// The unit quaternion (w, x, y, z) turning local z onto the unit direction `axis`.
+void orientation_along(const double axis[3], double q[4]) {
+    const double c = axis[2], s = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1]);
+    const double angle = std::atan2(s, c);
+    const double kx = s > 0.0 ? -axis[1] / s : 1.0, ky = s > 0.0 ? axis[0] / s : 0.0;  // z x axis
+    q[0] = std::cos(0.5 * angle);
+    q[1] = std::sin(0.5 * angle) * kx;
+    q[2] = std::sin(0.5 * angle) * ky;
+    q[3] = 0.0;
+}
+
+// A capsule of radius r and half axis 2r lying along heading (radians, in the plane z = 0)
+// tilted by tilt (radians, its +z end down), whose lowest point is depth below z = 0 at its
+// centre's (cx, cy).
+Collider lying_capsule(double cx, double cy, double heading, double tilt, double radius, double depth) {
+    const double axis[3] = {std::cos(tilt) * std::cos(heading), std::cos(tilt) * std::sin(heading), -std::sin(tilt)};
+    double q[4];
+    orientation_along(axis, q);
+    const double lowest = -2.0 * radius * std::fabs(std::sin(tilt)) - radius;  // below the centre
+    const double position[3] = {cx, cy, -depth - lowest};
+    return make_collider(SH_SHAPE_CAPSULE, position, radius, q);
+}
+
+// Moment (N m) of the forces on the patch's nodes about point c.
+void moment_about(const Collider& c, const Patch& p, const double centre[3], double out[3]) {
+    double total[3];
+    const std::vector<double> f = forces(c, p, p.x.data(), total);
+    out[0] = out[1] = out[2] = 0.0;
+    for (size_t i = 0; i < f.size(); i += 3) {
+        const double r[3] = {p.x[i] - centre[0], p.x[i + 1] - centre[1], p.x[i + 2] - centre[2]};
+        out[0] += r[1] * f[i + 2] - r[2] * f[i + 1];
+        out[1] += r[2] * f[i] - r[0] * f[i + 2];
+        out[2] += r[0] * f[i + 1] - r[1] * f[i];
+    }
+}
+
+// A capsule smaller than the triangles of a flat patch, lying on it between its nodes: over
+// a face, across an edge, along an edge, across the fan of faces around a node it does not
+// reach. The whole ridge is equally deep, so the force is the law lambda d^n at its depth d,
+// along the normal, and (the ridge pressing evenly) its centre of pressure is the capsule's
+// centre: no moment about its foot.
+void test_small_capsule_lying_between_nodes_feels_the_law(void**) {
+    const Patch flat = hexagon(0.01, 0.0);
+    const double radius = 0.001, depth = 0.0004;
+    const double spots[4][3] = {{0.004, 0.002, 0.3}, {0.005, 0.0, M_PI / 2}, {0.005, 0.0, 0.0}, {0.0, 0.0016, 0.0}};
+    for (const auto& spot : spots) {
+        const Collider c = lying_capsule(spot[0], spot[1], spot[2], 0.0, radius, depth);
+        double total[3], moment[3];
+        forces(c, flat, flat.x.data(), total);
+        const double foot[3] = {spot[0], spot[1], 0.0};
+        moment_about(c, flat, foot, moment);
+        const double law = c.params.stiffness * std::pow(depth, c.params.exponent);
+        const double arm = std::sqrt(moment[0] * moment[0] + moment[1] * moment[1]) / law;
+        printf("lying capsule at (%.1f, %.1f) mm, heading %.2f: F (%.3g, %.3g, %.6g) N, lambda d^n %.6g N, centre of pressure off by %.3g mm\n",
+               1e3 * spot[0], 1e3 * spot[1], spot[2], total[0], total[1], total[2], law, 1e3 * arm);
+        assert_true(std::fabs(total[2] + law) < 1e-3 * law);
+        assert_true(std::fabs(total[0]) + std::fabs(total[1]) < 1e-9 * law);
+        assert_true(arm < 0.02 * radius);
+    }
+}
+
+// The same capsule over a face, tilted through lying flat by 0.1 rad either way (its lowest
+// point kept at the same depth): the force stays within the law at that depth and 11 % below
+// it (the smooth maximum's bound), and its centre of pressure goes over from the lower end to
+// the other in steps of at most 5 % of the way: the exact maximum's would jump from end to end
+// at once.
+void test_tilting_capsule_hands_over_smoothly(void**) {
+    const Patch flat = hexagon(0.01, 0.0);
+    const double radius = 0.001, depth = 0.0004;
+    double previous_force = 0.0, previous_centre = 0.0, worst_force = 0.0, worst_centre = 0.0;
+    double lowest = INFINITY, highest = 0.0, first_centre = 0.0;
+    const int steps = 400;
+    for (int i = 0; i <= steps; ++i) {
+        const double tilt = (-0.1 + 0.2 * i / steps);
+        const Collider c = lying_capsule(0.004, 0.002, 0.3, tilt, radius, depth);
+        double total[3], moment[3];
+        forces(c, flat, flat.x.data(), total);
+        const double foot[3] = {0.004, 0.002, 0.0};
+        moment_about(c, flat, foot, moment);
+        const double law = c.params.stiffness * std::pow(depth, c.params.exponent);
+        const double force = -total[2] / law;
+        // Centre of pressure along the heading: moment about the foot over the force.
+        const double centre = (moment[0] * std::sin(0.3) - moment[1] * std::cos(0.3)) / -total[2];
+        if (i > 0) {
+            worst_force = std::max(worst_force, std::fabs(force - previous_force));
+            worst_centre = std::max(worst_centre, std::fabs(centre - previous_centre));
+        } else {
+            first_centre = centre;
+        }
+        lowest = std::min(lowest, force);
+        highest = std::max(highest, force);
+        previous_force = force;
+        previous_centre = centre;
+    }
+    const double ends = 4.0 * radius;  // the axis from end to end
+    printf("tilting capsule: force %.4f..%.4f of lambda d^n, largest change per step %.3f %% of it; centre of pressure "
+           "from %.3f to %.3f mm, largest step %.3f mm\n",
+           lowest, highest, 100.0 * worst_force, 1e3 * first_centre, 1e3 * previous_centre, 1e3 * worst_centre);
+    assert_true(highest < 1.0 + 1e-6 && lowest > 0.89);
+    assert_true(worst_force < 0.02);
+    assert_true(first_centre * previous_centre < 0.0);  // from one end to the other
+    assert_true(std::fabs(first_centre) > 0.45 * ends && std::fabs(previous_centre) > 0.45 * ends);
+    assert_true(worst_centre < 0.05 * ends);
+}
+
+// A capsule lying across a bumped patch, slid at constant height over its faces, edges and
+// raised centre node (which it reaches) in 10 um steps: the force changes by at most 5 % per
+// step, as the sphere's does.
+void test_sliding_capsule_force_is_smooth(void**) {
+    const Patch cap = hexagon(0.006, 0.0008);
+    const double radius = 0.001, height = 0.0008 + radius - 0.0005;
+    double previous[3] = {0.0, 0.0, 0.0};
+    double worst = 0.0, smallest = INFINITY, largest = 0.0;
+    const int steps = 500;
+    for (int i = 0; i <= steps; ++i) {
+        const double s = -0.0025 + 0.005 * i / steps;
+        const double axis[3] = {std::cos(1.0), std::sin(1.0), 0.0};
+        double q[4];
+        orientation_along(axis, q);
+        const double position[3] = {s, 0.3 * s + 0.0002, height};
+        const Collider c = make_collider(SH_SHAPE_CAPSULE, position, radius, q);
+        double total[3];
+        forces(c, cap, cap.x.data(), total);
+        const double magnitude = std::sqrt(total[0] * total[0] + total[1] * total[1] + total[2] * total[2]);
+        if (i > 0) {
+            double change[3];
+            for (int k = 0; k < 3; ++k) change[k] = total[k] - previous[k];
+            worst = std::max(worst, std::sqrt(change[0] * change[0] + change[1] * change[1] + change[2] * change[2]) / magnitude);
+        }
+        smallest = std::min(smallest, magnitude);
+        largest = std::max(largest, magnitude);
+        for (int k = 0; k < 3; ++k) previous[k] = total[k];
+    }
+    printf("capsule slide: |F| %.4g..%.4g N, largest change per 10 um step %.3f %%\n", smallest, largest, 100.0 * worst);
+    assert_true(smallest > 0.0);
+    assert_true(worst < 0.05);
+}
+
 }  // namespace
 
 int main() {
@@ -338,6 +482,9 @@ int main() {
         cmocka_unit_test(test_resolved_contact_is_the_nodes_own),
         cmocka_unit_test(test_sliding_force_is_smooth),
         cmocka_unit_test(test_potential_is_smooth_along_paths),
+        cmocka_unit_test(test_small_capsule_lying_between_nodes_feels_the_law),
+        cmocka_unit_test(test_tilting_capsule_hands_over_smoothly),
+        cmocka_unit_test(test_sliding_capsule_force_is_smooth),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -2,6 +2,7 @@
 """Press a sphere into the top of a tetrahedral mesh, as a new user would, and print the force.
 
     python3 scripts/press_probe.py MESH SIZE RADIUS [--stiffness L] [--friction MU] [--plot PNG]
+                                   [--capsule HALF_LENGTH]
 
 MESH is a file under ../shared/meshes (or a path), scaled so that its largest extent is SIZE (m);
 RADIUS is the sphere's (m). Corotational, 5 kPa, nu 0.45, implicit Euler at 60 Hz, no gravity,
@@ -10,7 +11,8 @@ MU, default 0) starts touching the highest node and presses 1.5 cm down in 1 s, 
 while a haptic context renders it at 1 kHz (16-17 ticks per full step). Prints the mesh's surface
 edge lengths against the radius, the full model's and the rendered force every 10 steps, the step
 times, the count of SH_WARN_NOT_CONVERGED and the largest tick-to-tick change of the rendered
-force; with --plot, draws both forces against the tool's travel into PNG (needs matplotlib).
+force; with --plot, draws both forces against the tool's travel into PNG (needs matplotlib). With
+--capsule the tool is a capsule of that half length (m) lying along x instead of the sphere.
 Needs the library (SOFTHAP_LIBRARY) and bindings/python on PYTHONPATH.
 """
 
@@ -57,18 +59,22 @@ def plot(path, title, travel_full, full, travel_ticks, rendered):
     fig.savefig(path, dpi=120)
 
 
-def main(name, size, radius, stiffness, friction, plot_path):
+def main(name, size, radius, stiffness, friction, plot_path, half_length=None):
     mesh = load(name, size)
     x = mesh.nodes
     edges = surface_edges(mesh)
-    print("%s: %d tets, surface edges median %.1f mm (max %.1f), sphere radius %.1f mm"
+    print("%s: %d tets, surface edges median %.1f mm (max %.1f), tool radius %.1f mm"
           % (name, len(mesh.tets), 1e3 * np.median(edges), 1e3 * edges.max(), 1e3 * radius))
+    shape, orientation = dict(radius=radius), (1.0, 0.0, 0.0, 0.0)
+    if half_length is not None:  # lying along x: the local z axis turned onto x
+        orientation = (np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0)
+        shape.update(half_length=half_length, orientation=orientation)
     with softhap.World(gravity=(0, 0, 0)) as world:
         body = world.add_fem_body(mesh, model="corotational", young=5e3, poisson=0.45, integrator="implicit_euler")
         body.fix_nodes(np.flatnonzero(x[:, 2] < x[:, 2].min() + 0.015))
         top = x[np.argmax(x[:, 2])] + (0.0, 0.0, radius)
-        tool = world.add_tool("sphere", radius=radius, position=top, stiffness=stiffness, exponent=1.5,
-                              friction=friction)
+        tool = world.add_tool("sphere" if half_length is None else "capsule", position=top, stiffness=stiffness,
+                              exponent=1.5, friction=friction, **shape)
         haptic = world.add_haptic(tool, dt=1e-3)
         rendered, times, travel_ticks, travel_full, full = [], [], [], [], []
         steps = int(round((PRESS_TIME + HOLD_TIME) / STEP))
@@ -76,9 +82,9 @@ def main(name, size, radius, stiffness, friction, plot_path):
             ticks = 16 if step % 3 == 0 else 17
             for tick in range(ticks):
                 device = pose(top, (step + tick / ticks) * STEP)
-                rendered.append(np.linalg.norm(haptic.step(device).force))
+                rendered.append(np.linalg.norm(haptic.step(device, orientation).force))
                 travel_ticks.append(1e3 * (top - device)[2])
-            tool.set_pose(pose(top, (step + 1) * STEP))
+            tool.set_pose(pose(top, (step + 1) * STEP), orientation)
             start = time.perf_counter()
             world.step(STEP)
             times.append(1e3 * (time.perf_counter() - start))
@@ -106,5 +112,6 @@ if __name__ == "__main__":
     parser.add_argument("--stiffness", type=float, default=1e3)
     parser.add_argument("--friction", type=float, default=0.0)
     parser.add_argument("--plot")
+    parser.add_argument("--capsule", type=float, metavar="HALF_LENGTH")
     args = parser.parse_args()
-    main(args.mesh, args.size, args.radius, args.stiffness, args.friction, args.plot)
+    main(args.mesh, args.size, args.radius, args.stiffness, args.friction, args.plot, args.capsule)

@@ -32,14 +32,21 @@ struct ContactPoint {
                              ///< the normal, sign included
     double other_weights[3]; ///< kNodeFace: the other body's face nodes' shares (-w, the far
                              ///< side); their gradients are these times the normal
+    /// A collider's excess term mixed over its balls (BallMix): the term's stiffness among
+    /// its nodes, hessian[3a+r][3b+s] for nodes a, b and axes r, s (N/m), not yet projected
+    /// to positive semi-definite; the tangent takes it instead of stiffness g g^T. Else false.
+    bool has_hessian = false;
+    double hessian[9][9];
 };
 
-/// The weight of p's normal tangent, g_a g_b^T per pair of its nodes, in a matrix
+/// The weight of p's normal tangent, g_a g_b^T per pair of its nodes (a term with has_hessian:
+/// its damping's only), in a matrix
 /// stiffness_scale K + damping_scale D: a subtracted term (an edge's excess, whose stiffness is
 /// negative) is left out, so that the tangent stays positive semi-definite (and bounds the
 /// potential's Hessian from above).
 inline double normal_tangent_scale(const ContactPoint& p, double stiffness_scale, double damping_scale) {
-    const double scale = stiffness_scale * p.stiffness + damping_scale * p.damping;
+    // A term with its own Hessian takes that instead of k g g^T (positive_hessian).
+    const double scale = (p.has_hessian ? 0.0 : stiffness_scale * p.stiffness) + damping_scale * p.damping;
     return scale > 0.0 ? scale : 0.0;
 }
 

@@ -55,8 +55,11 @@ private:
 };
 
 // The blocks of one contact point's tangent among its own nodes (free_index >= 0) into system.
-void add_point_tangent(const ContactPoint& p, const PointTangent& tangent, const int32_t* free_index,
-                       SparseSystem& system) {
+void add_point_tangent(const ContactPoint& p, const PointTangent& tangent, double stiffness_scale,
+                       const int32_t* free_index, SparseSystem& system) {
+    double hessian[9][9];
+    const bool has_hessian = p.has_hessian && stiffness_scale != 0.0;
+    if (has_hessian) positive_hessian(p, hessian);
     for (int a = 0; a < p.count; ++a) {
         const int32_t fa = free_index[p.nodes[a]];
         if (fa < 0) continue;
@@ -65,6 +68,8 @@ void add_point_tangent(const ContactPoint& p, const PointTangent& tangent, const
             if (fb < 0) continue;
             double block[9];
             tangent.block(p.gradient[a], p.weights[a], p.gradient[b], p.weights[b], block);
+            for (int r = 0; r < 3 && has_hessian; ++r)
+                for (int s = 0; s < 3; ++s) block[3 * r + s] += stiffness_scale * hessian[3 * a + r][3 * b + s];
             system.add_block(fa, fb, block, 1.0);
         }
     }
@@ -76,11 +81,12 @@ void BodyContacts::add_tangent(const double* x, const double* v, double stiffnes
                                const int32_t* free_index, SparseSystem& system) const {
     const ScopedTimer timer(scratch_.evaluation_seconds);
     evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
-        add_point_tangent(p, PointTangent(p, *c.params, stiffness_scale, damping_scale), free_index, system);
+        add_point_tangent(p, PointTangent(p, *c.params, stiffness_scale, damping_scale), stiffness_scale, free_index,
+                          system);
     });
     evaluate_friction(v, [&](const ContactCandidate& c, const ContactPoint& p) {
         const PointTangent tangent(p, *c.params, stiffness_scale, damping_scale, friction_chord(c, p));
-        add_point_tangent(p, tangent, free_index, system);
+        add_point_tangent(p, tangent, stiffness_scale, free_index, system);
     });
 }
 

@@ -5,6 +5,8 @@
 #include "contact/hunt_crossley.hpp"
 #include "core/vec3.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 
@@ -223,6 +225,35 @@ void mix_term(const ContactPoint& term, double share, double coefficient, Contac
     mass += w;
 }
 
+// The Hessian of a mixed term over its nodes' 3 count coordinates: sum_i c_i H_i (each
+// ball's own, its stiffness k g g^T) + sum_ij (d c_i / d P_j) G_i G_j^T, G_i the gradient of
+// ball i's term (minus its node forces), with d c_i / d P_j from BallMix: the smooth maximum's
+// curvature within this term (across terms it is left out, as the tangent keeps to a term's
+// nodes).
+class MixedHessian {
+public:
+    void add(const ContactPoint& term, double coefficient, double curvature, double cross) {
+        double g[9] = {}, G[9] = {};
+        for (int a = 0; a < term.count; ++a)
+            for (int k = 0; k < 3; ++k) {
+                g[3 * a + k] = term.gradient[a][k];
+                G[3 * a + k] = -term.node_force[a][k];
+            }
+        for (int r = 0; r < 9; ++r) {
+            b_[r] += cross * G[r];
+            c_[r] += coefficient * G[r];
+            for (int s = 0; s < 9; ++s) k_[r][s] += coefficient * term.stiffness * g[r] * g[s] + curvature * G[r] * G[s];
+        }
+    }
+    void write(double out[9][9]) const {
+        for (int r = 0; r < 9; ++r)
+            for (int s = 0; s < 9; ++s) out[r][s] = k_[r][s] - b_[r] * c_[s] - c_[r] * b_[s];
+    }
+
+private:
+    double k_[9][9] = {}, b_[9] = {}, c_[9] = {};
+};
+
 // The mixed term of a collider of several balls (see BallMix).
 bool mixed_term(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
                 double weight, const BallMix& mix, ContactPoint& out) {
@@ -232,12 +263,16 @@ bool mixed_term(const Collider& collider, const StepLaw& law, const double* x, c
     for (int a = 0; a < count; ++a) out.nodes[a] = nodes[a];
     double mass = 0.0;
     bool any = false;
+    MixedHessian hessian;
     for_each_ball_term(collider, law, x, nodes, count, weight, [&](int i, const ContactPoint& term) {
         if (mix.share(i) == 0.0 && mix.coefficient(i) == 0.0) return;
         mix_term(term, mix.share(i), mix.coefficient(i), out, mass);
+        hessian.add(term, mix.coefficient(i), mix.curvature(i), mix.cross(i));
         any = true;
     });
     if (!any || !(mass > 0.0)) return false;
+    hessian.write(out.hessian);
+    out.has_hessian = true;
     out.depth /= mass;
     for (int k = 0; k < 3; ++k) out.point[k] /= mass;
     if (!normalize3(out.normal)) return false;
@@ -251,38 +286,40 @@ bool mixed_term(const Collider& collider, const StepLaw& law, const double* x, c
 }  // namespace
 
 void BallMix::reserve(int count) {
-    if (mix_.size() < 3 * static_cast<size_t>(count)) mix_.resize(3 * static_cast<size_t>(count));
+    if (mix_.size() < kFields * static_cast<size_t>(count)) mix_.resize(kFields * static_cast<size_t>(count));
 }
 
 void BallMix::begin(const Collider& collider) {
     count_ = collider.shape.ball_count();
-    for (int i = 0; i < count_; ++i) mix_[3 * static_cast<size_t>(i)] = 0.0;
+    for (int i = 0; i < count_; ++i) mix_[kFields * static_cast<size_t>(i)] = 0.0;
 }
 
 void BallMix::add(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
                   double weight) {
     for_each_ball_term(collider, law, x, nodes, count, weight,
-                       [&](int i, const ContactPoint& term) { mix_[3 * static_cast<size_t>(i)] += term.energy; });
+                       [&](int i, const ContactPoint& term) { mix_[kFields * static_cast<size_t>(i)] += term.energy; });
 }
 
 void BallMix::finish() {
-    // In units of the largest total, so that the powers stay in range.
+    // In units u_i = P_i / P_max of the largest total, so that the powers stay in range.
     double largest = 0.0;
-    for (int i = 0; i < count_; ++i) largest = std::max(largest, mix_[3 * static_cast<size_t>(i)]);
+    for (int i = 0; i < count_; ++i) largest = std::max(largest, mix_[kFields * static_cast<size_t>(i)]);
     double sum_p = 0.0, sum_p1 = 0.0;
     for (int i = 0; i < count_ && largest > 0.0; ++i) {
-        const double u = std::max(mix_[3 * static_cast<size_t>(i)], 0.0) / largest;
+        const double u = std::max(mix_[kFields * static_cast<size_t>(i)], 0.0) / largest;
         const double power = std::pow(u, kOrder);
         sum_p += power;
         sum_p1 += power * u;
     }
     const double mean = sum_p > 0.0 ? sum_p1 / sum_p : 0.0, p = kOrder;
     for (int i = 0; i < count_; ++i) {
-        double* m = &mix_[3 * static_cast<size_t>(i)];
+        double* m = &mix_[kFields * static_cast<size_t>(i)];
         const double u = largest > 0.0 ? std::max(m[0], 0.0) / largest : 0.0;
-        const double power = u > 0.0 ? std::pow(u, kOrder - 1) : 0.0;
-        m[1] = power > 0.0 ? power * u / sum_p : 0.0;
-        m[2] = power > 0.0 ? power * ((p + 1.0) * u - p * mean) / sum_p : 0.0;
+        const double power = u > 0.0 ? std::pow(u, kOrder - 2) : 0.0;  // u^(p-2)
+        m[1] = power > 0.0 ? power * u * u / sum_p : 0.0;
+        m[2] = power > 0.0 ? power * u * ((p + 1.0) * u - p * mean) / sum_p : 0.0;
+        m[3] = power > 0.0 ? p * power * ((p + 1.0) * u - (p - 1.0) * mean) / (sum_p * largest) : 0.0;
+        m[4] = power > 0.0 ? p * power * u / (sum_p * largest) : 0.0;
     }
 }
 
@@ -297,12 +334,25 @@ bool excess_shape_contact(const Collider& collider, const StepLaw& law, const do
     return found;
 }
 
+void positive_hessian(const ContactPoint& p, double out[9][9]) {
+    using Matrix9 = Eigen::Matrix<double, 9, 9>;
+    const Eigen::Map<const Eigen::Matrix<double, 9, 9, Eigen::RowMajor>> h(&p.hessian[0][0]);
+    const Matrix9 symmetric = 0.5 * (h + h.transpose());
+    const Eigen::SelfAdjointEigenSolver<Matrix9> eigen(symmetric);
+    const Matrix9 positive =
+        eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * eigen.eigenvectors().transpose();
+    for (int r = 0; r < 9; ++r)
+        for (int s = 0; s < 9; ++s) out[r][s] = positive(r, s);
+}
+
 void apply_excess_damping(const sh_contact_params& p, const double vrel[3], ContactPoint& out) {
     const double factor = std::max(0.0, 1.0 - 1.5 * p.damping * dot3(out.normal, vrel));
     for (int k = 0; k < 3; ++k) out.relative_velocity[k] = vrel[k];
     out.normal_force *= factor;
     out.net_normal_force *= factor;
     out.stiffness *= factor;
+    for (int r = 0; r < 9 && out.has_hessian; ++r)
+        for (int s = 0; s < 9; ++s) out.hessian[r][s] *= factor;
     for (int a = 0; a < out.count; ++a)
         for (int k = 0; k < 3; ++k) out.node_force[a][k] *= factor;
 }

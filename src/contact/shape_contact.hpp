@@ -90,11 +90,18 @@ public:
     void finish();
 
     /// Ball i's share s_i of its terms' energy and coefficient c_i of their gradients.
-    double share(int i) const { return mix_[3 * static_cast<size_t>(i) + 1]; }
-    double coefficient(int i) const { return mix_[3 * static_cast<size_t>(i) + 2]; }
+    double share(int i) const { return mix_[kFields * static_cast<size_t>(i) + 1]; }
+    double coefficient(int i) const { return mix_[kFields * static_cast<size_t>(i) + 2]; }
+
+    /// The Hessian of X over the totals, d c_i / d P_j = curvature_i delta_ij - (cross_i c_j +
+    /// c_i cross_j) (1/J): the smooth maximum's own curvature, which stiffens a lying capsule's
+    /// face against tilting (by far more than the law's curvature does).
+    double curvature(int i) const { return mix_[kFields * static_cast<size_t>(i) + 3]; }
+    double cross(int i) const { return mix_[kFields * static_cast<size_t>(i) + 4]; }
 
 private:
-    vec<double> mix_;  ///< per ball: total P_i, share s_i, coefficient c_i
+    static constexpr size_t kFields = 5;
+    vec<double> mix_;  ///< per ball: total P_i, share, coefficient, curvature, cross
     int count_ = 0;
 };
 
@@ -110,6 +117,10 @@ private:
 /// linear).
 bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
                           int count, double weight, const BallMix* mix, ContactPoint& out);
+
+/// out = p.hessian (p.has_hessian) projected to positive semi-definite: its negative
+/// eigenvalues set to 0, so that the tangent bounds the term's curvature from above.
+void positive_hessian(const ContactPoint& p, double out[9][9]);
 
 /// Explicit bodies: scales an excess term's forces by the Hunt-Crossley damping factor
 /// 1 + 3/2 alpha x' (at least 0) at the depth rate x' its point has at relative velocity vrel.

@@ -473,6 +473,47 @@ void test_sliding_capsule_force_is_smooth(void**) {
     assert_true(worst < 0.05);
 }
 
+// The stiffness the tangent takes for a capsule's mixed excess terms (their hessian, node
+// terms k g g^T) against the slope of the forces (central differences), over the vertical
+// motion of the patch's nodes under a capsule lying on a face between them, flat and tilted:
+// within 3 % of the largest entry. The smooth maximum's own curvature dominates it (it
+// stiffens the face against tilting), so a tangent of the law's curvature alone would be far
+// off (Newton then converged linearly).
+void test_capsule_tangent_matches_the_forces_slope(void**) {
+    const Patch flat = hexagon(0.01, 0.0);
+    const size_t n = flat.x.size() / 3;
+    for (const double tilt : {0.0, 0.002, 0.02}) {
+        const Collider c = lying_capsule(0.004, 0.002, 0.3, tilt, 0.001, 0.0004);
+        std::vector<double> tangent(n * n, 0.0), slope(n * n, 0.0);
+        each_term(c, flat, flat.x.data(), [&](const ContactPoint& q) {
+            for (int a = 0; a < q.count; ++a)
+                for (int b = 0; b < q.count; ++b)
+                    tangent[static_cast<size_t>(q.nodes[a]) * n + static_cast<size_t>(q.nodes[b])] +=
+                        q.has_hessian ? q.hessian[3 * a + 2][3 * b + 2] : q.stiffness * q.gradient[a][2] * q.gradient[b][2];
+        });
+        std::vector<double> x = flat.x;
+        const double h = 1e-8;
+        double largest = 0.0, gap = 0.0;
+        for (size_t j = 0; j < n; ++j) {
+            double total[3];
+            x[3 * j + 2] += h;
+            const std::vector<double> up = forces(c, flat, x.data(), total);
+            x[3 * j + 2] -= 2.0 * h;
+            const std::vector<double> down = forces(c, flat, x.data(), total);
+            x[3 * j + 2] += h;
+            for (size_t i = 0; i < n; ++i) slope[i * n + j] = -(up[3 * i + 2] - down[3 * i + 2]) / (2.0 * h);
+        }
+        for (size_t k = 0; k < n * n; ++k) {
+            largest = std::max(largest, std::fabs(slope[k]));
+            gap = std::max(gap, std::fabs(slope[k] - tangent[k]));
+        }
+        printf("capsule tilted %.3f rad: largest stiffness %.4g N/m, largest gap to the forces' slope %.3g N/m\n", tilt,
+               largest, gap);
+        assert_true(largest > 0.0);
+        assert_true(gap < 0.03 * largest);
+    }
+}
+
 }  // namespace
 
 int main() {
@@ -485,6 +526,7 @@ int main() {
         cmocka_unit_test(test_small_capsule_lying_between_nodes_feels_the_law),
         cmocka_unit_test(test_tilting_capsule_hands_over_smoothly),
         cmocka_unit_test(test_sliding_capsule_force_is_smooth),
+        cmocka_unit_test(test_capsule_tangent_matches_the_forces_slope),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "collision/aabb_tree.hpp"
+#include "contact/ball_mix.hpp"
 #include "contact/collider.hpp"
 #include "contact/shape_contact.hpp"
 #include "model/body.hpp"
@@ -186,6 +187,10 @@ private:
     /// If group's collider is made of several balls: sums its excess terms at x into
     /// scratch_.balls for the group's evaluation (BallMix).
     void mix_balls(const Group& group, const double* x) const;
+    /// The tangent of group's collider's BallMix across its terms (if it is made of several
+    /// balls) into system, times stiffness_scale.
+    void add_ball_mix_tangent(const Group& group, const double* x, double stiffness_scale, const int32_t* free_index,
+                              SparseSystem& system) const;
     /// Adds p's node forces (a collider's term) to the nodes' net push, listing each node once.
     void add_node_push(const ContactPoint& p) const;
     /// Calls emit(node, push) for each node with a net push since the last call, and clears it.

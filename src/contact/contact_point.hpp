@@ -32,11 +32,15 @@ struct ContactPoint {
                              ///< the normal, sign included
     double other_weights[3]; ///< kNodeFace: the other body's face nodes' shares (-w, the far
                              ///< side); their gradients are these times the normal
-    /// A collider's excess term mixed over its balls (BallMix): the term's stiffness among
-    /// its nodes, hessian[3a+r][3b+s] for nodes a, b and axes r, s (N/m), not yet projected
-    /// to positive semi-definite; the tangent takes it instead of stiffness g g^T. Else false.
+    /// A collider's excess term mixed over its balls (BallMix::term), for the haptic buffer's
+    /// bounds on its nodes' stiffness: its balls' law curvature among its nodes where positive,
+    /// hessian[3a+r][3b+s] for nodes a, b and axes r, s (N/m), and per node a bound (N/m) on
+    /// its rows of the smooth maximum's curvature within the term. The full model's tangent
+    /// takes neither, nor stiffness g g^T, but the mix's across its terms (BallMix::tangent).
+    /// Else has_hessian is false.
     bool has_hessian = false;
     double hessian[9][9];
+    double curvature_bound[3];
 };
 
 /// The weight of p's normal tangent, g_a g_b^T per pair of its nodes (a term with has_hessian:

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace sh {
 namespace {
@@ -55,11 +57,8 @@ private:
 };
 
 // The blocks of one contact point's tangent among its own nodes (free_index >= 0) into system.
-void add_point_tangent(const ContactPoint& p, const PointTangent& tangent, double stiffness_scale,
-                       const int32_t* free_index, SparseSystem& system) {
-    double hessian[9][9];
-    const bool has_hessian = p.has_hessian && stiffness_scale != 0.0;
-    if (has_hessian) positive_hessian(p, hessian);
+void add_point_tangent(const ContactPoint& p, const PointTangent& tangent, const int32_t* free_index,
+                       SparseSystem& system) {
     for (int a = 0; a < p.count; ++a) {
         const int32_t fa = free_index[p.nodes[a]];
         if (fa < 0) continue;
@@ -68,8 +67,6 @@ void add_point_tangent(const ContactPoint& p, const PointTangent& tangent, doubl
             if (fb < 0) continue;
             double block[9];
             tangent.block(p.gradient[a], p.weights[a], p.gradient[b], p.weights[b], block);
-            for (int r = 0; r < 3 && has_hessian; ++r)
-                for (int s = 0; s < 3; ++s) block[3 * r + s] += stiffness_scale * hessian[3 * a + r][3 * b + s];
             system.add_block(fa, fb, block, 1.0);
         }
     }
@@ -81,12 +78,46 @@ void BodyContacts::add_tangent(const double* x, const double* v, double stiffnes
                                const int32_t* free_index, SparseSystem& system) const {
     const ScopedTimer timer(scratch_.evaluation_seconds);
     evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
-        add_point_tangent(p, PointTangent(p, *c.params, stiffness_scale, damping_scale), stiffness_scale, free_index,
-                          system);
+        add_point_tangent(p, PointTangent(p, *c.params, stiffness_scale, damping_scale), free_index, system);
     });
     evaluate_friction(v, [&](const ContactCandidate& c, const ContactPoint& p) {
         const PointTangent tangent(p, *c.params, stiffness_scale, damping_scale, friction_chord(c, p));
-        add_point_tangent(p, tangent, stiffness_scale, free_index, system);
+        add_point_tangent(p, tangent, free_index, system);
+    });
+    if (stiffness_scale == 0.0) return;
+    if (!std::getenv("NO_MIX_TANGENT")) for (const Group& group : groups_) add_ball_mix_tangent(group, x, stiffness_scale, free_index, system);
+}
+
+void BodyContacts::add_ball_mix_tangent(const Group& group, const double* x, double stiffness_scale,
+                                        const int32_t* free_index, SparseSystem& system) const {
+    if (group.end <= group.begin) return;
+    const Collider* collider = candidates_[static_cast<size_t>(group.begin)].collider;
+    if (!collider || collider->shape.ball_count() < 2) return;
+    mix_balls(group, x);
+    BallMix& mix = scratch_.balls;
+    mix.begin_tangent();
+    for (int32_t i = group.begin; i < group.end; ++i) {
+        const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
+        if (c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kEdgeShape)
+            mix.add_tangent_term(*c.collider, step_law(c), x, c.face, c.kind == ContactCandidate::kFaceShape ? 3 : 2,
+                                 c.excess_weight);
+    }
+    // A block between nodes that share no element has no place in the system: it goes onto
+    // both nodes' own blocks as its norm times the identity, which bounds it from above.
+    mix.tangent([&](int32_t a, int32_t b, const double* block) {
+        const int32_t fa = free_index[a], fb = free_index[b];
+        if (fa < 0 || fb < 0) return;
+        if (fa == fb || system.has_block(fa, fb)) {
+            system.add_block(fa, fb, block, stiffness_scale);
+            return;
+        }
+        if (std::getenv("DROP_OUT")) return;
+        if (std::getenv("LUMP_DEBUG")) { double q = 0; for (int k = 0; k < 9; ++k) q += block[k] * block[k]; std::fprintf(stderr, "lump %d %d %.3g\n", a, b, std::sqrt(q)); }
+        double squares = 0.0;
+        for (int k = 0; k < 9; ++k) squares += block[k] * block[k];
+        const double bound[9] = {std::sqrt(squares), 0.0, 0.0, 0.0, std::sqrt(squares), 0.0, 0.0, 0.0, std::sqrt(squares)};
+        system.add_block(fa, fa, bound, stiffness_scale);
+        system.add_block(fb, fb, bound, stiffness_scale);
     });
 }
 

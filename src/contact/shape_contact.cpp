@@ -1,11 +1,9 @@
 #include "contact/shape_contact.hpp"
 
-#include "collision/ball_excess.hpp"
-#include "collision/unit_vector.hpp"
+#include "contact/ball_mix.hpp"
+#include "contact/ball_terms.hpp"
 #include "contact/hunt_crossley.hpp"
 #include "core/vec3.hpp"
-
-#include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>
@@ -35,55 +33,6 @@ bool node_shape_contact(const Collider& collider, const double* x, int32_t node,
 
 namespace {
 
-// The step's Hunt-Crossley law as the potential the excess maximises.
-class StepLawPotential final : public DepthPotential {
-public:
-    StepLawPotential(const sh_contact_params& params, const StepLaw& law) : params_(params), law_(law) {}
-    double energy(double depth) const override { return hunt_crossley_step_energy(params_, law_, depth); }
-    double force(double depth) const override { return hunt_crossley_step(params_, law_, depth).force; }
-    double stiffness(double depth) const override { return hunt_crossley_step(params_, law_, depth).stiffness; }
-
-private:
-    const sh_contact_params& params_;
-    const StepLaw& law_;
-};
-
-// Where every node of a feature is in the collider, the mesh resolves the contact there and
-// its node terms carry it: the feature's excess (then only the interpolant's own small error,
-// whose maximiser wanders with every node's motion and slows Newton) fades out as its
-// shallowest nodes come in: factor 1 - prod_a s(d_a), s a C^1 smoothstep from 0 at depth 0 to
-// 1 at the band. A feature with a node outside keeps its whole excess, so a tool smaller than
-// the triangles is held exactly as the potential says.
-class ResolvedFade {
-public:
-    explicit ResolvedFade(double band) : band_(band) {}
-    void add_node(double depth) {
-        const double t = std::min(std::max(depth / band_, 0.0), 1.0);
-        step_[count_] = t * t * (3.0 - 2.0 * t);
-        slope_[count_] = 6.0 * t * (1.0 - t) / band_;
-        ++count_;
-    }
-    /// Multiplies the factor (and its slopes) by a constant weight.
-    void scale(double weight) { weight_ = weight; }
-    double factor() const {
-        double product = 1.0;
-        for (int a = 0; a < count_; ++a) product *= step_[a];
-        return weight_ * (1.0 - product);
-    }
-    /// d factor / d depth of node a.
-    double slope(int a) const {
-        double product = -weight_ * slope_[a];
-        for (int b = 0; b < count_; ++b)
-            if (b != a) product *= step_[b];
-        return product;
-    }
-
-private:
-    double band_, weight_ = 1.0;
-    double step_[3] = {}, slope_[3] = {};
-    int count_ = 0;
-};
-
 }  // namespace
 
 double excess_weight(const Collider& collider, double size) {
@@ -93,256 +42,15 @@ double excess_weight(const Collider& collider, double size) {
 
 double resolved_band(const Collider& collider) { return 0.02 * collider.shape.inner_radius(); }
 
-namespace {
-
-// The feature's bounding sphere: centre and radius (m).
-double feature_bounds(const double* const points[3], int count, double centre[3]) {
-    for (int k = 0; k < 3; ++k) {
-        centre[k] = 0.0;
-        for (int a = 0; a < count; ++a) centre[k] += points[a][k] / count;
-    }
-    double radius = 0.0;
-    for (int a = 0; a < count; ++a) {
-        double d[3];
-        sub3(points[a], centre, d);
-        radius = std::max(radius, norm3(d));
-    }
-    return radius;
-}
-
-// A node's depth (m) in the ball at centre, and its push's direction.
-double ball_depth(const Collider& collider, const double centre[3], const double* p, double normal[3]) {
-    sub3(p, centre, normal);
-    const double dist = norm3(normal);
-    if (dist > 1e-12 * collider.shape.ball_radius()) {
-        for (int k = 0; k < 3; ++k) normal[k] /= dist;
-    } else {  // at the centre: any direction; the collider's local x axis
-        const double ex[3] = {1.0, 0.0, 0.0};
-        collider.pose.rotate(ex, normal);
-    }
-    return collider.shape.ball_radius() - dist;
-}
-
-// The excess term of the ball at centre over the feature (points, nodes, count), as
-// excess_shape_contact describes it for a sphere: its nodes' depths are the ball's.
-bool ball_term(const Collider& collider, const DepthPotential& psi, const double* const points[3], const int32_t* nodes,
-               int count, double weight, const double centre[3], ContactPoint& out) {
-    LocalSimplex s;
-    s.count = count;
-    double node_push[3][3], node_normal[3][3];
-    ResolvedFade fade(resolved_band(collider));
-    for (int a = 0; a < count; ++a) {
-        const double depth = ball_depth(collider, centre, points[a], node_normal[a]);
-        const bool inside = depth > 0.0;
-        s.energy[a] = inside ? psi.energy(depth) : 0.0;
-        const double force = inside ? psi.force(depth) : 0.0;
-        for (int k = 0; k < 3; ++k) {
-            s.p[a][k] = points[a][k];
-            node_push[a][k] = force * node_normal[a][k];
-        }
-        fade.add_node(inside ? depth : 0.0);
-    }
-    if (!(fade.factor() > 0.0)) return false;
-    fade.scale(weight);
-    const LocalExcess e = ball_excess(s, psi, centre, collider.shape.ball_radius());
-    if (!(e.value > 0.0) || !std::isfinite(e.value)) return false;
-    out.depth = e.depth;
-    for (int k = 0; k < 3; ++k) {
-        out.normal[k] = e.n[k];
-        out.point[k] = e.x[k];
-    }
-    set_contact_nodes(count, nodes, e.w, out);
-    const double sign = count == 2 ? -1.0 : 1.0;  // faces add, edges subtract
-    const double scale = sign * fade.factor();
-    out.law_scale = sign;
-    out.energy = scale * e.value;
-    out.normal_force = scale * psi.force(e.depth);
-    // For the tangent: the law's curvature at the maximiser times the excess's share of the
-    // law's energy there, which vanishes with the excess (where the law's own curvature does
-    // not, as for a linear law at its onset).
-    const double law_energy = psi.energy(e.depth);
-    out.stiffness = scale * psi.stiffness(e.depth) * (law_energy > 0.0 ? std::min(e.value / law_energy, 1.0) : 0.0);
-    out.damping = out.friction = out.friction_normal = 0.0;
-    out.net_normal_force = 0.0;
-    for (int k = 0; k < 3; ++k) out.relative_velocity[k] = 0.0;
-    // Node a: w_a (push at the maximiser - its own push), the gradient of the excess, and
-    // the fade's: -excess d(factor)/dx_a, along the node's push.
-    for (int a = 0; a < count; ++a) {
-        const double fade_slope = sign * e.value * fade.slope(a);
-        for (int k = 0; k < 3; ++k) {
-            out.node_force[a][k] = scale * e.w[a] * (e.push[k] - node_push[a][k]) + fade_slope * node_normal[a][k];
-            // For the tangent, stiffness times gradient gradient^T: the law's curvature at the
-            // maximiser through its weights (the positive part of the term's Hessian; the
-            // nodes' own curvature it subtracts, the maximiser's motion and the fade are left
-            // to the line search). Not the node forces over the law's force: that ratio grows
-            // without bound where the maximiser is shallow and its nodes deep.
-            out.net_normal_force += out.node_force[a][k] * out.normal[k];
-        }
-    }
-    return true;
-}
-
-// Calls visit(i, term) for each ball i of the collider with an excess term over the feature.
-template <class Visit>
-void for_each_ball_term(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
-                        double weight, Visit&& visit) {
-    if (collider.shape.ball_count() == 0 || !(weight > 0.0)) return;
-    const StepLawPotential psi(collider.params, law);
-    const double* points[3];
-    for (int a = 0; a < count; ++a) points[a] = at(x, nodes[a]);
-    double centre[3];
-    const double reach = feature_bounds(points, count, centre) + collider.shape.ball_radius();
-    int first = 0, last = -1;
-    collider.shape.balls_near(collider.pose, centre, reach, first, last);
-    for (int i = first; i <= last; ++i) {
-        double ball[3];
-        collider.shape.ball_centre(collider.pose, i, ball);
-        ContactPoint term;
-        if (ball_term(collider, psi, points, nodes, count, weight, ball, term)) visit(i, term);
-    }
-}
-
-// Adds `share` of term's energy and geometry, and `coefficient` of its forces, to out;
-// geometry weighs by |share * energy| (`mass` keeps the sum).
-void mix_term(const ContactPoint& term, double share, double coefficient, ContactPoint& out, double& mass) {
-    const double w = std::fabs(share * term.energy);
-    out.energy += share * term.energy;
-    out.stiffness += share * term.stiffness;
-    out.normal_force += coefficient * term.normal_force;
-    out.net_normal_force += coefficient * term.net_normal_force;
-    out.depth += w * term.depth;
-    for (int k = 0; k < 3; ++k) {
-        out.point[k] += w * term.point[k];
-        out.normal[k] += w * term.normal[k];
-    }
-    for (int a = 0; a < term.count; ++a) {
-        out.weights[a] += w * term.weights[a];
-        for (int k = 0; k < 3; ++k) {
-            out.node_force[a][k] += coefficient * term.node_force[a][k];
-            out.gradient[a][k] += w * term.gradient[a][k];
-        }
-    }
-    mass += w;
-}
-
-// The Hessian of a mixed term over its nodes' 3 count coordinates: sum_i c_i H_i (each
-// ball's own, its stiffness k g g^T) + sum_ij (d c_i / d P_j) G_i G_j^T, G_i the gradient of
-// ball i's term (minus its node forces), with d c_i / d P_j from BallMix: the smooth maximum's
-// curvature within this term (across terms it is left out, as the tangent keeps to a term's
-// nodes).
-class MixedHessian {
-public:
-    void add(const ContactPoint& term, double coefficient, double curvature, double cross) {
-        double g[9] = {}, G[9] = {};
-        for (int a = 0; a < term.count; ++a)
-            for (int k = 0; k < 3; ++k) {
-                g[3 * a + k] = term.gradient[a][k];
-                G[3 * a + k] = -term.node_force[a][k];
-            }
-        for (int r = 0; r < 9; ++r) {
-            b_[r] += cross * G[r];
-            c_[r] += coefficient * G[r];
-            for (int s = 0; s < 9; ++s) k_[r][s] += coefficient * term.stiffness * g[r] * g[s] + curvature * G[r] * G[s];
-        }
-    }
-    void write(double out[9][9]) const {
-        for (int r = 0; r < 9; ++r)
-            for (int s = 0; s < 9; ++s) out[r][s] = k_[r][s] - b_[r] * c_[s] - c_[r] * b_[s];
-    }
-
-private:
-    double k_[9][9] = {}, b_[9] = {}, c_[9] = {};
-};
-
-// The mixed term of a collider of several balls (see BallMix).
-bool mixed_term(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
-                double weight, const BallMix& mix, ContactPoint& out) {
-    out = ContactPoint{};
-    out.count = count;
-    out.law_scale = count == 2 ? -1.0 : 1.0;
-    for (int a = 0; a < count; ++a) out.nodes[a] = nodes[a];
-    double mass = 0.0;
-    bool any = false;
-    MixedHessian hessian;
-    for_each_ball_term(collider, law, x, nodes, count, weight, [&](int i, const ContactPoint& term) {
-        if (mix.share(i) == 0.0 && mix.coefficient(i) == 0.0) return;
-        mix_term(term, mix.share(i), mix.coefficient(i), out, mass);
-        hessian.add(term, mix.coefficient(i), mix.curvature(i), mix.cross(i));
-        any = true;
-    });
-    if (!any || !(mass > 0.0)) return false;
-    hessian.write(out.hessian);
-    out.has_hessian = true;
-    out.depth /= mass;
-    for (int k = 0; k < 3; ++k) out.point[k] /= mass;
-    if (!normalize3(out.normal)) return false;
-    for (int a = 0; a < count; ++a) {
-        out.weights[a] /= mass;
-        for (int k = 0; k < 3; ++k) out.gradient[a][k] /= mass;
-    }
-    return true;
-}
-
-}  // namespace
-
-void BallMix::reserve(int count) {
-    if (mix_.size() < kFields * static_cast<size_t>(count)) mix_.resize(kFields * static_cast<size_t>(count));
-}
-
-void BallMix::begin(const Collider& collider) {
-    count_ = collider.shape.ball_count();
-    for (int i = 0; i < count_; ++i) mix_[kFields * static_cast<size_t>(i)] = 0.0;
-}
-
-void BallMix::add(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
-                  double weight) {
-    for_each_ball_term(collider, law, x, nodes, count, weight,
-                       [&](int i, const ContactPoint& term) { mix_[kFields * static_cast<size_t>(i)] += term.energy; });
-}
-
-void BallMix::finish() {
-    // In units u_i = P_i / P_max of the largest total, so that the powers stay in range.
-    double largest = 0.0;
-    for (int i = 0; i < count_; ++i) largest = std::max(largest, mix_[kFields * static_cast<size_t>(i)]);
-    double sum_p = 0.0, sum_p1 = 0.0;
-    for (int i = 0; i < count_ && largest > 0.0; ++i) {
-        const double u = std::max(mix_[kFields * static_cast<size_t>(i)], 0.0) / largest;
-        const double power = std::pow(u, kOrder);
-        sum_p += power;
-        sum_p1 += power * u;
-    }
-    const double mean = sum_p > 0.0 ? sum_p1 / sum_p : 0.0, p = kOrder;
-    for (int i = 0; i < count_; ++i) {
-        double* m = &mix_[kFields * static_cast<size_t>(i)];
-        const double u = largest > 0.0 ? std::max(m[0], 0.0) / largest : 0.0;
-        const double power = u > 0.0 ? std::pow(u, kOrder - 2) : 0.0;  // u^(p-2)
-        m[1] = power > 0.0 ? power * u * u / sum_p : 0.0;
-        m[2] = power > 0.0 ? power * u * ((p + 1.0) * u - p * mean) / sum_p : 0.0;
-        m[3] = power > 0.0 ? p * power * ((p + 1.0) * u - (p - 1.0) * mean) / (sum_p * largest) : 0.0;
-        m[4] = power > 0.0 ? p * power * u / (sum_p * largest) : 0.0;
-    }
-}
-
 bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
                           int count, double weight, const BallMix* mix, ContactPoint& out) {
-    if (collider.shape.ball_count() > 1) return mix && mixed_term(collider, law, x, nodes, count, weight, *mix, out);
+    if (collider.shape.ball_count() > 1) return mix && mix->term(collider, law, x, nodes, count, weight, out);
     bool found = false;
     for_each_ball_term(collider, law, x, nodes, count, weight, [&](int, const ContactPoint& term) {
         out = term;
         found = true;
     });
     return found;
-}
-
-void positive_hessian(const ContactPoint& p, double out[9][9]) {
-    using Matrix9 = Eigen::Matrix<double, 9, 9>;
-    const Eigen::Map<const Eigen::Matrix<double, 9, 9, Eigen::RowMajor>> h(&p.hessian[0][0]);
-    const Matrix9 symmetric = 0.5 * (h + h.transpose());
-    const Eigen::SelfAdjointEigenSolver<Matrix9> eigen(symmetric);
-    const Matrix9 positive =
-        eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * eigen.eigenvectors().transpose();
-    for (int r = 0; r < 9; ++r)
-        for (int s = 0; s < 9; ++s) out[r][s] = positive(r, s);
 }
 
 void apply_excess_damping(const sh_contact_params& p, const double vrel[3], ContactPoint& out) {

@@ -7,7 +7,6 @@
 #include "contact/collider.hpp"
 #include "contact/contact_point.hpp"
 #include "contact/hunt_crossley.hpp"
-#include "core/memory.hpp"
 
 #include <softhap/softhap.h>
 
@@ -15,6 +14,8 @@
 #include <cstdint>
 
 namespace sh {
+
+class BallMix;
 
 /// The share of node a's row in contact p's stiffness k g g^T, per unit k: |g_a| sum_b |g_b|
 /// (Gershgorin's bound on the row), for the stable step of an explicit integrator.
@@ -54,57 +55,6 @@ double excess_weight(const Collider& collider, double size);
 /// (the mesh then resolves the contact there): a fiftieth of the collider's inner radius.
 double resolved_band(const Collider& collider);
 
-/// The excess of a collider made of several balls (Shape::ball_count: a capsule is the balls
-/// along its axis). Each ball i has the excess terms of a sphere over every surface edge and
-/// triangle, whose signed sum over the surface is the ball's own excess there, P_i (with its
-/// own nodes' depths in their interpolants and fades). The collider's excess is their Lehmer
-/// mean of order p = kOrder,
-///   X = sum_i P_i^(p+1) / sum_i P_i^p   (over P_i > 0),
-/// a smooth maximum: equal to the P_i where they are equal (a capsule lying on a face: the
-/// balls along its ridge reach equally deep, and the face's nodes share the ridge's push
-/// evenly), equal to the only ball that reaches, otherwise between their mean and their
-/// largest, within about 11 % of the largest as a capsule tilts onto one end. The exact
-/// maximum would make its maximiser jump from one end of a lying capsule to the other as
-/// the face tilts, and the forces on the face's nodes with it. Each feature's term takes
-/// sum_i s_i T_i of its balls' terms T_i as its energy, s_i = P_i^p / sum_j P_j^p, and
-/// sum_i c_i grad T_i as its gradient, c_i = P_i^(p-1) ((p+1) P_i - p X) / sum_j P_j^p: the
-/// terms sum to X and their forces to X's gradient. So a collider of several balls takes
-/// two passes over its terms per evaluation: add() for every term, finish(), then
-/// excess_shape_contact.
-class BallMix {
-public:
-    static constexpr int kOrder = 8;
-
-    /// Makes room for count balls (allocates if there is less).
-    void reserve(int count);
-
-    /// Starts a sum over collider's balls (the room reserved must hold them).
-    void begin(const Collider& collider);
-
-    /// Adds the ball terms of the edge (count 2) or triangle (count 3) nodes at positions x
-    /// (see excess_shape_contact) to the balls' totals.
-    void add(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
-             double weight);
-
-    /// Computes the shares and coefficients from the totals.
-    void finish();
-
-    /// Ball i's share s_i of its terms' energy and coefficient c_i of their gradients.
-    double share(int i) const { return mix_[kFields * static_cast<size_t>(i) + 1]; }
-    double coefficient(int i) const { return mix_[kFields * static_cast<size_t>(i) + 2]; }
-
-    /// The Hessian of X over the totals, d c_i / d P_j = curvature_i delta_ij - (cross_i c_j +
-    /// c_i cross_j) (1/J): the smooth maximum's own curvature, which stiffens a lying capsule's
-    /// face against tilting (by far more than the law's curvature does).
-    double curvature(int i) const { return mix_[kFields * static_cast<size_t>(i) + 3]; }
-    double cross(int i) const { return mix_[kFields * static_cast<size_t>(i) + 4]; }
-
-private:
-    static constexpr size_t kFields = 5;
-    vec<double> mix_;  ///< per ball: total P_i, share, coefficient, curvature, cross
-    int count_ = 0;
-};
-
 /// The excess term of the surface edge (count 2) or outward triangle (count 3) nodes at
 /// positions x under law (the step's, or the law at rest): fills out's geometry at the
 /// maximiser (depth, point, weights, normal), its signed energy and law_scale (-1 for an
@@ -117,10 +67,6 @@ private:
 /// linear).
 bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
                           int count, double weight, const BallMix* mix, ContactPoint& out);
-
-/// out = p.hessian (p.has_hessian) projected to positive semi-definite: its negative
-/// eigenvalues set to 0, so that the tangent bounds the term's curvature from above.
-void positive_hessian(const ContactPoint& p, double out[9][9]);
 
 /// Explicit bodies: scales an excess term's forces by the Hunt-Crossley damping factor
 /// 1 + 3/2 alpha x' (at least 0) at the depth rate x' its point has at relative velocity vrel.

@@ -6,7 +6,7 @@
 #pragma once
 
 #include "contact/collider.hpp"
-#include "contact/shape_contact.hpp"
+#include "contact/ball_mix.hpp"
 #include "core/memory.hpp"
 #include "haptic/buffer.hpp"
 #include "haptic/force_filter.hpp"

@@ -310,15 +310,16 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         else apply_excess_damping(law, vrel, p);
         // The term's normal tangent (the full model's, contact_tangent.cpp), k g g^T with g its
         // gradients, bounded by a block diagonal: node a gets k |g_a| (sum_b |g_b|) (its
-        // stiffness_share) along g_a (Cauchy-Schwarz), for integrate(). A term with its own
-        // Hessian H gives node a sum_b |H_ab| (Gershgorin) along the term's normal.
+        // stiffness_share) along g_a (Cauchy-Schwarz), for integrate(). A term mixed over a
+        // tool's balls gives node a its Gershgorin bounds (its hessian's sum_b |H_ab| and its
+        // curvature_bound) along the term's normal.
         const double stiffness = normal_tangent_scale(p, 1.0, 0.0), damping = normal_tangent_scale(p, 0.0, 1.0);
         for (int a = 0; a < p.count; ++a) {
             const double length = norm3(p.gradient[a]), share = stiffness_share(p, a);
             double direction[3] = {0.0, 0.0, 0.0};
             if (length > 0.0)
                 for (int k = 0; k < 3; ++k) direction[k] = p.gradient[a][k] / length;
-            const double own = p.has_hessian ? hessian_row_bound(p, a) : 0.0;
+            const double own = p.has_hessian ? hessian_row_bound(p, a) + p.curvature_bound[a] : 0.0;
             add_contact_tangent(p.nodes[a], p.has_hessian ? p.normal : direction, stiffness * share + own,
                                 damping * share);
             for (int k = 0; k < 3; ++k) {

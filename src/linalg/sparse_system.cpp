@@ -249,6 +249,14 @@ void SparseSystem::add_block(int32_t free_i, int32_t free_j, const double* B, do
     }
 }
 
+bool SparseSystem::has_block(int32_t free_i, int32_t free_j) const {
+    const int32_t row = 3 * std::min(free_i, free_j), column = 3 * std::max(free_i, free_j);
+    const int32_t* first = row_indices_.data() + column_starts_[static_cast<size_t>(column)];
+    const int32_t* last = row_indices_.data() + column_starts_[static_cast<size_t>(column) + 1];
+    const int32_t* slot = std::lower_bound(first, last, row);
+    return slot != last && *slot == row;
+}
+
 void SparseSystem::add_diagonal(const double* diag, double scale) {
     double* v = values_.data();
     const int32_t* cs = column_starts_.data();

@@ -42,6 +42,8 @@ public:
     /// transpose to (J, I): only the stored upper triangle is touched. The nodes must share an
     /// element (or be equal); otherwise throws SH_ERR_INTERNAL.
     void add_block(int32_t free_i, int32_t free_j, const double* B, double scale);
+    /// True if the pattern holds the block of free nodes I and J (they share an element).
+    bool has_block(int32_t free_i, int32_t free_j) const;
     /// Adds diag[d] to diagonal entry d, for d < dof_count() (lumped mass, per-DOF terms).
     void add_diagonal(const double* diag, double scale);
     const vec<int32_t>& column_starts() const { return column_starts_; }  ///< dof_count()+1

@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace sh {
 namespace {
@@ -129,6 +131,7 @@ void solve_problem(NewtonProblem& problem, const double g[3], const sh_static_de
                 r = out_of_balance(problem, g, factor, residual) / load_norm;
             }
             ++report.iterations;
+            if (std::getenv("STATIC_DEBUG")) std::fprintf(stderr, "it %d r %.3e alpha %.3g accepted %d slope %.3e\n", report.iterations, r, 2 * alpha, accepted ? 1 : 0, slope);
             if (report.history_count < SH_STATIC_HISTORY) report.residual_history[report.history_count++] = r;
             converged = r <= std::max(def.tolerance, floor);
             require(std::isfinite(r), SH_ERR_SOLVER, "the Newton iteration produced a non-finite state");

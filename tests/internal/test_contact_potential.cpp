@@ -5,6 +5,7 @@
 // laws, the energy follows the forces' work along random paths, and a sphere sliding at constant height over a curved patch feels a force that
 // changes smoothly. Capsules, boxes and convex hulls have node terms only (their forces are
 // still checked against the potential).
+#include "contact/ball_mix.hpp"
 #include "contact/collider.hpp"
 #include "contact/hunt_crossley.hpp"
 #include "contact/shape_contact.hpp"
@@ -302,6 +303,7 @@ void test_sliding_force_is_smooth(void**) {
 // path matches the forces' work (midpoint rule) to 1 %, so there is no jump or kink that a
 // line search would trip on.
 void test_potential_is_smooth_along_paths(void**) {
+    for (const sh_shape_kind kind : {SH_SHAPE_SPHERE, SH_SHAPE_CAPSULE})
     for (const double radius : {0.001, 0.003})
         for (const double exponent : {1.0, 1.5}) {
             Patch cap = hexagon(0.0025, 0.0003);
@@ -310,7 +312,7 @@ void test_potential_is_smooth_along_paths(void**) {
             for (double& v : direction) v = (rand() / static_cast<double>(RAND_MAX) - 0.5) * 1e-3;
             for (double& v : cap.x) v += (rand() / static_cast<double>(RAND_MAX) - 0.5) * 2e-4;
             const double position[3] = {0.0003, 0.0002, 0.0003 + radius - 0.6 * radius};
-            Collider c = make_collider(SH_SHAPE_SPHERE, position, radius);
+            Collider c = make_collider(kind, position, radius);
             c.params.exponent = exponent;
             const int steps = 4000;
             std::vector<double> x = cap.x;
@@ -328,8 +330,8 @@ void test_potential_is_smooth_along_paths(void**) {
                 largest = std::max(largest, std::fabs(work));
                 previous = e;
             }
-            printf("sphere %.0f mm on 2.5 mm triangles, n %.1f: largest step energy %.3g J, largest gap to the work %.3g J\n", 1e3 * radius,
-                   exponent, largest, worst);
+            printf("%s %.0f mm on 2.5 mm triangles, n %.1f: largest step energy %.3g J, largest gap to the work %.3g J\n",
+                   kind == SH_SHAPE_SPHERE ? "sphere" : "capsule", 1e3 * radius, exponent, largest, worst);
             assert_true(largest > 0.0);
             assert_true(worst < 0.01 * largest);
         }
@@ -473,23 +475,45 @@ void test_sliding_capsule_force_is_smooth(void**) {
     assert_true(worst < 0.05);
 }
 
-// The stiffness the tangent takes for a capsule's mixed excess terms (their hessian, node
-// terms k g g^T) against the slope of the forces (central differences), over the vertical
-// motion of the patch's nodes under a capsule lying on a face between them, flat and tilted:
-// within 3 % of the largest entry. The smooth maximum's own curvature dominates it (it
-// stiffens the face against tilting), so a tangent of the law's curvature alone would be far
-// off (Newton then converged linearly).
+// The vertical stiffness the full model's tangent takes from a capsule (its node terms
+// k g g^T, and the mix's tangent across its excess terms, BallMix::tangent) over the nodes of
+// a patch under a capsule lying between them, against the slope of the forces (central
+// differences): over a face, flat and tilted, across an edge, and over the faces around a node
+// it does not reach. Within 3 % of the largest entry. The smooth maximum's own curvature
+// dominates it (it stiffens a face against tilting): a tangent of the law's curvature alone is
+// far off, and Newton then converges linearly.
 void test_capsule_tangent_matches_the_forces_slope(void**) {
-    const Patch flat = hexagon(0.01, 0.0);
-    const size_t n = flat.x.size() / 3;
-    for (const double tilt : {0.0, 0.002, 0.02}) {
-        const Collider c = lying_capsule(0.004, 0.002, 0.3, tilt, 0.001, 0.0004);
+    const double poses[7][6] = {{0.004, 0.002, 0.3, 0.0, 0.0, 0.01},
+                                {0.004, 0.002, 0.3, 0.002, 0.0, 0.01},
+                                {0.004, 0.002, 0.3, 0.02, 0.0, 0.01},
+                                {0.005, 0.0, M_PI / 2, 0.0, 0.0, 0.01},
+                                {0.0, 0.0016, 0.0, 0.0, 0.0, 0.01},
+                                {0.0005, 0.0003, 0.4, 0.0, 0.0008, 0.003},
+                                {0.0005, 0.0003, 0.4, 0.3, 0.0008, 0.003}};
+    for (const auto& pose : poses) {
+        const Patch flat = hexagon(pose[5], pose[4]);
+        const size_t n = flat.x.size() / 3;
+        const Collider c = lying_capsule(pose[0], pose[1], pose[2], pose[3], 0.001, 0.0004 + pose[4]);
         std::vector<double> tangent(n * n, 0.0), slope(n * n, 0.0);
         each_term(c, flat, flat.x.data(), [&](const ContactPoint& q) {
             for (int a = 0; a < q.count; ++a)
                 for (int b = 0; b < q.count; ++b)
                     tangent[static_cast<size_t>(q.nodes[a]) * n + static_cast<size_t>(q.nodes[b])] +=
-                        q.has_hessian ? q.hessian[3 * a + 2][3 * b + 2] : q.stiffness * q.gradient[a][2] * q.gradient[b][2];
+                        q.has_hessian ? 0.0 : q.stiffness * q.gradient[a][2] * q.gradient[b][2];
+        });
+        const sh::StepLaw law = sh::hunt_crossley_step_law(c.params, 0.0, 0.0);
+        sh::BallMix mix;
+        mix.reserve(c.shape.ball_count());
+        mix.begin(c);
+        for (size_t e = 0; e < flat.edges.size(); e += 2) mix.add(c, law, flat.x.data(), &flat.edges[e], 2, 1.0);
+        for (size_t t = 0; t < flat.tris.size(); t += 3) mix.add(c, law, flat.x.data(), &flat.tris[t], 3, 1.0);
+        mix.finish();
+        mix.begin_tangent();
+        for (size_t e = 0; e < flat.edges.size(); e += 2) mix.add_tangent_term(c, law, flat.x.data(), &flat.edges[e], 2, 1.0);
+        for (size_t t = 0; t < flat.tris.size(); t += 3) mix.add_tangent_term(c, law, flat.x.data(), &flat.tris[t], 3, 1.0);
+        mix.tangent([&](int32_t a, int32_t b, const double* block) {
+            tangent[static_cast<size_t>(a) * n + static_cast<size_t>(b)] += block[8];
+            if (a != b) tangent[static_cast<size_t>(b) * n + static_cast<size_t>(a)] += block[8];
         });
         std::vector<double> x = flat.x;
         const double h = 1e-8;
@@ -507,8 +531,9 @@ void test_capsule_tangent_matches_the_forces_slope(void**) {
             largest = std::max(largest, std::fabs(slope[k]));
             gap = std::max(gap, std::fabs(slope[k] - tangent[k]));
         }
-        printf("capsule tilted %.3f rad: largest stiffness %.4g N/m, largest gap to the forces' slope %.3g N/m\n", tilt,
-               largest, gap);
+        if (getenv("TAN_DEBUG")) for (size_t i = 0; i < n; ++i) { for (size_t j = 0; j < n; ++j) printf(" %7.2f/%7.2f", slope[i*n+j], tangent[i*n+j]); printf("\n"); }
+        printf("capsule at (%.1f, %.1f) mm heading %.2f tilted %.3f rad: largest stiffness %.4g N/m, largest gap to the "
+               "forces' slope %.3g N/m\n", 1e3 * pose[0], 1e3 * pose[1], pose[2], pose[3], largest, gap);
         assert_true(largest > 0.0);
         assert_true(gap < 0.03 * largest);
     }

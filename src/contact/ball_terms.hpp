@@ -1,0 +1,78 @@
+// A ball's excess terms over a body's surface (shape_contact.hpp): a sphere's, or each of the
+// balls a capsule is made of (Shape::ball_count), for the excess of one ball
+// (excess_shape_contact) and the mix of several (BallMix).
+#pragma once
+
+#include "collision/closest_point.hpp"
+#include "collision/shape.hpp"
+#include "contact/collider.hpp"
+#include "contact/contact_point.hpp"
+#include "contact/hunt_crossley.hpp"
+#include "core/vec3.hpp"
+
+#include <cstdint>
+
+namespace sh {
+
+/// The step's Hunt-Crossley law as the potential a ball's excess maximises.
+class StepLawPotential final : public DepthPotential {
+public:
+    StepLawPotential(const sh_contact_params& params, const StepLaw& law) : params_(params), law_(law) {}
+    double energy(double depth) const override { return hunt_crossley_step_energy(params_, law_, depth); }
+    double force(double depth) const override { return hunt_crossley_step(params_, law_, depth).force; }
+    double stiffness(double depth) const override { return hunt_crossley_step(params_, law_, depth).stiffness; }
+
+private:
+    const sh_contact_params& params_;
+    const StepLaw& law_;
+};
+
+/// The centre (m, world) and radius (m) of the bounding sphere of a feature's count points.
+double feature_bounds(const double* const points[3], int count, double centre[3]);
+
+/// A surface edge's or triangle's nodes: their positions, and their depths (m, 0 outside)
+/// and push directions in the collider.
+struct FeatureNodes {
+    const double* points[3];
+    double depth[3];
+    double normal[3][3];
+    /// Fills the count nodes at positions x against collider.
+    void set(const Collider& collider, const double* x, const int32_t* nodes, int count);
+};
+
+/// The excess term of the ball at centre (world; the collider's ball radius) over the edge
+/// (count 2) or triangle (count 3) of feature's nodes, as excess_shape_contact describes it
+/// for a sphere: the interpolant takes the nodes' depths in the ball, and the fade (the mesh
+/// resolving the contact) their depths in the collider, so that a capsule's balls leave a
+/// feature whose nodes are all in the capsule to its node terms, as a sphere's does. False
+/// if it has none.
+bool ball_term(const Collider& collider, const DepthPotential& psi, const FeatureNodes& feature, const int32_t* nodes,
+               int count, double weight, const double centre[3], ContactPoint& out);
+
+/// Calls visit(i, term) for each ball i of the collider with an excess term over the edge or
+/// triangle of nodes at positions x (law, weight: see excess_shape_contact).
+template <class Visit>
+void for_each_ball_term(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
+                        double weight, Visit&& visit) {
+    if (collider.shape.ball_count() == 0 || !(weight > 0.0)) return;
+    const StepLawPotential psi(collider.params, law);
+    FeatureNodes feature;
+    feature.set(collider, x, nodes, count);
+    const double* const* points = feature.points;
+    double centre[3];
+    const double reach = feature_bounds(points, count, centre) + collider.shape.ball_radius();
+    int first = 0, last = -1;
+    collider.shape.balls_near(collider.pose, centre, reach, first, last);
+    for (int i = first; i <= last; ++i) {
+        double ball[3], w[3];
+        collider.shape.ball_centre(collider.pose, i, ball);
+        // A ball that does not reach the feature has no term there (most of those near it).
+        const double distance = count == 3 ? closest_on_triangle(ball, points[0], points[1], points[2], w)
+                                           : distance_to_segment(ball, points[0], points[1]);
+        if (!(distance < collider.shape.ball_radius())) continue;
+        ContactPoint term;
+        if (ball_term(collider, psi, feature, nodes, count, weight, ball, term)) visit(i, term);
+    }
+}
+
+}  // namespace sh

@@ -785,6 +785,73 @@ static void test_convex_tool_steps_without_allocating(void** state) {
 #endif
 }
 
+/* A capsule smaller than the block's 2.5 mm cells, lying level across its top between the
+ * nodes (its balls' excess holds it, BallMix): the whole-body buffer pressed 0.4 mm and let to
+ * settle renders the full model's static solve at that pose, as the sphere's does, and its
+ * haptic steps allocate nothing. */
+static void test_lying_capsule_buffer_matches_static_solve_without_allocating(void** state) {
+    (void)state;
+    const double depth = 0.0004, radius = 0.001;
+    sh_collider_def tool;
+    sh_collider_def_default(&tool);
+    tool.shape.kind = SH_SHAPE_CAPSULE;
+    tool.shape.radius = radius;
+    tool.shape.half_length = 0.003;
+    tool.contact.stiffness = 1e4;
+    tool.contact.exponent = 1.5;
+    tool.contact.damping = 0.0;
+    const double level[4] = {sqrt(0.5), 0.0, sqrt(0.5), 0.0}; /* the axis along x */
+    const double pressed[3] = {0.5 * kBlock[0] + 0.6e-3, 0.5 * kBlock[1] + 1.1e-3, kBlock[2] + radius - depth};
+    for (int k = 0; k < 4; ++k) tool.orientation[k] = level[k];
+    for (int k = 0; k < 3; ++k) tool.position[k] = pressed[k];
+
+    scene reference = make_scene(0.0, 1.0);
+    assert_ok(sh_tool_destroy(reference.world, reference.tool));
+    assert_ok(sh_tool_create(reference.world, &tool, &reference.tool));
+    sh_static_def solve;
+    sh_static_def_default(&solve);
+    solve.tolerance = 1e-9;
+    solve.max_iterations = 400;
+    sh_static_report report;
+    assert_ok(sh_world_solve_static(reference.world, &solve, &report));
+    double f_static[3], t_static[3];
+    assert_ok(sh_tool_get_wrench(reference.world, reference.tool, f_static, t_static));
+
+    scene s = make_scene(40.0, 1.0);
+    assert_ok(sh_tool_destroy(s.world, s.tool));
+    tool.position[2] = kBlock[2] + radius; /* touching */
+    assert_ok(sh_tool_create(s.world, &tool, &s.tool));
+    sh_haptic_def def = haptic_def(&s);
+    def.radius = 1.0; /* everything */
+    def.capacity_tets = 2000;
+    def.capacity_nodes = 1000;
+    def.max_force = 100.0;
+    def.max_force_rate = 1e6;
+    def.ramp_time = 0.0;
+    def.stale_after = 1e3;
+    sh_haptic* haptic = NULL;
+    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    sh_haptic_output out;
+    atomic_store(&g_watched_allocations, 0);
+    tl_watched = 1;
+    for (int i = 0; i < 3000; ++i) {
+        const double s_press = i < 300 ? (i + 1) / 300.0 : 1.0;
+        const double p[3] = {pressed[0], pressed[1], kBlock[2] + radius - s_press * depth};
+        assert_ok(sh_haptic_step(haptic, p, level, 1e-3, &out));
+    }
+    tl_watched = 0;
+    printf("lying capsule: static solve %d iterations, %.6g N; whole-body buffer %.6g N, %d sub-steps\n",
+           report.iterations, f_static[2], out.raw_force[2], out.substeps);
+    assert_int_equal(atomic_load(&g_watched_allocations), 0);
+    /* Held: no node is in the capsule (its nodes' terms alone give 0 N); the block gives way
+     * under it, so the contact is shallower than the 0.4 mm press and the force below its law. */
+    assert_true(f_static[2] > 0.1 * tool.contact.stiffness * pow(depth, 1.5));
+    assert_close(out.raw_force[2], f_static[2], 5e-3 * f_static[2]);
+    assert_ok(sh_haptic_destroy(haptic));
+    sh_world_destroy(s.world);
+    sh_world_destroy(reference.world);
+}
+
 /* A physical blade dragged through the block with a haptic context: the haptic side moves the
  * held nodes with the device, renders their pull, counts the blade's work and lets go, and
  * adopts the buffers the full model's breaks re-cut, all without allocating. The hold is
@@ -849,6 +916,7 @@ int main(void) {
         cmocka_unit_test(test_first_force_one_tick_after_contact),
         cmocka_unit_test(test_capacity_overflow_keeps_the_nearest),
         cmocka_unit_test(test_convex_tool_steps_without_allocating),
+        cmocka_unit_test(test_lying_capsule_buffer_matches_static_solve_without_allocating),
         cmocka_unit_test(test_physical_blade_hold_steps_without_allocating),
         cmocka_unit_test(test_haptic_thread_never_allocates_nor_locks),
     };

@@ -20,7 +20,7 @@ namespace sh {
 /// a smooth maximum: equal to the P_i where they are equal (a capsule lying on a face: the
 /// balls along its ridge reach equally deep, and the face's nodes share the ridge's push
 /// evenly), equal to the only ball that reaches, otherwise between their mean and their
-/// largest, within about 11 % of the largest as a capsule tilts onto one end. The exact
+/// largest, within about 15 % of the largest as a capsule tilts onto one end. The exact
 /// maximum would make its maximiser jump from one end of a lying capsule to the other as
 /// the face tilts, and the forces on the face's nodes with it. Each feature's term takes
 /// sum_i s_i T_i of its balls' terms T_i as its energy, s_i = P_i^p / sum_j P_j^p, and
@@ -29,7 +29,7 @@ namespace sh {
 /// two passes over its terms per evaluation: add() for every term, finish(), then term().
 class BallMix {
 public:
-    static constexpr int kOrder = 8;
+    static constexpr int kOrder = 4;
 
     /// Makes room for count balls (allocates if there is less).
     void reserve(int count);

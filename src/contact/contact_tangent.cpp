@@ -9,8 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 namespace sh {
 namespace {
@@ -85,7 +83,7 @@ void BodyContacts::add_tangent(const double* x, const double* v, double stiffnes
         add_point_tangent(p, tangent, free_index, system);
     });
     if (stiffness_scale == 0.0) return;
-    if (!std::getenv("NO_MIX_TANGENT")) for (const Group& group : groups_) add_ball_mix_tangent(group, x, stiffness_scale, free_index, system);
+    for (const Group& group : groups_) add_ball_mix_tangent(group, x, stiffness_scale, free_index, system);
 }
 
 void BodyContacts::add_ball_mix_tangent(const Group& group, const double* x, double stiffness_scale,
@@ -111,8 +109,6 @@ void BodyContacts::add_ball_mix_tangent(const Group& group, const double* x, dou
             system.add_block(fa, fb, block, stiffness_scale);
             return;
         }
-        if (std::getenv("DROP_OUT")) return;
-        if (std::getenv("LUMP_DEBUG")) { double q = 0; for (int k = 0; k < 9; ++k) q += block[k] * block[k]; std::fprintf(stderr, "lump %d %d %.3g\n", a, b, std::sqrt(q)); }
         double squares = 0.0;
         for (int k = 0; k < 9; ++k) squares += block[k] * block[k];
         const double bound[9] = {std::sqrt(squares), 0.0, 0.0, 0.0, std::sqrt(squares), 0.0, 0.0, 0.0, std::sqrt(squares)};

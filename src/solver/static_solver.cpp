@@ -7,8 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 namespace sh {
 namespace {
@@ -66,6 +64,78 @@ double out_of_balance(const NewtonProblem& problem, const double g[3], double lo
     return std::sqrt(s);
 }
 
+// Moves the problem's bodies to their saved positions (workspace.xs) plus alpha times the
+// step (matrix.delta).
+void place_along_step(NewtonProblem& problem, double alpha) {
+    const vec<double>& step = problem.matrix().delta;
+    problem.each([&](SteppedBody& stepped, size_t offset) {
+        Body& body = *stepped.body;
+        const vec<int32_t>& global = stepped.newton->matrix.system.dof_to_global();
+        for (size_t d = 0; d < global.size(); ++d) {
+            const size_t j = static_cast<size_t>(global[d]);
+            body.x[j] = stepped.workspace.xs[j] + alpha * step[offset + d];
+        }
+    });
+}
+
+// The potential's slope along the step at the current residual (matrix.residual).
+double slope_along_step(const NewtonMatrix& matrix) {
+    double slope = 0.0;
+    for (size_t d = 0; d < matrix.residual.size(); ++d) slope -= matrix.residual[d] * matrix.delta[d];
+    return slope;
+}
+
+// A full step that the potential still falls steeply beyond (its slope there above half the
+// start's) came from a tangent stiffer than the potential along it, as where a contact's
+// projected curvature drops a negative part: the step doubles while the potential keeps
+// falling, up to kExtensions times. Each try costs an evaluation; Newton's own steps near
+// convergence end flat and take none.
+constexpr int kExtensions = 6;
+
+// Line search along the solved step (matrix.delta) from the bodies' positions, residual
+// matrix.residual and relative residual r: halves from the full step until Armijo's decrease
+// (or a smaller residual where the potential is flat to its round-off; never an iterate
+// that raises the potential: a smaller residual there can lead the iteration round in a
+// cycle over a kink of the contact potential), then extends a full step as above. Leaves the
+// bodies there (or where they were if nothing helps) and returns the relative residual.
+double search_along_step(NewtonProblem& problem, const double g[3], double factor, double load_norm, double r) {
+    NewtonMatrix& matrix = problem.matrix();
+    const double slope = slope_along_step(matrix);  // d potential / d alpha at alpha = 0
+    double scale = 0.0;
+    const double energy0 = problem.potential_energy(g, factor, false, scale), r0 = r;
+    problem.each([](SteppedBody& stepped, size_t) {
+        std::copy(stepped.body->x.begin(), stepped.body->x.end(), stepped.workspace.xs.begin());
+    });
+    double alpha = 1.0, energy = energy0;
+    bool accepted = false;
+    for (int trial = 0; trial < 30 && !accepted; ++trial, alpha *= 0.5) {
+        place_along_step(problem, alpha);
+        r = out_of_balance(problem, g, factor, matrix.residual) / load_norm;
+        energy = problem.potential_energy(g, factor, false, scale);
+        accepted = std::isfinite(energy) && (energy <= energy0 + 1e-4 * alpha * slope ||
+                                             (r < r0 && energy <= energy0 + sum_roundoff(scale)));
+    }
+    if (!accepted) {  // no step helped: stay where the iteration was
+        place_along_step(problem, 0.0);
+        return out_of_balance(problem, g, factor, matrix.residual) / load_norm;
+    }
+    alpha *= 2.0;  // the accepted one
+    if (alpha < 1.0) return r;
+    for (int k = 0; k < kExtensions && slope_along_step(matrix) < 0.5 * slope; ++k) {
+        place_along_step(problem, 2.0 * alpha);
+        const double r_next = out_of_balance(problem, g, factor, matrix.residual) / load_norm;
+        const double e_next = problem.potential_energy(g, factor, false, scale);
+        if (!(std::isfinite(e_next) && e_next < energy)) {
+            place_along_step(problem, alpha);
+            return out_of_balance(problem, g, factor, matrix.residual) / load_norm;
+        }
+        alpha *= 2.0;
+        energy = e_next;
+        r = r_next;
+    }
+    return r;
+}
+
 // Newton-Raphson with line search for the problem's bodies, their states prepared.
 void solve_problem(NewtonProblem& problem, const double g[3], const sh_static_def& def, sh_static_report& report) {
     NewtonMatrix& matrix = problem.matrix();
@@ -95,43 +165,8 @@ void solve_problem(NewtonProblem& problem, const double g[3], const sh_static_de
             floor = std::max(floor, problem.assemble(assemble_body, 1.0, 0.0, true) / load_norm);
             matrix.solver->factorize(matrix.system);
             matrix.solver->solve(matrix.system, residual.data(), step.data());
-            double slope = 0.0;  // d potential / d alpha at alpha = 0
-            for (size_t d = 0; d < residual.size(); ++d) slope -= residual[d] * step[d];
-            double scale = 0.0;
-            const double energy0 = problem.potential_energy(g, factor, false, scale), r0 = r;
-            problem.each([](SteppedBody& stepped, size_t) {
-                Body& body = *stepped.body;
-                std::copy(body.x.begin(), body.x.end(), stepped.workspace.xs.begin());
-            });
-            double alpha = 1.0;
-            bool accepted = false;
-            for (int trial = 0; trial < 30 && !accepted; ++trial, alpha *= 0.5) {
-                problem.each([&](SteppedBody& stepped, size_t offset) {
-                    Body& body = *stepped.body;
-                    const vec<int32_t>& global = stepped.newton->matrix.system.dof_to_global();
-                    for (size_t d = 0; d < global.size(); ++d) {
-                        const size_t j = static_cast<size_t>(global[d]);
-                        body.x[j] = stepped.workspace.xs[j] + alpha * step[offset + d];
-                    }
-                });
-                r = out_of_balance(problem, g, factor, residual) / load_norm;
-                const double energy = problem.potential_energy(g, factor, false, scale);
-                // Armijo's decrease, or a smaller residual where the potential is flat to its
-                // round-off; never an iterate that raises the potential (a smaller residual
-                // there can lead the iteration round in a cycle over a kink of the contact
-                // potential).
-                accepted = std::isfinite(energy) && (energy <= energy0 + 1e-4 * alpha * slope ||
-                                                     (r < r0 && energy <= energy0 + sum_roundoff(scale)));
-            }
-            if (!accepted) {  // no step helped: stay where the iteration was
-                problem.each([](SteppedBody& stepped, size_t) {
-                    Body& body = *stepped.body;
-                    std::copy(stepped.workspace.xs.begin(), stepped.workspace.xs.end(), body.x.begin());
-                });
-                r = out_of_balance(problem, g, factor, residual) / load_norm;
-            }
+            r = search_along_step(problem, g, factor, load_norm, r);
             ++report.iterations;
-            if (std::getenv("STATIC_DEBUG")) std::fprintf(stderr, "it %d r %.3e alpha %.3g accepted %d slope %.3e\n", report.iterations, r, 2 * alpha, accepted ? 1 : 0, slope);
             if (report.history_count < SH_STATIC_HISTORY) report.residual_history[report.history_count++] = r;
             converged = r <= std::max(def.tolerance, floor);
             require(std::isfinite(r), SH_ERR_SOLVER, "the Newton iteration produced a non-finite state");

@@ -49,7 +49,8 @@ public:
     /// The number of balls whose union the contact potential's excess terms take
     /// (shape_contact.hpp): 1 for a sphere; for a capsule, balls of its radius along its axis
     /// from end to end, at most half a radius apart; 0 for kinds whose nodes carry all of
-    /// their contact (box, convex hull, plane).
+    /// their contact (box, convex hull, plane). A kind's balls lie evenly spaced along a
+    /// segment, in order.
     int ball_count() const { return geometry_.ball_count; }
 
     /// The balls' radius (m).

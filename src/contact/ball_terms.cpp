@@ -86,6 +86,15 @@ void FeatureNodes::set(const Collider& collider, const double* x, const int32_t*
     }
 }
 
+void feature_normal(const double* const points[3], double normal[3]) {
+    double ab[3], ac[3];
+    sub3(points[1], points[0], ab);
+    sub3(points[2], points[0], ac);
+    cross3(ab, ac, normal);
+    const double length = norm3(normal);
+    for (int k = 0; k < 3; ++k) normal[k] = length > 0.0 ? normal[k] / length : 0.0;
+}
+
 bool ball_term(const Collider& collider, const DepthPotential& psi, const FeatureNodes& feature, const int32_t* nodes,
                int count, double weight, const double centre[3], ContactPoint& out) {
     LocalSimplex s;

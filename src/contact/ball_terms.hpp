@@ -10,6 +10,8 @@
 #include "contact/hunt_crossley.hpp"
 #include "core/vec3.hpp"
 
+#include <cmath>
+
 #include <cstdint>
 
 namespace sh {
@@ -29,6 +31,9 @@ private:
 
 /// The centre (m, world) and radius (m) of the bounding sphere of a feature's count points.
 double feature_bounds(const double* const points[3], int count, double centre[3]);
+
+/// The unit normal of the triangle of points (zero if it is degenerate).
+void feature_normal(const double* const points[3], double normal[3]);
 
 /// A surface edge's or triangle's nodes: their positions, and their depths (m, 0 outside)
 /// and push directions in the collider.
@@ -63,13 +68,26 @@ void for_each_ball_term(const Collider& collider, const StepLaw& law, const doub
     const double reach = feature_bounds(points, count, centre) + collider.shape.ball_radius();
     int first = 0, last = -1;
     collider.shape.balls_near(collider.pose, centre, reach, first, last);
-    for (int i = first; i <= last; ++i) {
-        double ball[3], w[3];
-        collider.shape.ball_centre(collider.pose, i, ball);
-        // A ball that does not reach the feature has no term there (most of those near it).
+    if (first > last) return;
+    // The balls lie evenly spaced along a segment (Shape::ball_count): from the first's centre
+    // in steps.
+    double ball[3], step[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 0.0};
+    collider.shape.ball_centre(collider.pose, first, ball);
+    if (last > first) {
+        collider.shape.ball_centre(collider.pose, last, step);
+        for (int k = 0; k < 3; ++k) step[k] = (step[k] - ball[k]) / (last - first);
+    }
+    if (count == 3) feature_normal(points, normal);
+    const double radius = collider.shape.ball_radius();
+    for (int i = first; i <= last; ++i, ball[0] += step[0], ball[1] += step[1], ball[2] += step[2]) {
+        // A ball that does not reach the feature has no term there (most of those near it):
+        // first its plane, then the feature itself.
+        double offset[3], w[3];
+        sub3(ball, points[0], offset);
+        if (count == 3 && !(std::fabs(dot3(offset, normal)) < radius)) continue;
         const double distance = count == 3 ? closest_on_triangle(ball, points[0], points[1], points[2], w)
                                            : distance_to_segment(ball, points[0], points[1]);
-        if (!(distance < collider.shape.ball_radius())) continue;
+        if (!(distance < radius)) continue;
         ContactPoint term;
         if (ball_term(collider, psi, feature, nodes, count, weight, ball, term)) visit(i, term);
     }

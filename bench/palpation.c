@@ -1,13 +1,13 @@
 /*
- * softhap_bench palpation: a sphere tool pressed into the liver held at its base, the full model
- * stepped at 60 Hz with implicit Euler (as a haptic host's sim thread steps it). One JSON line
- * per material on stdout, progress on stderr. The scene is tests/python/test_organ_scenes.py's
- * palpation (liver_and_tool, press_triangle, pose_at).
+ * softhap_bench palpation: a sphere tool (or a lying capsule) pressed into the liver held at its
+ * base, the full model stepped at 60 Hz with implicit Euler (as a haptic host's sim thread steps
+ * it). One JSON line per material and tool on stdout, progress on stderr. The scene is
+ * tests/python/test_organ_scenes.py's palpation (liver_and_tool, press_triangle, pose_at).
  *
  *   softhap_bench palpation [FILTER] [--meshes DIR]
  *
- * FILTER keeps the cases whose name, palpation/<material>, contains it (material corotational,
- * stvk or neohookean). --meshes DIR gives the mesh folder (else bench_find_mesh_dir's search:
+ * FILTER keeps the cases whose name, palpation/<material> (the sphere) or
+ * palpation/<material>/capsule, contains it (material corotational, stvk or neohookean). --meshes DIR gives the mesh folder (else bench_find_mesh_dir's search:
  * $SOFTHAP_MESHES, the build's default, ../shared/meshes, ../../shared/meshes).
  *
  * Scene. SOFA's liver2.msh (507 nodes, 1493 tets) scaled by 0.1 (21 cm long), not moved; the
@@ -21,6 +21,10 @@
  * centroid of the fixed nodes. The sphere starts touching that triangle's plane at its centroid
  * (centre kToolRadius / normal_z above it); before step i (1..120) it is posed
  * 1.5 cm * min(1, i / 60) lower: pressed 1.5 cm in 1 s at constant speed, then held 1 s.
+ * The capsule case presses a capsule of radius 2 mm and half length 1 cm lying level along x
+ * (2.4 cm long, its law 4e4 N/m^1.5 so that it holds 3.6 N at its radius; friction as the
+ * sphere's) over the same point: smaller across than the 15 mm triangles, so that its balls'
+ * excess, not its nodes, holds it.
  *
  * Per material, over the 120 steps (each sh_world_step timed on its own with now_ns, with a step
  * report; the first includes the implicit solver's and the surface trees' set-up: "first_step_ms"):
@@ -60,6 +64,9 @@ static const double kToolExponent = 1.5;
 static const double kToolFriction = 0.5;  /* static and dynamic */
 static const double kLevelNormalZ = 0.98; /* a press triangle's unit normal has z above this */
 static const double kPressDepth = 0.015;  /* m */
+static const double kCapsuleRadius = 0.002, kCapsuleHalfLength = 0.01, kCapsuleStiffness = 4e4;
+static const double kLevelAlongX[4] = {0.70710678118654752, 0.0, 0.70710678118654752, 0.0};
+static const double kIdentity[4] = {1.0, 0.0, 0.0, 0.0};
 enum { kPressSteps = 60, kHoldSteps = 60, kSteps = kPressSteps + kHoldSteps }; /* 1 s, 1 s */
 
 static const sh_material_model kModels[] = {SH_MATERIAL_COROTATIONAL, SH_MATERIAL_STVK, SH_MATERIAL_NEOHOOKEAN};
@@ -77,8 +84,27 @@ typedef struct {
     int32_t node_count, tet_count;
     int32_t* fixed;
     int32_t fixed_count;
-    double start[3]; /* the sphere's centre touching the press triangle (m) */
+    double centroid[3], normal[3]; /* the press triangle's (m, unit) */
 } liver;
+
+/* A tool the liver is pressed with. */
+typedef struct {
+    const char* suffix; /* of the case's name */
+    sh_shape_kind kind;
+    double radius, half_length, stiffness;
+    const double* orientation;
+} press_tool;
+
+static const press_tool kTools[] = {
+    {"", SH_SHAPE_SPHERE, kToolRadius, 0.0, kToolStiffness, kIdentity},
+    {"/capsule", SH_SHAPE_CAPSULE, kCapsuleRadius, kCapsuleHalfLength, kCapsuleStiffness, kLevelAlongX},
+};
+
+/* Where tool starts: touching the press triangle's plane above its centroid (m). */
+static void tool_start(const liver* l, const press_tool* tool, double start[3]) {
+    for (int k = 0; k < 3; ++k) start[k] = l->centroid[k];
+    start[2] += tool->radius / l->normal[2];
+}
 
 /* Picks the nodes of x[0..n) less than kFixedHeight above the lowest into l->fixed; their
  * centroid into base. */
@@ -139,17 +165,16 @@ static int load_liver(const char* dir, liver* l) {
     CHECK(sh_mesh_get_nodes(l->mesh, x, info.node_count));
     int32_t tri_count;
     int32_t* tris = bench_surface_triangles(l->mesh, &tri_count);
-    double base[3], centroid[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 1.0};
+    double base[3];
+    l->normal[2] = 1.0;
     fix_base(x, info.node_count, l, base);
-    const int found = press_triangle(x, tris, tri_count, base, centroid, normal);
+    const int found = press_triangle(x, tris, tri_count, base, l->centroid, l->normal);
     free(x);
     free(tris);
     if (!found) {
         fprintf(stderr, "softhap_bench: %s has no level top triangle to press\n", kMeshFile);
         return 0;
     }
-    for (int k = 0; k < 3; ++k) l->start[k] = centroid[k];
-    l->start[2] += kToolRadius / normal[2];
     return 1;
 }
 
@@ -160,16 +185,20 @@ static void free_liver(liver* l) {
 }
 
 /* A world without gravity holding the liver as one implicit-Euler body of the given model, its
- * base fixed, and the sphere tool at l->start (its id in *tool). */
-static sh_world* make_world(const liver* l, sh_material_model model, sh_tool_id* tool) {
+ * base fixed, and the tool at start (its id in *tool). */
+static sh_world* make_world(const liver* l, sh_material_model model, const press_tool* pt, const double start[3],
+                            sh_tool_id* tool) {
     sh_world* world = bench_world_create(0);
     sh_fem_body_def def = bench_fem_body_def(l->mesh, model, kYoung, kPoisson, kDensity);
     def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
     sh_body_id body;
     CHECK(sh_fem_body_create(world, &def, &body));
     CHECK(sh_body_fix_nodes(world, body, l->fixed, l->fixed_count));
-    sh_collider_def td = bench_sphere_def(kToolRadius, l->start);
-    td.contact.stiffness = kToolStiffness;
+    sh_collider_def td = bench_sphere_def(pt->radius, start);
+    td.shape.kind = pt->kind;
+    td.shape.half_length = pt->half_length;
+    for (int k = 0; k < 4; ++k) td.orientation[k] = pt->orientation[k];
+    td.contact.stiffness = pt->stiffness;
     td.contact.exponent = kToolExponent;
     td.contact.static_friction = td.contact.dynamic_friction = kToolFriction;
     CHECK(sh_tool_create(world, &td, tool));
@@ -211,12 +240,12 @@ static void logged_step(sh_world* world, int s, const char* name, press_log* log
 }
 
 /* The press and the hold (see the header), the tool's force after each. */
-static void run_press(sh_world* world, sh_tool_id tool, const double start[3], const char* name, press_log* log) {
-    static const double kIdentity[4] = {1.0, 0.0, 0.0, 0.0};
+static void run_press(sh_world* world, sh_tool_id tool, const double start[3], const double orientation[4],
+                      const char* name, press_log* log) {
     for (int s = 0; s < kSteps; ++s) {
         const int pressed = s < kPressSteps ? s + 1 : kPressSteps;
         const double pose[3] = {start[0], start[1], start[2] - kPressDepth * pressed / kPressSteps};
-        CHECK(sh_tool_set_pose(world, tool, pose, kIdentity));
+        CHECK(sh_tool_set_pose(world, tool, pose, orientation));
         logged_step(world, s, name, log);
         if (s + 1 == kPressSteps) log->force_end_press = tool_force(world, tool);
     }
@@ -227,15 +256,15 @@ static void run_press(sh_world* world, sh_tool_id tool, const double start[3], c
 /* Report                                                                                       */
 
 /* The case's JSON line (sorts the log's times) and a summary on stderr. */
-static void print_case(const char* name, sh_material_model model, const liver* l, press_log* log,
-                       const uint64_t warnings[SH_WARN_COUNT]) {
+static void print_case(const char* name, sh_material_model model, const press_tool* pt, const liver* l,
+                       press_log* log, const uint64_t warnings[SH_WARN_COUNT]) {
     const double first_ns = log->ns[0];
     const stats t = summarize(log->ns, kSteps);
-    printf("{\"case\":\"palpation\",\"material\":\"%s\",\"mesh\":\"%s\",\"tets\":%d,\"nodes\":%d,\"fixed_nodes\":%d,"
+    printf("{\"case\":\"palpation\",\"material\":\"%s\",\"tool\":\"%s\",\"mesh\":\"%s\",\"tets\":%d,\"nodes\":%d,\"fixed_nodes\":%d,"
            "\"dt\":%.6g,\"steps\":%d,\"step_median_ms\":%.3f,\"step_p99_ms\":%.3f,\"step_max_ms\":%.3f,"
            "\"first_step_ms\":%.3f,\"newton_iterations_total\":%ld,\"newton_iterations_max\":%d,"
            "\"substeps_total\":%ld,\"substeps_max\":%d,\"warnings\":{",
-           material_name(model), kMeshName, l->tet_count, l->node_count, l->fixed_count, kDt, kSteps, t.median * 1e-6,
+           material_name(model), pt->kind == SH_SHAPE_CAPSULE ? "capsule" : "sphere", kMeshName, l->tet_count, l->node_count, l->fixed_count, kDt, kSteps, t.median * 1e-6,
            t.p99 * 1e-6, t.max * 1e-6, first_ns * 1e-6, log->newton_total, log->newton_max, log->substeps_total,
            log->substeps_max);
     for (int w = 0; w < SH_WARN_COUNT; ++w)
@@ -247,19 +276,21 @@ static void print_case(const char* name, sh_material_model model, const liver* l
             name, log->force_end_press, log->force_end_hold, t.median * 1e-6, t.max * 1e-6);
 }
 
-/* One material: a fresh world, the press and hold, the JSON line. */
-static void run_case(const liver* l, sh_material_model model, const char* filter) {
+/* One material and tool: a fresh world, the press and hold, the JSON line. */
+static void run_case(const liver* l, sh_material_model model, const press_tool* pt, const char* filter) {
     char name[128];
-    snprintf(name, sizeof name, "palpation/%s", material_name(model));
+    snprintf(name, sizeof name, "palpation/%s%s", material_name(model), pt->suffix);
     if (!name_matches(name, filter)) return;
+    double start[3];
+    tool_start(l, pt, start);
     sh_tool_id tool;
-    sh_world* world = make_world(l, model, &tool);
+    sh_world* world = make_world(l, model, pt, start, &tool);
     press_log log;
     memset(&log, 0, sizeof log);
-    run_press(world, tool, l->start, name, &log);
+    run_press(world, tool, start, pt->orientation, name, &log);
     uint64_t warnings[SH_WARN_COUNT];
     CHECK(sh_world_get_warnings(world, warnings));
-    print_case(name, model, l, &log, warnings);
+    print_case(name, model, pt, l, &log, warnings);
     CHECK(sh_world_destroy(world));
 }
 
@@ -268,7 +299,7 @@ static void run_case(const liver* l, sh_material_model model, const char* filter
 /* The subcommand's usage on stderr. */
 static void usage(void) {
     fprintf(stderr, "usage: softhap_bench palpation [FILTER] [--meshes DIR]\n"
-                    "  FILTER  keep the cases whose name contains it (palpation/<material>)\n"
+                    "  FILTER  keep the cases whose name contains it (palpation/<material>[/capsule])\n"
                     "  --meshes DIR  mesh folder holding liver2.msh\n");
 }
 
@@ -288,9 +319,10 @@ int run_palpation(int argc, char** argv) {
     if (!dir) return 1;
     liver l;
     if (!load_liver(dir, &l)) return 1;
-    fprintf(stderr, "palpation: %s/%s: %d nodes, %d tets, %d fixed; tool starts at (%.4f, %.4f, %.4f) m\n", dir,
-            kMeshFile, l.node_count, l.tet_count, l.fixed_count, l.start[0], l.start[1], l.start[2]);
-    for (size_t k = 0; k < sizeof kModels / sizeof kModels[0]; ++k) run_case(&l, kModels[k], filter);
+    fprintf(stderr, "palpation: %s/%s: %d nodes, %d tets, %d fixed; press triangle at (%.4f, %.4f, %.4f) m\n", dir,
+            kMeshFile, l.node_count, l.tet_count, l.fixed_count, l.centroid[0], l.centroid[1], l.centroid[2]);
+    for (size_t t = 0; t < sizeof kTools / sizeof kTools[0]; ++t)
+        for (size_t k = 0; k < sizeof kModels / sizeof kModels[0]; ++k) run_case(&l, kModels[k], &kTools[t], filter);
     free_liver(&l);
     return 0;
 }

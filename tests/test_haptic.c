@@ -179,6 +179,37 @@ static sh_haptic_def haptic_def(const scene* s) {
 
 static double norm3(const double* a) { return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
 
+/* A haptic context on s whose buffer holds everything within radius of the tool (capacity for
+ * the whole block), with no ramp and no staleness (the sim thread does not step here). */
+static sh_haptic* whole_block_haptic(const scene* s, double radius) {
+    sh_haptic_def def = haptic_def(s);
+    def.radius = radius;
+    def.capacity_tets = 2000;
+    def.capacity_nodes = 1000;
+    def.max_force = 100.0;
+    def.max_force_rate = 1e6;
+    def.ramp_time = 0.0;
+    def.stale_after = 1e3;
+    sh_haptic* haptic = NULL;
+    assert_ok(sh_haptic_create(s->world, &def, &haptic));
+    return haptic;
+}
+
+/* Ticks of 1 ms pressing the tool (orientation q) from start down by depth over press_ticks,
+ * then holding it, ticks in all; the last output in *out, every tick fault-free. The
+ * allocations the ticks make are counted in g_watched_allocations (reset here). */
+static void press_watched(sh_haptic* haptic, const double start[3], double depth, int press_ticks, int ticks,
+                          const double q[4], sh_haptic_output* out) {
+    atomic_store(&g_watched_allocations, 0);
+    tl_watched = 1;
+    for (int i = 0; i < ticks; ++i) {
+        const double p[3] = {start[0], start[1], start[2] - depth * fmin(1.0, (i + 1.0) / press_ticks)};
+        assert_ok(sh_haptic_step(haptic, p, q, 1e-3, out));
+        assert_int_equal(out->faults, 0);
+    }
+    tl_watched = 0;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* The buffer's force against the full model                                                    */
 
@@ -205,24 +236,10 @@ static void test_whole_body_buffer_matches_static_solve(void** state) {
     assert_ok(sh_tool_get_wrench(reference.world, reference.tool, f_static, t_static));
 
     scene s = make_scene(40.0, top);
-    sh_haptic_def def = haptic_def(&s);
-    def.radius = 1.0; /* everything */
-    def.capacity_tets = 2000;
-    def.capacity_nodes = 1000;
-    def.max_force = 100.0;
-    def.max_force_rate = 1e6;
-    def.ramp_time = 0.0;
-    def.stale_after = 1e3; /* the sim thread does not step here */
-    sh_haptic* haptic = NULL;
-    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    sh_haptic* haptic = whole_block_haptic(&s, 1.0); /* everything */
     sh_haptic_output out;
-    const double dt = 1e-3;
-    for (int i = 0; i < 3000; ++i) {
-        const double s_press = i < 300 ? (i + 1) / 300.0 : 1.0; /* press over 0.3 s, then hold */
-        const double p[3] = {pressed[0], pressed[1], top - s_press * depth};
-        assert_ok(sh_haptic_step(haptic, p, kIdentity, dt, &out));
-        assert_int_equal(out.faults, 0);
-    }
+    const double start[3] = {pressed[0], pressed[1], top};
+    press_watched(haptic, start, depth, 300, 3000, kIdentity, &out); /* press over 0.3 s, then hold */
     printf("whole-body buffer: %d tets, %d nodes, %d sub-steps; force %.6g N against the static solve's %.6g N\n",
            out.buffer_tets, out.buffer_nodes, out.substeps, out.raw_force[2], f_static[2]);
     assert_int_equal(out.buffer_tets, 8 * 8 * 4 * 6);
@@ -732,7 +749,7 @@ static void test_haptic_thread_never_allocates_nor_locks(void** state) {
 static void test_convex_tool_steps_without_allocating(void** state) {
     (void)state;
 #if defined(SOFTHAP_TEST_WITH_CCD)
-    const double top = kBlock[2], h = 0.003, dt = 1e-3;
+    const double top = kBlock[2], h = 0.003;
     double force[2] = {0.0, 0.0};
     for (int c = 0; c < 2; ++c) {
         scene s = make_scene(40.0, top + 0.01);
@@ -758,20 +775,9 @@ static void test_convex_tool_steps_without_allocating(void** state) {
         tool.position[1] = 0.5 * kBlock[1] + 1e-4;
         tool.position[2] = top + h;
         assert_ok(sh_tool_create(s.world, &tool, &s.tool));
-        sh_haptic_def def = haptic_def(&s);
-        def.radius = 0.008;
-        def.ramp_time = 0.0;
-        def.stale_after = 1e3;
-        sh_haptic* haptic = NULL;
-        assert_ok(sh_haptic_create(s.world, &def, &haptic));
+        sh_haptic* haptic = whole_block_haptic(&s, 0.008);
         sh_haptic_output out;
-        atomic_store(&g_watched_allocations, 0);
-        tl_watched = 1;
-        for (int i = 0; i < 1500; ++i) {
-            const double p[3] = {tool.position[0], tool.position[1], top + h - 0.001 * fmin(1.0, (i + 1) / 200.0)};
-            assert_ok(sh_haptic_step(haptic, p, kIdentity, dt, &out));
-        }
-        tl_watched = 0;
+        press_watched(haptic, tool.position, 0.001, 200, 1500, kIdentity, &out);
         assert_int_equal(atomic_load(&g_watched_allocations), 0);
         force[c] = out.raw_force[2];
         assert_ok(sh_haptic_destroy(haptic));
@@ -821,25 +827,9 @@ static void test_lying_capsule_buffer_matches_static_solve_without_allocating(vo
     assert_ok(sh_tool_destroy(s.world, s.tool));
     tool.position[2] = kBlock[2] + radius; /* touching */
     assert_ok(sh_tool_create(s.world, &tool, &s.tool));
-    sh_haptic_def def = haptic_def(&s);
-    def.radius = 1.0; /* everything */
-    def.capacity_tets = 2000;
-    def.capacity_nodes = 1000;
-    def.max_force = 100.0;
-    def.max_force_rate = 1e6;
-    def.ramp_time = 0.0;
-    def.stale_after = 1e3;
-    sh_haptic* haptic = NULL;
-    assert_ok(sh_haptic_create(s.world, &def, &haptic));
+    sh_haptic* haptic = whole_block_haptic(&s, 1.0); /* everything */
     sh_haptic_output out;
-    atomic_store(&g_watched_allocations, 0);
-    tl_watched = 1;
-    for (int i = 0; i < 3000; ++i) {
-        const double s_press = i < 300 ? (i + 1) / 300.0 : 1.0;
-        const double p[3] = {pressed[0], pressed[1], kBlock[2] + radius - s_press * depth};
-        assert_ok(sh_haptic_step(haptic, p, level, 1e-3, &out));
-    }
-    tl_watched = 0;
+    press_watched(haptic, tool.position, depth, 300, 3000, level, &out);
     printf("lying capsule: static solve %d iterations, %.6g N; whole-body buffer %.6g N, %d sub-steps\n",
            report.iterations, f_static[2], out.raw_force[2], out.substeps);
     assert_int_equal(atomic_load(&g_watched_allocations), 0);

@@ -36,13 +36,13 @@ void mix_term(const ContactPoint& term, double share, double coefficient, Contac
     mass += w;
 }
 
-// The stiffness of a mixed term over its nodes' 3 count coordinates, in two parts. Its balls'
-// law curvature, sum_i c_i k_i g_i g_i^T (each ball's own tangent), kept where c_i k_i > 0,
-// so positive semi-definite: the term's hessian, which the full model's tangent takes. And
-// the smooth maximum's curvature within the term, sum_ij (d c_i / d P_j) G_i G_j^T with G_i
-// the gradient of ball i's term (minus its node forces), d c_i / d P_j from BallMix: only
-// its bound per node (Gershgorin), for the haptic buffer; the full model takes this part
-// across all the mix's terms instead (BallMix::tangent).
+// The stiffness of a mixed term over its nodes' 3 count coordinates, for the haptic buffer's
+// bounds on its nodes (the full model's tangent takes the mix's across all its terms instead,
+// BallMix::tangent), in two parts. Its balls' law curvature, sum_i c_i k_i g_i g_i^T (each
+// ball's own tangent), kept where c_i k_i > 0, so positive semi-definite: the term's hessian.
+// And the smooth maximum's curvature within the term, sum_ij (d c_i / d P_j) G_i G_j^T with
+// G_i the gradient of ball i's term (minus its node forces), d c_i / d P_j from BallMix: its
+// bound per node (Gershgorin), curvature_bound.
 class MixedHessian {
 public:
     void add(const ContactPoint& term, double coefficient, double curvature, double cross) {
@@ -150,7 +150,6 @@ void BallMix::finish() {
         m[4] = power > 0.0 ? p * power * u / (sum_p * largest) : 0.0;
     }
 }
-
 
 void BallMix::begin_tangent() {
     touched_.clear();

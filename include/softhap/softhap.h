@@ -777,7 +777,7 @@ typedef struct sh_shape {
     sh_shape_kind kind;      /**< the kind; default SH_SHAPE_SPHERE */
     double radius;           /**< sphere, capsule: radius (m), > 0; default 5 mm */
     double half_length;      /**< capsule: half the segment's length (m), >= 0 and at most
-                                  250,000 radii (its contact takes a ball every half radius) */
+                                  1024 radii (its contact takes a ball every half radius) */
     double half_extents[3];  /**< box: half widths along local x, y, z (m), each > 0 */
     const double* points;    /**< convex: point_count x 3 points (m, local frame), not all in
                                   one plane; copied at creation */

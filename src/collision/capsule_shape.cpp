@@ -11,6 +11,9 @@
 namespace sh {
 namespace {
 
+// The longest capsule in radii: its balls (4 per radius) are summed on every evaluation.
+constexpr double kMaxHalfLength = 1024.0;
+
 void capsule_init(const sh_shape& def, ShapeGeometry& g) {
     g.radius = checked_radius(def);
     SH_REQUIRE(std::isfinite(def.half_length) && def.half_length >= 0.0, SH_ERR_INVALID_ARGUMENT,
@@ -20,10 +23,10 @@ void capsule_init(const sh_shape& def, ShapeGeometry& g) {
     // Balls at most half a radius apart from end to end: their union is the capsule but for
     // scallops of at most 3 % of the radius between them, which no ball's excess sees (each
     // one's maximiser is at the foot of its own centre).
-    const double intervals = std::ceil(4.0 * g.half_length / g.radius);
-    SH_REQUIRE(intervals < 1e6, SH_ERR_INVALID_ARGUMENT,
-               "shape.half_length = %g m is more than 250,000 times shape.radius = %g m", g.half_length, g.radius);
-    g.ball_count = 1 + static_cast<int>(intervals);
+    SH_REQUIRE(g.half_length <= kMaxHalfLength * g.radius, SH_ERR_INVALID_ARGUMENT,
+               "shape.half_length = %g m is more than %g times shape.radius = %g m", g.half_length, kMaxHalfLength,
+               g.radius);
+    g.ball_count = 1 + static_cast<int>(std::ceil(4.0 * g.half_length / g.radius));
 }
 
 // Ball i's position along the axis (m).

@@ -8,7 +8,9 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <limits>
 
 namespace sh {
 namespace {
@@ -66,13 +68,13 @@ public:
         for (int a = 0; a < 3; ++a) {
             out.curvature_bound[a] = 0.0;
             for (int b = 0; b < 3; ++b) {
-                double squares = 0.0;
-                for (int r = 3 * a; r < 3 * a + 3; ++r)
-                    for (int s = 3 * b; s < 3 * b + 3; ++s) {
-                        const double v = curvature_[r][s] - b_[r] * c_[s] - c_[r] * b_[s];
-                        squares += v * v;
+                double block[9];
+                for (int r = 0; r < 3; ++r)
+                    for (int s = 0; s < 3; ++s) {
+                        const int i = 3 * a + r, j = 3 * b + s;
+                        block[3 * r + s] = curvature_[i][j] - b_[i] * c_[j] - c_[i] * b_[j];
                     }
-                out.curvature_bound[a] += std::sqrt(squares);
+                out.curvature_bound[a] += block_norm(block, 3, 1);
             }
         }
         for (int r = 0; r < 9; ++r)
@@ -113,12 +115,20 @@ bool BallMix::term(const Collider& collider, const StepLaw& law, const double* x
     return true;
 }
 
+double mixed_stiffness_bound(const ContactPoint& p, int a) {
+    if (!p.has_hessian) return 0.0;
+    double bound = p.curvature_bound[a];
+    for (int b = 0; b < p.count; ++b) bound += block_norm(&p.hessian[3 * a][3 * b], 9, 1);
+    return bound;
+}
+
 void BallMix::reserve(int count) {
     if (mix_.size() < kFields * static_cast<size_t>(count)) mix_.resize(kFields * static_cast<size_t>(count));
 }
 
 void BallMix::begin(const Collider& collider) {
     count_ = collider.shape.ball_count();
+    assert(mix_.size() >= kFields * static_cast<size_t>(count_) && "BallMix::reserve first");
     for (int i = 0; i < count_; ++i) mix_[kFields * static_cast<size_t>(i)] = 0.0;
 }
 
@@ -129,9 +139,12 @@ void BallMix::add(const Collider& collider, const StepLaw& law, const double* x,
 }
 
 void BallMix::finish() {
-    // In units u_i = P_i / P_max of the largest total, so that the powers stay in range.
+    // In units u_i = P_i / P_max of the largest total, so that the powers stay in range; a
+    // largest total within round-off of the smallest doubles counts as none (its curvature,
+    // over P_max, would overflow).
     double largest = 0.0;
     for (int i = 0; i < count_; ++i) largest = std::max(largest, mix_[kFields * static_cast<size_t>(i)]);
+    if (!(largest > std::numeric_limits<double>::min() / std::numeric_limits<double>::epsilon())) largest = 0.0;
     double sum_p = 0.0, sum_p1 = 0.0;
     for (int i = 0; i < count_ && largest > 0.0; ++i) {
         const double u = std::max(mix_[kFields * static_cast<size_t>(i)], 0.0) / largest;

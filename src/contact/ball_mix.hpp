@@ -11,6 +11,12 @@
 
 namespace sh {
 
+/// An upper bound (N/m) on node a's rows of a mixed term's stiffness (ContactPoint's hessian
+/// and curvature_bound; 0 for other terms): Gershgorin's row sums of its blocks' norms, for
+/// an explicit integrator's stable step and the haptic buffer's contact tangent, isotropic
+/// (the mix's gradients are not along the term's normal alone).
+double mixed_stiffness_bound(const ContactPoint& p, int a);
+
 /// The excess of a collider made of several balls (Shape::ball_count: a capsule is the balls
 /// along its axis). Each ball i has the excess terms of a sphere over every surface edge and
 /// triangle, whose signed sum over the surface is the ball's own excess there, P_i (with its
@@ -29,6 +35,10 @@ namespace sh {
 /// two passes over its terms per evaluation: add() for every term, finish(), then term().
 class BallMix {
 public:
+    /// The Lehmer mean's order p: higher follows the largest ball more closely (within 11 %
+    /// for 8 as a capsule tilts, 16 % for 4, 25 % for 2) but swings its push between the
+    /// balls faster, and Newton's static press of a tilted capsule took 1,567 (8), 228 (4) and
+    /// 108 (2) iterations.
     static constexpr int kOrder = 4;
 
     /// Makes room for count balls (allocates if there is less).

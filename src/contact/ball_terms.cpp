@@ -86,13 +86,23 @@ void FeatureNodes::set(const Collider& collider, const double* x, const int32_t*
     }
 }
 
-void feature_normal(const double* const points[3], double normal[3]) {
+bool feature_normal(const double* const points[3], double normal[3]) {
     double ab[3], ac[3];
     sub3(points[1], points[0], ab);
     sub3(points[2], points[0], ac);
     cross3(ab, ac, normal);
-    const double length = norm3(normal);
-    for (int k = 0; k < 3; ++k) normal[k] = length > 0.0 ? normal[k] / length : 0.0;
+    // A sliver (its smallest angle below 1e-6 rad, or a degenerate triangle) counts as none:
+    // its normal and its closest points are at the mercy of round-off.
+    const double length = norm3(normal), scale = norm3(ab) * norm3(ac);
+    const bool flat = length > 1e-6 * scale;
+    for (int k = 0; k < 3; ++k) normal[k] = flat ? normal[k] / length : 0.0;
+    return flat;
+}
+
+double feature_distance(const double* p, const double* const points[3], int count, bool flat) {
+    if (count == 2) return distance_to_segment(p, points[0], points[1]);
+    double w[3];
+    return flat ? closest_on_triangle(p, points[0], points[1], points[2], w) : 0.0;
 }
 
 bool ball_term(const Collider& collider, const DepthPotential& psi, const FeatureNodes& feature, const int32_t* nodes,

@@ -32,8 +32,13 @@ private:
 /// The centre (m, world) and radius (m) of the bounding sphere of a feature's count points.
 double feature_bounds(const double* const points[3], int count, double centre[3]);
 
-/// The unit normal of the triangle of points (zero if it is degenerate).
-void feature_normal(const double* const points[3], double normal[3]);
+/// The unit normal of the triangle of points; false (and zero) if it is a sliver or
+/// degenerate.
+bool feature_normal(const double* const points[3], double normal[3]);
+
+/// The distance (m) from p to the edge (count 2) or triangle (count 3) of points, flat as
+/// feature_normal says (0, which culls nothing, for a sliver).
+double feature_distance(const double* p, const double* const points[3], int count, bool flat);
 
 /// A surface edge's or triangle's nodes: their positions, and their depths (m, 0 outside)
 /// and push directions in the collider.
@@ -77,17 +82,16 @@ void for_each_ball_term(const Collider& collider, const StepLaw& law, const doub
         collider.shape.ball_centre(collider.pose, last, step);
         for (int k = 0; k < 3; ++k) step[k] = (step[k] - ball[k]) / (last - first);
     }
-    if (count == 3) feature_normal(points, normal);
+    // A sliver's plane and closest point are round-off: only its bounds cull balls.
+    const bool flat = count == 3 && feature_normal(points, normal);
     const double radius = collider.shape.ball_radius();
     for (int i = first; i <= last; ++i, ball[0] += step[0], ball[1] += step[1], ball[2] += step[2]) {
         // A ball that does not reach the feature has no term there (most of those near it):
         // first its plane, then the feature itself.
-        double offset[3], w[3];
+        double offset[3];
         sub3(ball, points[0], offset);
-        if (count == 3 && !(std::fabs(dot3(offset, normal)) < radius)) continue;
-        const double distance = count == 3 ? closest_on_triangle(ball, points[0], points[1], points[2], w)
-                                           : distance_to_segment(ball, points[0], points[1]);
-        if (!(distance < radius)) continue;
+        if (flat && !(std::fabs(dot3(offset, normal)) < radius)) continue;
+        if (!(feature_distance(ball, points, count, flat) < radius)) continue;
         ContactPoint term;
         if (ball_term(collider, psi, feature, nodes, count, weight, ball, term)) visit(i, term);
     }

@@ -60,18 +60,20 @@ StepLaw BodyContacts::step_law(const ContactCandidate& c) const {
     return hunt_crossley_step_law(*c.params, c.start_depth, step_);
 }
 
-void BodyContacts::mix_balls(const Group& group, const double* x) const {
-    if (group.end <= group.begin) return;
+const Collider* BodyContacts::ball_mix_collider(const Group& group) const {
+    if (group.end <= group.begin) return nullptr;
     const Collider* collider = candidates_[static_cast<size_t>(group.begin)].collider;
-    if (!collider || collider->shape.ball_count() < 2) return;
+    return collider && collider->shape.ball_count() > 1 ? collider : nullptr;
+}
+
+void BodyContacts::mix_balls(const Group& group, const double* x) const {
+    const Collider* collider = ball_mix_collider(group);
+    if (!collider) return;
     scratch_.balls.reserve(collider->shape.ball_count());
     scratch_.balls.begin(*collider);
-    for (int32_t i = group.begin; i < group.end; ++i) {
-        const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
-        if (c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kEdgeShape)
-            scratch_.balls.add(*c.collider, step_law(c), x, c.face, c.kind == ContactCandidate::kFaceShape ? 3 : 2,
-                               c.excess_weight);
-    }
+    for_each_excess_candidate(group, [&](const ContactCandidate& c, int count) {
+        scratch_.balls.add(*collider, step_law(c), x, c.face, count, c.excess_weight);
+    });
     scratch_.balls.finish();
 }
 
@@ -203,7 +205,8 @@ double BodyContacts::stable_step(const double* x, const double* v, const double*
             const int32_t node = point ? point->nodes[a] : face ? c.face[a] : c.node;
             if (!body_.is_free(node)) continue;
             const double share = point ? stiffness_share(*point, a) : 1.0;
-            step = std::min(step, damped_stable_step(share * fn.stiffness, share * fn.damping, mass[node]));
+            const double mixed = point ? mixed_stiffness_bound(*point, a) : 0.0;  // a capsule's mix
+            step = std::min(step, damped_stable_step(share * fn.stiffness + mixed, share * fn.damping, mass[node]));
         }
     });
     return step;

@@ -187,6 +187,11 @@ private:
     /// If group's collider is made of several balls: sums its excess terms at x into
     /// scratch_.balls for the group's evaluation (BallMix).
     void mix_balls(const Group& group, const double* x) const;
+    /// Group's collider if it is made of several balls (a BallMix), else null.
+    const Collider* ball_mix_collider(const Group& group) const;
+    /// Calls visit(candidate, count) for each of group's excess candidates (edges 2, faces 3).
+    template <class Visit>
+    void for_each_excess_candidate(const Group& group, Visit&& visit) const;
     /// The tangent of group's collider's BallMix across its terms (if it is made of several
     /// balls) into system, times stiffness_scale.
     void add_ball_mix_tangent(const Group& group, const double* x, double stiffness_scale, const int32_t* free_index,

@@ -15,6 +15,15 @@ void BodyContacts::evaluate_friction(const double* v, Emit&& emit) const {
     }
 }
 
+template <class Visit>
+void BodyContacts::for_each_excess_candidate(const Group& group, Visit&& visit) const {
+    for (int32_t i = group.begin; i < group.end; ++i) {
+        const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
+        if (c.kind == ContactCandidate::kFaceShape) visit(c, 3);
+        if (c.kind == ContactCandidate::kEdgeShape) visit(c, 2);
+    }
+}
+
 template <class Emit>
 void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& emit) const {
     for (const Group& group : groups_) {

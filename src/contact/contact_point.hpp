@@ -49,7 +49,7 @@ struct ContactPoint {
 /// negative) is left out, so that the tangent stays positive semi-definite (and bounds the
 /// potential's Hessian from above).
 inline double normal_tangent_scale(const ContactPoint& p, double stiffness_scale, double damping_scale) {
-    // A term with its own Hessian takes that instead of k g g^T (positive_hessian).
+    // A term mixed over a collider's balls has its stiffness elsewhere (BallMix::tangent).
     const double scale = (p.has_hessian ? 0.0 : stiffness_scale * p.stiffness) + damping_scale * p.damping;
     return scale > 0.0 ? scale : 0.0;
 }

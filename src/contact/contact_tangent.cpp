@@ -88,18 +88,14 @@ void BodyContacts::add_tangent(const double* x, const double* v, double stiffnes
 
 void BodyContacts::add_ball_mix_tangent(const Group& group, const double* x, double stiffness_scale,
                                         const int32_t* free_index, SparseSystem& system) const {
-    if (group.end <= group.begin) return;
-    const Collider* collider = candidates_[static_cast<size_t>(group.begin)].collider;
-    if (!collider || collider->shape.ball_count() < 2) return;
+    const Collider* collider = ball_mix_collider(group);
+    if (!collider) return;
     mix_balls(group, x);
     BallMix& mix = scratch_.balls;
     mix.begin_tangent();
-    for (int32_t i = group.begin; i < group.end; ++i) {
-        const ContactCandidate& c = candidates_[static_cast<size_t>(i)];
-        if (c.kind == ContactCandidate::kFaceShape || c.kind == ContactCandidate::kEdgeShape)
-            mix.add_tangent_term(*c.collider, step_law(c), x, c.face, c.kind == ContactCandidate::kFaceShape ? 3 : 2,
-                                 c.excess_weight);
-    }
+    for_each_excess_candidate(group, [&](const ContactCandidate& c, int count) {
+        mix.add_tangent_term(*collider, step_law(c), x, c.face, count, c.excess_weight);
+    });
     // A block between nodes that share no element has no place in the system: it goes onto
     // both nodes' own blocks as its norm times the identity, which bounds it from above.
     mix.tangent([&](int32_t a, int32_t b, const double* block) {
@@ -109,9 +105,8 @@ void BodyContacts::add_ball_mix_tangent(const Group& group, const double* x, dou
             system.add_block(fa, fb, block, stiffness_scale);
             return;
         }
-        double squares = 0.0;
-        for (int k = 0; k < 9; ++k) squares += block[k] * block[k];
-        const double bound[9] = {std::sqrt(squares), 0.0, 0.0, 0.0, std::sqrt(squares), 0.0, 0.0, 0.0, std::sqrt(squares)};
+        const double norm = block_norm(block, 3, 1);
+        const double bound[9] = {norm, 0.0, 0.0, 0.0, norm, 0.0, 0.0, 0.0, norm};
         system.add_block(fa, fa, bound, stiffness_scale);
         system.add_block(fb, fb, bound, stiffness_scale);
     });

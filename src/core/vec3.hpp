@@ -30,6 +30,14 @@ inline void cross3(const double* a, const double* b, double* out) {
 inline double norm3(const double* a) { return std::sqrt(dot3(a, a)); }
 
 /// True if every component is finite.
+/// The Frobenius norm of the 3x3 block whose entry (r, s) is m[r * row + s * column].
+inline double block_norm(const double* m, size_t row, size_t column) {
+    double squares = 0.0;
+    for (size_t r = 0; r < 3; ++r)
+        for (size_t s = 0; s < 3; ++s) squares += m[r * row + s * column] * m[r * row + s * column];
+    return std::sqrt(squares);
+}
+
 inline bool finite3(const double* a) { return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]); }
 
 }  // namespace sh

@@ -78,18 +78,6 @@ bool term_contact(const Collider& tool, const double* x, const int32_t* nodes, i
                                 excess_weight(tool, size), &balls, out);
 }
 
-// Gershgorin's bound on node a's rows of p's Hessian: sum_b of its blocks' Frobenius norms (N/m).
-double hessian_row_bound(const ContactPoint& p, int a) {
-    double bound = 0.0;
-    for (int b = 0; b < p.count; ++b) {
-        double squares = 0.0;
-        for (int r = 0; r < 3; ++r)
-            for (int s = 0; s < 3; ++s) squares += p.hessian[3 * a + r][3 * b + s] * p.hessian[3 * a + r][3 * b + s];
-        bound += std::sqrt(squares);
-    }
-    return bound;
-}
-
 // How far past the full model's step (in steps) the boundary keeps its end velocity, when the
 // next buffer is late: the haptic clock and the full model's meet every 16 or 17 ticks at
 // 1 kHz and 60 Hz, so the boundary must not stop for the odd tick; a late full model is
@@ -311,17 +299,19 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
         // The term's normal tangent (the full model's, contact_tangent.cpp), k g g^T with g its
         // gradients, bounded by a block diagonal: node a gets k |g_a| (sum_b |g_b|) (its
         // stiffness_share) along g_a (Cauchy-Schwarz), for integrate(). A term mixed over a
-        // tool's balls gives node a its Gershgorin bounds (its hessian's sum_b |H_ab| and its
-        // curvature_bound) along the term's normal.
+        // tool's balls gives node a its mixed_stiffness_bound along every axis.
         const double stiffness = normal_tangent_scale(p, 1.0, 0.0), damping = normal_tangent_scale(p, 0.0, 1.0);
         for (int a = 0; a < p.count; ++a) {
             const double length = norm3(p.gradient[a]), share = stiffness_share(p, a);
             double direction[3] = {0.0, 0.0, 0.0};
             if (length > 0.0)
                 for (int k = 0; k < 3; ++k) direction[k] = p.gradient[a][k] / length;
-            const double own = p.has_hessian ? hessian_row_bound(p, a) + p.curvature_bound[a] : 0.0;
-            add_contact_tangent(p.nodes[a], p.has_hessian ? p.normal : direction, stiffness * share + own,
-                                damping * share);
+            add_contact_tangent(p.nodes[a], direction, stiffness * share, damping * share);
+            const double mixed = mixed_stiffness_bound(p, a);
+            for (int k = 0; k < 3 && mixed > 0.0; ++k) {
+                const double axis[3] = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
+                add_contact_tangent(p.nodes[a], axis, mixed, 0.0);
+            }
             for (int k = 0; k < 3; ++k) {
                 at(f, p.nodes[a])[k] += p.node_force[a][k];
                 at(contact_, p.nodes[a])[k] += p.node_force[a][k];

@@ -107,7 +107,8 @@ private:
     void take_update(double scale);
     /// Backtracking line search along delta; false if no step length qualifies.
     bool line_search(double slope, bool fresh);
-    /// After a fresh full update: extends it while Phi keeps falling steeply (see kExtensions).
+    /// After a fresh full update: extends it while Phi keeps falling steeply
+    /// (extend_update_while_falling).
     void extend_update(double slope);
     /// Newton iterations the step may take.
     int iteration_cap() const;
@@ -324,27 +325,18 @@ void NewtonStep::take_update(double scale) {
     evaluate();
 }
 
-// A fresh full update that Phi still falls steeply beyond (its slope there above half the
-// start's) came from a tangent stiffer than Phi along it, as where a contact's projected
-// curvature drops a negative part: it doubles while Phi keeps falling, up to kExtensions
-// times. Each try costs an evaluation; Newton's own updates near convergence end flat and
-// take none.
-constexpr int kExtensions = 6;
-
 void NewtonStep::extend_update(double slope) {
-    double scale = 1.0;
-    for (int k = 0; k < kExtensions; ++k) {
-        double slope_here = 0.0;
-        for (size_t d = 0; d < matrix_.delta.size(); ++d) slope_here += matrix_.residual[d] * matrix_.delta[d];
-        if (!(slope_here < 0.5 * slope)) return;
-        const Potential phi = phi_;
-        take_update(2.0 * scale);
-        if (!(phi_.finite() && phi_.value < phi.value)) {
+    extend_update_while_falling(
+        slope, phi_.value,
+        [&] {
+            double slope_here = 0.0;
+            for (size_t d = 0; d < matrix_.delta.size(); ++d) slope_here += matrix_.residual[d] * matrix_.delta[d];
+            return slope_here;
+        },
+        [&](double scale) {
             take_update(scale);
-            return;
-        }
-        scale *= 2.0;
-    }
+            return phi_.finite() ? phi_.value : NAN;
+        });
 }
 
 // Backtracks along delta from the iterate in previous_v (potential phi0 = phi_, slope

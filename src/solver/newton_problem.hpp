@@ -26,6 +26,28 @@ namespace sh {
 /// line searches allow a potential to rise by and still count as not raised.
 inline double sum_roundoff(double scale) { return 64.0 * std::numeric_limits<double>::epsilon() * scale; }
 
+/// Extends a full Newton update the potential still falls steeply beyond (its slope there,
+/// slope_here(), above half the start's slope0 < 0): such an update came from a tangent
+/// stiffer than the potential along it, as where a contact's projected curvature drops a
+/// negative part. move_to(s) goes to s times the update and returns the potential there
+/// (non-finite: unusable); from value, the potential at the full update, the update doubles
+/// while the potential keeps falling, at most 6 times (64x), and ends on the last one that
+/// fell. Each try costs an evaluation; Newton's own updates near convergence end flat and
+/// take none. The static solve and the implicit step share it.
+template <class SlopeHere, class MoveTo>
+void extend_update_while_falling(double slope0, double value, SlopeHere&& slope_here, MoveTo&& move_to) {
+    double scale = 1.0;
+    for (int k = 0; k < 6 && slope_here() < 0.5 * slope0; ++k) {
+        const double next = move_to(2.0 * scale);
+        if (!(std::isfinite(next) && next < value)) {
+            move_to(scale);
+            return;
+        }
+        scale *= 2.0;
+        value = next;
+    }
+}
+
 /// The bodies a Newton solve solves for: one alone (a view of it, made per solve) or several
 /// solved together (made empty, then prepared; the joint pattern is kept across solves, and
 /// grown, while it covers what the bodies need).

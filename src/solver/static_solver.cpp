@@ -85,19 +85,13 @@ double slope_along_step(const NewtonMatrix& matrix) {
     return slope;
 }
 
-// A full step that the potential still falls steeply beyond (its slope there above half the
-// start's) came from a tangent stiffer than the potential along it, as where a contact's
-// projected curvature drops a negative part: the step doubles while the potential keeps
-// falling, up to kExtensions times. Each try costs an evaluation; Newton's own steps near
-// convergence end flat and take none.
-constexpr int kExtensions = 6;
-
 // Line search along the solved step (matrix.delta) from the bodies' positions, residual
 // matrix.residual and relative residual r: halves from the full step until Armijo's decrease
 // (or a smaller residual where the potential is flat to its round-off; never an iterate
 // that raises the potential: a smaller residual there can lead the iteration round in a
-// cycle over a kink of the contact potential), then extends a full step as above. Leaves the
-// bodies there (or where they were if nothing helps) and returns the relative residual.
+// cycle over a kink of the contact potential), then extends a full step while the potential
+// falls steeply (extend_update_while_falling). Leaves the bodies there (or where they were if
+// nothing helps) and returns the relative residual.
 double search_along_step(NewtonProblem& problem, const double g[3], double factor, double load_norm, double r) {
     NewtonMatrix& matrix = problem.matrix();
     const double slope = slope_along_step(matrix);  // d potential / d alpha at alpha = 0
@@ -119,20 +113,14 @@ double search_along_step(NewtonProblem& problem, const double g[3], double facto
         place_along_step(problem, 0.0);
         return out_of_balance(problem, g, factor, matrix.residual) / load_norm;
     }
-    alpha *= 2.0;  // the accepted one
-    if (alpha < 1.0) return r;
-    for (int k = 0; k < kExtensions && slope_along_step(matrix) < 0.5 * slope; ++k) {
-        place_along_step(problem, 2.0 * alpha);
-        const double r_next = out_of_balance(problem, g, factor, matrix.residual) / load_norm;
-        const double e_next = problem.potential_energy(g, factor, false, scale);
-        if (!(std::isfinite(e_next) && e_next < energy)) {
-            place_along_step(problem, alpha);
-            return out_of_balance(problem, g, factor, matrix.residual) / load_norm;
-        }
-        alpha *= 2.0;
-        energy = e_next;
-        r = r_next;
-    }
+    if (2.0 * alpha < 1.0) return r;  // the accepted step (alpha is the one after it) was halved
+    extend_update_while_falling(
+        slope, energy, [&] { return slope_along_step(matrix); },
+        [&](double s) {
+            place_along_step(problem, s);
+            r = out_of_balance(problem, g, factor, matrix.residual) / load_norm;
+            return problem.potential_energy(g, factor, false, scale);
+        });
     return r;
 }
 

@@ -110,19 +110,10 @@ Collider make_collider(sh_shape_kind kind, const double position[3], double size
     return Collider(def, true);
 }
 
-// Calls visit(point) for every acting term of the patch's potential against the collider, at
-// rest: node terms with their law applied, excess terms as excess_shape_contact gives them.
+// Calls visit(nodes, count, weight) for each edge (count 2) and triangle (count 3) of the
+// patch, with its excess weight from its size in the patch as given (the reference shape).
 template <class Visit>
-void each_term(const Collider& c, const Patch& p, const double* x, Visit&& visit) {
-    const sh::StepLaw law = sh::hunt_crossley_step_law(c.params, 0.0, 0.0);
-    for (const int32_t node : p.nodes) {
-        ContactPoint point;
-        if (!sh::node_shape_contact(c, x, node, point)) continue;
-        sh::apply_normal_law(c.params, nullptr, point);
-        point.energy = sh::hunt_crossley_step_energy(c.params, law, point.depth);
-        visit(point);
-    }
-    // Each feature's weight from its size in the patch as given (the reference shape).
+void each_feature(const Collider& c, const Patch& p, Visit&& visit) {
     auto weight = [&](const int32_t* nodes, int count) {
         double size = 0.0;
         for (int a = 0; a < count; ++a) {
@@ -135,21 +126,36 @@ void each_term(const Collider& c, const Patch& p, const double* x, Visit&& visit
         }
         return sh::excess_weight(c, size);
     };
-    // A collider of several balls (a capsule) mixes its balls' terms over the whole patch.
-    sh::BallMix mix;
+    for (size_t e = 0; e < p.edges.size(); e += 2) visit(&p.edges[e], 2, weight(&p.edges[e], 2));
+    for (size_t t = 0; t < p.tris.size(); t += 3) visit(&p.tris[t], 3, weight(&p.tris[t], 3));
+}
+
+// The collider's BallMix over the patch at x (used by colliders of several balls).
+void mix_over(const Collider& c, const Patch& p, const sh::StepLaw& law, const double* x, sh::BallMix& mix) {
     mix.reserve(c.shape.ball_count());
     mix.begin(c);
-    for (size_t e = 0; e < p.edges.size(); e += 2) mix.add(c, law, x, &p.edges[e], 2, weight(&p.edges[e], 2));
-    for (size_t t = 0; t < p.tris.size(); t += 3) mix.add(c, law, x, &p.tris[t], 3, weight(&p.tris[t], 3));
+    each_feature(c, p, [&](const int32_t* nodes, int count, double weight) { mix.add(c, law, x, nodes, count, weight); });
     mix.finish();
-    for (size_t e = 0; e < p.edges.size(); e += 2) {
+}
+
+// Calls visit(point) for every acting term of the patch's potential against the collider, at
+// rest: node terms with their law applied, excess terms as excess_shape_contact gives them.
+template <class Visit>
+void each_term(const Collider& c, const Patch& p, const double* x, Visit&& visit) {
+    const sh::StepLaw law = sh::hunt_crossley_step_law(c.params, 0.0, 0.0);
+    for (const int32_t node : p.nodes) {
         ContactPoint point;
-        if (sh::excess_shape_contact(c, law, x, &p.edges[e], 2, weight(&p.edges[e], 2), &mix, point)) visit(point);
+        if (!sh::node_shape_contact(c, x, node, point)) continue;
+        sh::apply_normal_law(c.params, nullptr, point);
+        point.energy = sh::hunt_crossley_step_energy(c.params, law, point.depth);
+        visit(point);
     }
-    for (size_t t = 0; t < p.tris.size(); t += 3) {
+    sh::BallMix mix;
+    mix_over(c, p, law, x, mix);
+    each_feature(c, p, [&](const int32_t* nodes, int count, double weight) {
         ContactPoint point;
-        if (sh::excess_shape_contact(c, law, x, &p.tris[t], 3, weight(&p.tris[t], 3), &mix, point)) visit(point);
-    }
+        if (sh::excess_shape_contact(c, law, x, nodes, count, weight, &mix, point)) visit(point);
+    });
 }
 
 double potential(const Collider& c, const Patch& p, const double* x) {
@@ -479,14 +485,11 @@ void test_capsule_tangent_matches_the_forces_slope(void**) {
         });
         const sh::StepLaw law = sh::hunt_crossley_step_law(c.params, 0.0, 0.0);
         sh::BallMix mix;
-        mix.reserve(c.shape.ball_count());
-        mix.begin(c);
-        for (size_t e = 0; e < flat.edges.size(); e += 2) mix.add(c, law, flat.x.data(), &flat.edges[e], 2, 1.0);
-        for (size_t t = 0; t < flat.tris.size(); t += 3) mix.add(c, law, flat.x.data(), &flat.tris[t], 3, 1.0);
-        mix.finish();
+        mix_over(c, flat, law, flat.x.data(), mix);
         mix.begin_tangent();
-        for (size_t e = 0; e < flat.edges.size(); e += 2) mix.add_tangent_term(c, law, flat.x.data(), &flat.edges[e], 2, 1.0);
-        for (size_t t = 0; t < flat.tris.size(); t += 3) mix.add_tangent_term(c, law, flat.x.data(), &flat.tris[t], 3, 1.0);
+        each_feature(c, flat, [&](const int32_t* nodes, int count, double weight) {
+            mix.add_tangent_term(c, law, flat.x.data(), nodes, count, weight);
+        });
         mix.tangent([&](int32_t a, int32_t b, const double* block) {
             tangent[static_cast<size_t>(a) * n + static_cast<size_t>(b)] += block[8];
             if (a != b) tangent[static_cast<size_t>(b) * n + static_cast<size_t>(a)] += block[8];

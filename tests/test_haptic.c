@@ -118,15 +118,22 @@ typedef struct scene {
     sh_tool_id tool;
 } scene;
 
+/* A sphere of the given radius with an undamped contact law lambda d^exponent (the shape and
+ * the pose are the caller's to change). */
+static sh_collider_def undamped_tool(double radius, double stiffness, double exponent) {
+    sh_collider_def tool;
+    sh_collider_def_default(&tool);
+    tool.shape.radius = radius;
+    tool.contact.stiffness = stiffness;
+    tool.contact.exponent = exponent;
+    tool.contact.damping = 0.0;
+    return tool;
+}
+
 /* The sphere tool of radius kRadius over the block's top centre at height z, with a linear,
  * undamped contact law of the given stiffness (N/m). */
 static sh_tool_id add_sphere_tool(sh_world* world, double stiffness, double z) {
-    sh_collider_def tool;
-    sh_collider_def_default(&tool);
-    tool.shape.radius = kRadius;
-    tool.contact.stiffness = stiffness;
-    tool.contact.exponent = 1.0;
-    tool.contact.damping = 0.0;
+    sh_collider_def tool = undamped_tool(kRadius, stiffness, 1.0);
     tool.position[0] = 0.5 * kBlock[0];
     tool.position[1] = 0.5 * kBlock[1];
     tool.position[2] = z;
@@ -798,14 +805,9 @@ static void test_convex_tool_steps_without_allocating(void** state) {
 static void test_lying_capsule_buffer_matches_static_solve_without_allocating(void** state) {
     (void)state;
     const double depth = 0.0004, radius = 0.001;
-    sh_collider_def tool;
-    sh_collider_def_default(&tool);
+    sh_collider_def tool = undamped_tool(radius, 1e4, 1.5);
     tool.shape.kind = SH_SHAPE_CAPSULE;
-    tool.shape.radius = radius;
     tool.shape.half_length = 0.003;
-    tool.contact.stiffness = 1e4;
-    tool.contact.exponent = 1.5;
-    tool.contact.damping = 0.0;
     const double level[4] = {sqrt(0.5), 0.0, sqrt(0.5), 0.0}; /* the axis along x */
     const double pressed[3] = {0.5 * kBlock[0] + 0.6e-3, 0.5 * kBlock[1] + 1.1e-3, kBlock[2] + radius - depth};
     for (int k = 0; k < 4; ++k) tool.orientation[k] = level[k];

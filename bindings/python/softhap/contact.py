@@ -268,7 +268,9 @@ class WorldContacts(OwnedHandle):
         kind and its shape parameters (only the kind's are accepted; the defaults are those
         of sh_collider_def_default):
             "sphere": radius (m), centred on the pose;
-            "capsule": radius and half_length (m) of the segment along local z;
+            "capsule": radius and half_length (m) of the segment along local z (at most 1024
+            radii); spheres and capsules are held by a face between its nodes, boxes and
+            convex hulls push the nodes inside them only;
             "box": half_extents, 3 half widths along the local axes (m; no default);
             "convex": points, an (n, 3) array (m, local frame, n >= 4, not all in one plane;
             no default; needs a library built with libccd, else SH_ERR_UNSUPPORTED);

@@ -31,10 +31,6 @@ bool node_shape_contact(const Collider& collider, const double* x, int32_t node,
     return true;
 }
 
-namespace {
-
-}  // namespace
-
 double excess_weight(const Collider& collider, double size) {
     const double t = std::min(std::max(collider.shape.inner_radius() / size - 1.0, 0.0), 1.0);
     return std::isfinite(t) ? 1.0 - t * t * (3.0 - 2.0 * t) : 0.0;

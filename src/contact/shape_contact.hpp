@@ -42,7 +42,9 @@ bool node_shape_contact(const Collider& collider, const double* x, int32_t node,
 /// triangles feels the law psi'(d) at its depth d whether it touches a face, an edge or a
 /// vertex, the force is continuous as it slides across them, and a flat tool on nodes adds
 /// nothing to them. Each term is a function of the nodes' positions, its forces its exact
-/// gradient (the envelope theorem at the maximiser).
+/// gradient (the envelope theorem at the maximiser). This is a sphere's excess; a capsule's is
+/// a smooth maximum over the balls along its axis, each with a sphere's terms (BallMix), and
+/// boxes, convex hulls and planes have none.
 ///
 /// The share (0..1) of its excess a surface edge or triangle of size (m: its length, or its
 /// longest edge) carries against the collider: 1 while the collider's inner radius is at most

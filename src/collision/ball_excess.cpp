@@ -3,6 +3,7 @@
 // contact potential's face and edge terms take (contact/shape_contact.cpp).
 #include "collision/ball_excess.hpp"
 
+#include "collision/unit_vector.hpp"
 #include "core/vec3.hpp"
 
 #include <algorithm>
@@ -168,6 +169,16 @@ LocalExcess ball_excess(const LocalSimplex& s, const DepthPotential& psi, const 
         ball_on_segment(s, psi, centre, radius, i, (i + 1) % s.count, best);
     }
     return best;
+}
+
+double ball_depth(const double centre[3], double radius, const Pose& pose, const double x[3], double normal[3]) {
+    sub3(x, centre, normal);
+    const double dist = norm3(normal);
+    if (!(dist > 1e-12 * radius && normalize3(normal))) {  // at the centre: any direction
+        const double ex[3] = {1.0, 0.0, 0.0};
+        pose.rotate(ex, normal);
+    }
+    return radius - dist;
 }
 
 }  // namespace sh

@@ -11,4 +11,8 @@ namespace sh {
 /// centre's foot against the interpolant's slope), its edges' and its corners.
 LocalExcess ball_excess(const LocalSimplex& s, const DepthPotential& psi, const double centre[3], double radius);
 
+/// Point x's depth (m; <= 0 outside) in the ball (centre, radius), and in normal the unit
+/// direction that pushes it out: away from the centre, or pose's local x axis at the centre.
+double ball_depth(const double centre[3], double radius, const Pose& pose, const double x[3], double normal[3]);
+
 }  // namespace sh

@@ -1,4 +1,5 @@
 // The sphere kind: radius around the pose's position. A row of the shape table.
+#include "collision/ball_excess.hpp"
 #include "collision/shape_kind.hpp"
 #include "collision/unit_vector.hpp"
 #include "core/vec3.hpp"
@@ -27,17 +28,8 @@ void sphere_support(const ShapeGeometry& g, const Pose& pose, const double dir[3
 }
 
 bool sphere_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth, double normal[3]) {
-    double d[3] = {x[0] - pose.p[0], x[1] - pose.p[1], x[2] - pose.p[2]};
-    const double dist = norm3(d);
-    depth = g.radius - dist;
-    if (!(depth > 0.0)) return false;
-    if (dist > 1e-12 * g.radius && normalize3(d)) {
-        for (int k = 0; k < 3; ++k) normal[k] = d[k];
-    } else {  // at the centre: any direction; the local x axis
-        const double ex[3] = {1.0, 0.0, 0.0};
-        pose.rotate(ex, normal);
-    }
-    return true;
+    depth = ball_depth(pose.p, g.radius, pose, x, normal);
+    return depth > 0.0;
 }
 
 void sphere_balls_near(const ShapeGeometry&, const double x[3], double reach, int& first, int& last) {

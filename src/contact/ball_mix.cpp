@@ -38,13 +38,13 @@ void mix_term(const ContactPoint& term, double share, double coefficient, Contac
     mass += w;
 }
 
-// The stiffness of a mixed term over its nodes' 3 count coordinates, for the haptic buffer's
-// bounds on its nodes (the full model's tangent takes the mix's across all its terms instead,
-// BallMix::tangent), in two parts. Its balls' law curvature, sum_i c_i k_i g_i g_i^T (each
-// ball's own tangent), kept where c_i k_i > 0, so positive semi-definite: the term's hessian.
-// And the smooth maximum's curvature within the term, sum_ij (d c_i / d P_j) G_i G_j^T with
-// G_i the gradient of ball i's term (minus its node forces), d c_i / d P_j from BallMix: its
-// bound per node (Gershgorin), curvature_bound.
+// The stiffness of a mixed term over its nodes' 3 count coordinates, for its bound per node
+// (ContactPoint::stiffness_bound; the full model's tangent takes the mix's across all its
+// terms instead, BallMix::tangent), in two parts: its balls' law curvature, sum_i c_i k_i
+// g_i g_i^T (each ball's own tangent) where c_i k_i > 0, and the smooth maximum's curvature
+// within the term, sum_ij (d c_i / d P_j) G_i G_j^T, G_i the gradient of ball i's term (minus
+// its node forces) and d c_i / d P_j from BallMix. Each part's bound is Gershgorin's: its row
+// sums of its blocks' norms.
 class MixedHessian {
 public:
     void add(const ContactPoint& term, double coefficient, double curvature, double cross) {
@@ -64,21 +64,19 @@ public:
             }
         }
     }
-    void write(ContactPoint& out) const {
-        for (int a = 0; a < 3; ++a) {
-            out.curvature_bound[a] = 0.0;
-            for (int b = 0; b < 3; ++b) {
-                double block[9];
-                for (int r = 0; r < 3; ++r)
-                    for (int s = 0; s < 3; ++s) {
-                        const int i = 3 * a + r, j = 3 * b + s;
-                        block[3 * r + s] = curvature_[i][j] - b_[i] * c_[j] - c_[i] * b_[j];
-                    }
-                out.curvature_bound[a] += block_norm(block, 3, 1);
-            }
+    /// Node a's bound (N/m) over the term's count nodes.
+    double bound(int a, int count) const {
+        double sum = 0.0;
+        for (int b = 0; b < count; ++b) {
+            double block[9];
+            for (int r = 0; r < 3; ++r)
+                for (int s = 0; s < 3; ++s) {
+                    const int i = 3 * a + r, j = 3 * b + s;
+                    block[3 * r + s] = curvature_[i][j] - b_[i] * c_[j] - c_[i] * b_[j];
+                }
+            sum += block_norm(block, 3, 1) + block_norm(&law_[3 * a][3 * b], 9, 1);
         }
-        for (int r = 0; r < 9; ++r)
-            for (int s = 0; s < 9; ++s) out.hessian[r][s] = law_[r][s];
+        return sum;
     }
 
 private:
@@ -103,8 +101,8 @@ bool BallMix::term(const Collider& collider, const StepLaw& law, const double* x
         any = true;
     });
     if (!any || !(mass > 0.0)) return false;
-    hessian.write(out);
-    out.has_hessian = true;
+    out.mixed = true;
+    for (int a = 0; a < count; ++a) out.stiffness_bound[a] = hessian.bound(a, count);
     out.depth /= mass;
     for (int k = 0; k < 3; ++k) out.point[k] /= mass;
     if (!normalize3(out.normal)) return false;
@@ -113,13 +111,6 @@ bool BallMix::term(const Collider& collider, const StepLaw& law, const double* x
         for (int k = 0; k < 3; ++k) out.gradient[a][k] /= mass;
     }
     return true;
-}
-
-double mixed_stiffness_bound(const ContactPoint& p, int a) {
-    if (!p.has_hessian) return 0.0;
-    double bound = p.curvature_bound[a];
-    for (int b = 0; b < p.count; ++b) bound += block_norm(&p.hessian[3 * a][3 * b], 9, 1);
-    return bound;
 }
 
 void BallMix::reserve(int count) {

@@ -11,12 +11,6 @@
 
 namespace sh {
 
-/// An upper bound (N/m) on node a's rows of a mixed term's stiffness (ContactPoint's hessian
-/// and curvature_bound; 0 for other terms): Gershgorin's row sums of its blocks' norms, for
-/// an explicit integrator's stable step and the haptic buffer's contact tangent, isotropic
-/// (the mix's gradients are not along the term's normal alone).
-double mixed_stiffness_bound(const ContactPoint& p, int a);
-
 /// The excess of a collider made of several balls (Shape::ball_count: a capsule is the balls
 /// along its axis). Each ball i has the excess terms of a sphere over every surface edge and
 /// triangle, whose signed sum over the surface is the ball's own excess there, P_i (with its
@@ -56,9 +50,9 @@ public:
     void finish();
 
     /// The mixed excess term of the edge or triangle (excess_shape_contact for a collider of
-    /// several balls), its hessian the stiffness within the term (has_hessian): its balls'
-    /// law curvature and the smooth maximum's, for bounds on the term's own nodes (the haptic
-    /// buffer's); the full model's tangent takes the whole mix's (add_tangent_term, tangent).
+    /// several balls): mixed, with a bound on each node's stiffness from its balls' law
+    /// curvature and the smooth maximum's (stiffness_bound); the full model's tangent takes the
+    /// whole mix's (add_tangent_term, tangent).
     /// False if no ball with a share reaches it.
     bool term(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
               double weight, ContactPoint& out) const;

@@ -47,19 +47,6 @@ private:
     int count_ = 0;
 };
 
-// A node's depth (m) in the ball at centre, and its push's direction.
-double ball_depth(const Collider& collider, const double centre[3], const double* p, double normal[3]) {
-    sub3(p, centre, normal);
-    const double dist = norm3(normal);
-    if (dist > 1e-12 * collider.shape.ball_radius()) {
-        for (int k = 0; k < 3; ++k) normal[k] /= dist;
-    } else {  // at the centre: any direction; the collider's local x axis
-        const double ex[3] = {1.0, 0.0, 0.0};
-        collider.pose.rotate(ex, normal);
-    }
-    return collider.shape.ball_radius() - dist;
-}
-
 }  // namespace
 
 // The feature's bounding sphere: centre and radius (m).
@@ -78,8 +65,10 @@ double feature_bounds(const double* const points[3], int count, double centre[3]
 }
 
 void FeatureNodes::set(const Collider& collider, const double* x, const int32_t* nodes, int count) {
+    own_depths = collider.shape.ball_count() > 1;
     for (int a = 0; a < count; ++a) {
         points[a] = at(x, nodes[a]);
+        if (!own_depths) continue;
         Penetration pen;
         depth[a] = collider.shape.penetrate_point(collider.pose, points[a], pen) ? pen.depth : 0.0;
         for (int k = 0; k < 3; ++k) normal[a][k] = depth[a] > 0.0 ? pen.normal[k] : 0.0;
@@ -111,8 +100,11 @@ bool ball_term(const Collider& collider, const DepthPotential& psi, const Featur
     s.count = count;
     double node_push[3][3], node_normal[3][3];
     ResolvedFade fade(resolved_band(collider));
+    // The fade takes the nodes' depths in the collider (a sphere's: in its one ball).
+    double fade_normal[3][3];
     for (int a = 0; a < count; ++a) {
-        const double depth = ball_depth(collider, centre, feature.points[a], node_normal[a]);
+        const double depth =
+            ball_depth(centre, collider.shape.ball_radius(), collider.pose, feature.points[a], node_normal[a]);
         const bool inside = depth > 0.0;
         s.energy[a] = inside ? psi.energy(depth) : 0.0;
         const double force = inside ? psi.force(depth) : 0.0;
@@ -120,7 +112,8 @@ bool ball_term(const Collider& collider, const DepthPotential& psi, const Featur
             s.p[a][k] = feature.points[a][k];
             node_push[a][k] = force * node_normal[a][k];
         }
-        fade.add_node(feature.depth[a]);
+        fade.add_node(feature.own_depths ? feature.depth[a] : std::max(depth, 0.0));
+        for (int k = 0; k < 3; ++k) fade_normal[a][k] = feature.own_depths ? feature.normal[a][k] : node_normal[a][k];
     }
     if (!(fade.factor() > 0.0)) return false;
     fade.scale(weight);
@@ -131,6 +124,12 @@ bool ball_term(const Collider& collider, const DepthPotential& psi, const Featur
         out.normal[k] = e.n[k];
         out.point[k] = e.x[k];
     }
+    // For the tangent, stiffness times gradient gradient^T (set_contact_nodes: the weights
+    // times the normal): the law's curvature at the maximiser through its weights (the
+    // positive part of the term's Hessian; the nodes' own curvature it subtracts, the
+    // maximiser's motion and the fade are left to the line search). Not the node forces over
+    // the law's force: that ratio grows without bound where the maximiser is shallow and its
+    // nodes deep.
     set_contact_nodes(count, nodes, e.w, out);
     const double sign = count == 2 ? -1.0 : 1.0;  // faces add, edges subtract
     const double scale = sign * fade.factor();
@@ -150,12 +149,7 @@ bool ball_term(const Collider& collider, const DepthPotential& psi, const Featur
     for (int a = 0; a < count; ++a) {
         const double fade_slope = sign * e.value * fade.slope(a);
         for (int k = 0; k < 3; ++k) {
-            out.node_force[a][k] = scale * e.w[a] * (e.push[k] - node_push[a][k]) + fade_slope * feature.normal[a][k];
-            // For the tangent, stiffness times gradient gradient^T: the law's curvature at the
-            // maximiser through its weights (the positive part of the term's Hessian; the
-            // nodes' own curvature it subtracts, the maximiser's motion and the fade are left
-            // to the line search). Not the node forces over the law's force: that ratio grows
-            // without bound where the maximiser is shallow and its nodes deep.
+            out.node_force[a][k] = scale * e.w[a] * (e.push[k] - node_push[a][k]) + fade_slope * fade_normal[a][k];
             out.net_normal_force += out.node_force[a][k] * out.normal[k];
         }
     }

@@ -40,10 +40,11 @@ bool feature_normal(const double* const points[3], double normal[3]);
 /// feature_normal says (0, which culls nothing, for a sliver).
 double feature_distance(const double* p, const double* const points[3], int count, bool flat);
 
-/// A surface edge's or triangle's nodes: their positions, and their depths (m, 0 outside)
-/// and push directions in the collider.
+/// A surface edge's or triangle's nodes: their positions and, for a collider of several
+/// balls, their depths (m, 0 outside) and push directions in it (a sphere's are its ball's).
 struct FeatureNodes {
     const double* points[3];
+    bool own_depths;  ///< depth and normal are set (the collider has several balls)
     double depth[3];
     double normal[3][3];
     /// Fills the count nodes at positions x against collider.

@@ -32,25 +32,26 @@ struct ContactPoint {
                              ///< the normal, sign included
     double other_weights[3]; ///< kNodeFace: the other body's face nodes' shares (-w, the far
                              ///< side); their gradients are these times the normal
-    /// A collider's excess term mixed over its balls (BallMix::term), for the haptic buffer's
-    /// bounds on its nodes' stiffness: its balls' law curvature among its nodes where positive,
-    /// hessian[3a+r][3b+s] for nodes a, b and axes r, s (N/m), and per node a bound (N/m) on
-    /// its rows of the smooth maximum's curvature within the term. The full model's tangent
-    /// takes neither, nor stiffness g g^T, but the mix's across its terms (BallMix::tangent).
-    /// Else has_hessian is false.
-    bool has_hessian = false;
-    double hessian[9][9];
-    double curvature_bound[3];
+    /// A collider's excess term mixed over its balls (BallMix::term): the full model's
+    /// tangent takes the mix's across its terms (BallMix::tangent), not stiffness g g^T, and
+    /// stiffness_bound holds an upper bound (N/m) on each node's rows of the term's stiffness,
+    /// along every axis (the mix's gradients are not along the normal alone), for an explicit
+    /// integrator's stable step and the haptic buffer's contact tangent. Else false.
+    bool mixed = false;
+    double stiffness_bound[3];
 };
 
-/// The weight of p's normal tangent, g_a g_b^T per pair of its nodes (a term with has_hessian:
-/// its damping's only), in a matrix
+/// Node a's stiffness_bound for a mixed term, else 0 (N/m).
+inline double mixed_stiffness_bound(const ContactPoint& p, int a) { return p.mixed ? p.stiffness_bound[a] : 0.0; }
+
+/// The weight of p's normal tangent, g_a g_b^T per pair of its nodes (a mixed term: its
+/// damping's only), in a matrix
 /// stiffness_scale K + damping_scale D: a subtracted term (an edge's excess, whose stiffness is
 /// negative) is left out, so that the tangent stays positive semi-definite (and bounds the
 /// potential's Hessian from above).
 inline double normal_tangent_scale(const ContactPoint& p, double stiffness_scale, double damping_scale) {
     // A term mixed over a collider's balls has its stiffness elsewhere (BallMix::tangent).
-    const double scale = (p.has_hessian ? 0.0 : stiffness_scale * p.stiffness) + damping_scale * p.damping;
+    const double scale = (p.mixed ? 0.0 : stiffness_scale * p.stiffness) + damping_scale * p.damping;
     return scale > 0.0 ? scale : 0.0;
 }
 

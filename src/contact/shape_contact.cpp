@@ -55,9 +55,7 @@ void apply_excess_damping(const sh_contact_params& p, const double vrel[3], Cont
     out.normal_force *= factor;
     out.net_normal_force *= factor;
     out.stiffness *= factor;
-    for (int r = 0; r < 9 && out.has_hessian; ++r)
-        for (int s = 0; s < 9; ++s) out.hessian[r][s] *= factor;
-    for (int a = 0; a < 3 && out.has_hessian; ++a) out.curvature_bound[a] *= factor;
+    for (int a = 0; a < 3 && out.mixed; ++a) out.stiffness_bound[a] *= factor;
     for (int a = 0; a < out.count; ++a)
         for (int k = 0; k < 3; ++k) out.node_force[a][k] *= factor;
 }

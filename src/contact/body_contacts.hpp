@@ -180,6 +180,10 @@ private:
     /// damping or friction), point null for one not in contact.
     template <class Emit>
     void evaluate_candidates(const double* x, const double* v, Emit&& emit) const;
+    /// evaluate_candidates, calling after_group(group) when a group's candidates are done (its
+    /// collider's BallMix still in scratch_.balls).
+    template <class Emit, class AfterGroup>
+    void evaluate_candidates(const double* x, const double* v, Emit&& emit, AfterGroup&& after_group) const;
     /// evaluate_candidates for the candidates in contact only, with a reference to the point.
     template <class Emit>
     void evaluate(const double* x, const double* v, Emit&& emit) const;
@@ -193,7 +197,7 @@ private:
     template <class Visit>
     void for_each_excess_candidate(const Group& group, Visit&& visit) const;
     /// The tangent of group's collider's BallMix across its terms (if it is made of several
-    /// balls) into system, times stiffness_scale.
+    /// balls; the mix at x already in scratch_.balls) into system, times stiffness_scale.
     void add_ball_mix_tangent(const Group& group, const double* x, double stiffness_scale, const int32_t* free_index,
                               SparseSystem& system) const;
     /// Adds p's node forces (a collider's term) to the nodes' net push, listing each node once.

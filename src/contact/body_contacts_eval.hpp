@@ -24,8 +24,8 @@ void BodyContacts::for_each_excess_candidate(const Group& group, Visit&& visit) 
     }
 }
 
-template <class Emit>
-void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& emit) const {
+template <class Emit, class AfterGroup>
+void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& emit, AfterGroup&& after_group) const {
     for (const Group& group : groups_) {
         mix_balls(group, x);
         for (int32_t i = group.begin; i < group.end; ++i) {
@@ -37,7 +37,13 @@ void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& 
             }
             emit(c, &point);
         }
+        after_group(group);
     }
+}
+
+template <class Emit>
+void BodyContacts::evaluate_candidates(const double* x, const double* v, Emit&& emit) const {
+    evaluate_candidates(x, v, emit, [](const Group&) {});
 }
 
 template <class Emit>

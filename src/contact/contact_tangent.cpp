@@ -75,22 +75,24 @@ void add_point_tangent(const ContactPoint& p, const PointTangent& tangent, const
 void BodyContacts::add_tangent(const double* x, const double* v, double stiffness_scale, double damping_scale,
                                const int32_t* free_index, SparseSystem& system) const {
     const ScopedTimer timer(scratch_.evaluation_seconds);
-    evaluate(x, v, [&](const ContactCandidate& c, const ContactPoint& p) {
-        add_point_tangent(p, PointTangent(p, *c.params, stiffness_scale, damping_scale), free_index, system);
-    });
+    evaluate_candidates(
+        x, v,
+        [&](const ContactCandidate& c, const ContactPoint* p) {
+            if (p) add_point_tangent(*p, PointTangent(*p, *c.params, stiffness_scale, damping_scale), free_index, system);
+        },
+        [&](const Group& group) {
+            if (stiffness_scale != 0.0) add_ball_mix_tangent(group, x, stiffness_scale, free_index, system);
+        });
     evaluate_friction(v, [&](const ContactCandidate& c, const ContactPoint& p) {
         const PointTangent tangent(p, *c.params, stiffness_scale, damping_scale, friction_chord(c, p));
         add_point_tangent(p, tangent, free_index, system);
     });
-    if (stiffness_scale == 0.0) return;
-    for (const Group& group : groups_) add_ball_mix_tangent(group, x, stiffness_scale, free_index, system);
 }
 
 void BodyContacts::add_ball_mix_tangent(const Group& group, const double* x, double stiffness_scale,
                                         const int32_t* free_index, SparseSystem& system) const {
     const Collider* collider = ball_mix_collider(group);
     if (!collider) return;
-    mix_balls(group, x);
     BallMix& mix = scratch_.balls;
     mix.begin_tangent();
     for_each_excess_candidate(group, [&](const ContactCandidate& c, int count) {

@@ -83,14 +83,17 @@ def test_binary_file_without_meshio_is_unsupported(meshes, tmp_path, monkeypatch
     assert err.value.status_name == "SH_ERR_UNSUPPORTED"
 
 
-def test_tetrahedralize_the_smooth_liver_and_simulate_it(meshes):
+def test_tetrahedralize_the_smooth_liver_and_simulate_it(meshes, tmp_path, monkeypatch):
     pytest.importorskip("pytetwild")
     pytest.importorskip("meshio")
     import meshio
     surface = meshio.read(meshes / "liver-smooth.obj")
     vertices = surface.points * 0.01
     triangles = np.concatenate([b.data for b in surface.cells if b.type == "triangle"])
-    liver = softhap.tetrahedralize(meshes / "liver-smooth.obj", units="cm", edge_length=0.008)
+    source = (meshes / "liver-smooth.obj").resolve()
+    monkeypatch.chdir(tmp_path)
+    liver = softhap.tetrahedralize(source, units="cm", edge_length=0.008)
+    assert list(tmp_path.iterdir()) == []  # no scratch file left in the caller's directory
     assert liver.info["reoriented_tet_count"] == 0
     assert liver.info["volume"] == pytest.approx(enclosed_volume(vertices, triangles), rel=0.03)
     with softhap.World(gravity=(0.0, 0.0, -9.81)) as world:

@@ -4,6 +4,7 @@ through an optional meshing backend (pytetwild, fTetWild's Python binding, MPL-2
 from __future__ import annotations
 
 import os
+import tempfile
 from typing import Any, Optional, Tuple, Union
 
 import numpy as np
@@ -61,7 +62,15 @@ def tetrahedralize(surface: Union[str, os.PathLike, Tuple[Any, Any]], units: Uni
     options = {"quiet": quiet}
     if edge_length is not None:
         options["edge_length_abs"] = float(edge_length)
-    nodes, tets = pytetwild.tetrahedralize(vertices, triangles, **options)
+    # fTetWild writes a scratch file (__tracked_surface.stl) into the working directory: run it
+    # in a temporary one, so that the caller's is left as it was.
+    cwd = os.getcwd()
+    with tempfile.TemporaryDirectory() as scratch:
+        os.chdir(scratch)
+        try:
+            nodes, tets = pytetwild.tetrahedralize(vertices, triangles, **options)
+        finally:
+            os.chdir(cwd)
     e = nodes[tets[:, 1:]] - nodes[tets[:, :1]]
     negative = np.einsum("ij,ij->i", e[:, 0], np.cross(e[:, 1], e[:, 2])) < 0.0
     tets[negative] = tets[negative][:, [0, 1, 3, 2]]  # fTetWild's orientation is the opposite one

@@ -59,7 +59,6 @@ struct ShapeKind {
 /// The row of kind: SH_ERR_INVALID_ARGUMENT if kind is not a sh_shape_kind.
 const ShapeKind& shape_kind(int kind);
 
-
 /// Bounds of a shape symmetric about the pose's position: reach[k] (m) on either side along
 /// world axis k, grown by margin.
 inline void centred_bounds(const Pose& pose, const double reach[3], double margin, double lo[3], double hi[3]) {

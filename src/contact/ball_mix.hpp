@@ -20,13 +20,13 @@ namespace sh {
 /// a smooth maximum: equal to the P_i where they are equal (a capsule lying on a face: the
 /// balls along its ridge reach equally deep, and the face's nodes share the ridge's push
 /// evenly), equal to the only ball that reaches, otherwise between their mean and their
-/// largest, within about 15 % of the largest as a capsule tilts onto one end. The exact
+/// largest, within about 16 % of the largest as a capsule tilts onto one end. The exact
 /// maximum would make its maximiser jump from one end of a lying capsule to the other as
 /// the face tilts, and the forces on the face's nodes with it. Each feature's term takes
 /// sum_i s_i T_i of its balls' terms T_i as its energy, s_i = P_i^p / sum_j P_j^p, and
 /// sum_i c_i grad T_i as its gradient, c_i = P_i^(p-1) ((p+1) P_i - p X) / sum_j P_j^p: the
 /// terms sum to X and their forces to X's gradient. So a collider of several balls takes
-/// two passes over its terms per evaluation: add() for every term, finish(), then term().
+/// two passes over its terms per evaluation: sum() over them all, then term() for each.
 class BallMix {
 public:
     /// The Lehmer mean's order p: higher follows the largest ball more closely (within 11 %
@@ -38,16 +38,18 @@ public:
     /// Makes room for count balls (allocates if there is less).
     void reserve(int count);
 
-    /// Starts a sum over collider's balls (the room reserved must hold them).
-    void begin(const Collider& collider);
-
-    /// Adds the ball terms of the edge (count 2) or triangle (count 3) nodes at positions x
-    /// (law, weight: see excess_shape_contact) to the balls' totals.
-    void add(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
-             double weight);
-
-    /// Computes the shares and coefficients from the totals.
-    void finish();
+    /// Sums collider's balls' totals over the surface's edges and triangles and computes the
+    /// shares and coefficients (the room reserved must hold its balls): each_term(add) calls
+    /// add(law, x, nodes, count, weight) for each edge (count 2) or triangle (count 3) of nodes
+    /// at positions x (law, weight: see excess_shape_contact).
+    template <class EachTerm>
+    void sum(const Collider& collider, EachTerm&& each_term) {
+        begin(collider);
+        each_term([&](const StepLaw& law, const double* x, const int32_t* nodes, int count, double weight) {
+            add(collider, law, x, nodes, count, weight);
+        });
+        finish();
+    }
 
     /// The mixed excess term of the edge or triangle (excess_shape_contact for a collider of
     /// several balls): mixed, with a bound on each node's stiffness from its balls' law
@@ -87,6 +89,13 @@ public:
     double cross(int i) const { return mix_[kFields * static_cast<size_t>(i) + 4]; }
 
 private:
+    /// Starts a sum over collider's balls.
+    void begin(const Collider& collider);
+    /// Adds the ball terms of one edge or triangle to the balls' totals.
+    void add(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
+             double weight);
+    /// Computes the shares and coefficients from the totals.
+    void finish();
     /// The dense tangent over the touched nodes (3 per node, row-major), from the sums.
     void tangent_matrix(vec<double>& out) const;
 

@@ -70,11 +70,11 @@ void BodyContacts::mix_balls(const Group& group, const double* x) const {
     const Collider* collider = ball_mix_collider(group);
     if (!collider) return;
     scratch_.balls.reserve(collider->shape.ball_count());
-    scratch_.balls.begin(*collider);
-    for_each_excess_candidate(group, [&](const ContactCandidate& c, int count) {
-        scratch_.balls.add(*collider, step_law(c), x, c.face, count, c.excess_weight);
+    scratch_.balls.sum(*collider, [&](auto&& add) {
+        for_each_excess_candidate(group, [&](const ContactCandidate& c, int count) {
+            add(step_law(c), x, c.face, count, c.excess_weight);
+        });
     });
-    scratch_.balls.finish();
 }
 
 bool BodyContacts::touching(const ContactCandidate& c, const double* x, const double* v, ContactPoint& out) const {

@@ -29,7 +29,6 @@ inline void cross3(const double* a, const double* b, double* out) {
 /// |a|
 inline double norm3(const double* a) { return std::sqrt(dot3(a, a)); }
 
-/// True if every component is finite.
 /// The Frobenius norm of the 3x3 block whose entry (r, s) is m[r * row + s * column].
 inline double block_norm(const double* m, size_t row, size_t column) {
     double squares = 0.0;
@@ -38,6 +37,7 @@ inline double block_norm(const double* m, size_t row, size_t column) {
     return std::sqrt(squares);
 }
 
+/// True if every component is finite.
 inline bool finite3(const double* a) { return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]); }
 
 }  // namespace sh

@@ -282,12 +282,11 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
     const sh_contact_params& law = tool_.params;
     clear_contact();
     if (tool_.shape.ball_count() > 1) {  // a tool of several balls: their mix first (BallMix)
-        balls_.begin(tool_);
-        visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
-            if (count > 1)
-                balls_.add(tool_, hunt_crossley_step_law(law, 0.0, 0.0), x, nodes, count, excess_weight(tool_, size));
+        balls_.sum(tool_, [&](auto&& add) {
+            visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
+                if (count > 1) add(hunt_crossley_step_law(law, 0.0, 0.0), x, nodes, count, excess_weight(tool_, size));
+            });
         });
-        balls_.finish();
     }
     visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
         ContactPoint p;

@@ -235,26 +235,26 @@ void SparseSystem::add_block(int32_t free_i, int32_t free_j, const double* B, do
     const int32_t I = transpose ? free_j : free_i, J = transpose ? free_i : free_j;
     for (int s = 0; s < 3; ++s) {
         const int32_t column = 3 * J + s;
-        const int32_t* first = row_indices_.data() + column_starts_[static_cast<size_t>(column)];
-        const int32_t* last = row_indices_.data() + column_starts_[static_cast<size_t>(column) + 1];
         for (int r = 0; r < 3; ++r) {
             const int32_t row = 3 * I + r;
             if (row > column) continue;
-            const int32_t* slot = std::lower_bound(first, last, row);
-            SH_REQUIRE(slot != last && *slot == row, SH_ERR_INTERNAL,
-                       "sparse system: no block for free nodes %d and %d", free_i, free_j);
+            const int32_t slot = value_slot(row, column);
+            SH_REQUIRE(slot >= 0, SH_ERR_INTERNAL, "sparse system: no block for free nodes %d and %d", free_i, free_j);
             const double b = transpose ? B[3 * s + r] : B[3 * r + s];
-            values_[static_cast<size_t>(slot - row_indices_.data())] += scale * b;
+            values_[static_cast<size_t>(slot)] += scale * b;
         }
     }
 }
 
-bool SparseSystem::has_block(int32_t free_i, int32_t free_j) const {
-    const int32_t row = 3 * std::min(free_i, free_j), column = 3 * std::max(free_i, free_j);
+int32_t SparseSystem::value_slot(int32_t row, int32_t column) const {
     const int32_t* first = row_indices_.data() + column_starts_[static_cast<size_t>(column)];
     const int32_t* last = row_indices_.data() + column_starts_[static_cast<size_t>(column) + 1];
     const int32_t* slot = std::lower_bound(first, last, row);
-    return slot != last && *slot == row;
+    return slot != last && *slot == row ? static_cast<int32_t>(slot - row_indices_.data()) : -1;
+}
+
+bool SparseSystem::has_block(int32_t free_i, int32_t free_j) const {
+    return value_slot(3 * std::min(free_i, free_j), 3 * std::max(free_i, free_j)) >= 0;
 }
 
 void SparseSystem::add_diagonal(const double* diag, double scale) {

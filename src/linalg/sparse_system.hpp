@@ -64,6 +64,8 @@ public:
     void describe_dof(int32_t d, char* out, size_t size) const;
 
 private:
+    /// Value slot of stored entry (row, column), row <= column; -1 if the pattern has none.
+    int32_t value_slot(int32_t row, int32_t column) const;
     int32_t dof_count_ = 0;
     size_t element_count_ = 0;
     uint64_t pattern_id_ = 0;

@@ -107,6 +107,8 @@ private:
     void take_update(double scale);
     /// Backtracking line search along delta; false if no step length qualifies.
     bool line_search(double slope, bool fresh);
+    /// d Phi / d scale along delta at the current iterate: the residual (grad Phi) dotted with it.
+    double slope_along_update() const;
     /// After a fresh full update: extends it while Phi keeps falling steeply
     /// (extend_update_while_falling).
     void extend_update(double slope);
@@ -325,14 +327,15 @@ void NewtonStep::take_update(double scale) {
     evaluate();
 }
 
+double NewtonStep::slope_along_update() const {
+    double slope = 0.0;
+    for (size_t d = 0; d < matrix_.delta.size(); ++d) slope += matrix_.residual[d] * matrix_.delta[d];
+    return slope;
+}
+
 void NewtonStep::extend_update(double slope) {
     extend_update_while_falling(
-        slope, phi_.value,
-        [&] {
-            double slope_here = 0.0;
-            for (size_t d = 0; d < matrix_.delta.size(); ++d) slope_here += matrix_.residual[d] * matrix_.delta[d];
-            return slope_here;
-        },
+        slope, phi_.value, [&] { return slope_along_update(); },
         [&](double scale) {
             take_update(scale);
             return phi_.finite() ? phi_.value : NAN;
@@ -452,8 +455,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
             return false;
         }
         keep_velocities();
-        double slope = 0.0;  // d Phi / d scale along delta, at scale 0
-        for (size_t d = 0; d < matrix_.delta.size(); ++d) slope += matrix_.residual[d] * matrix_.delta[d];
+        const double slope = slope_along_update();  // at scale 0
         const bool fresh = fresh_;
         if (!(slope < 0.0) || !line_search(slope, fresh)) {
             if (!fresh) {  // the kept factorisation is too far from the current tangent

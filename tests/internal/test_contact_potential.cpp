@@ -133,9 +133,9 @@ void each_feature(const Collider& c, const Patch& p, Visit&& visit) {
 // The collider's BallMix over the patch at x (used by colliders of several balls).
 void mix_over(const Collider& c, const Patch& p, const sh::StepLaw& law, const double* x, sh::BallMix& mix) {
     mix.reserve(c.shape.ball_count());
-    mix.begin(c);
-    each_feature(c, p, [&](const int32_t* nodes, int count, double weight) { mix.add(c, law, x, nodes, count, weight); });
-    mix.finish();
+    mix.sum(c, [&](auto&& add) {
+        each_feature(c, p, [&](const int32_t* nodes, int count, double weight) { add(law, x, nodes, count, weight); });
+    });
 }
 
 // Calls visit(point) for every acting term of the patch's potential against the collider, at
@@ -414,10 +414,10 @@ void test_small_capsule_lying_between_nodes_feels_the_law(void**) {
 }
 
 // The same capsule over a face, tilted through lying flat by 0.1 rad either way (its lowest
-// point kept at the same depth): the force stays within the law at that depth and 16 % below
-// it (the smooth maximum's bound), and its centre of pressure goes over from the lower end to
-// the other in steps of at most 5 % of the way: the exact maximum's would jump from end to end
-// at once.
+// point kept at the same depth): the force stays within the law at that depth (a mean cannot
+// exceed its largest ball) and at most 16 % below it (the bound README documents for order 4;
+// 0.849 measured), and its centre of pressure goes over from the lower end to the other in
+// steps of at most 5 % of the way: the exact maximum's would jump from end to end at once.
 void test_tilting_capsule_hands_over_smoothly(void**) {
     const Patch flat = hexagon(0.01, 0.0);
     const double radius = 0.001, depth = 0.0004;

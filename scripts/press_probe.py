@@ -99,8 +99,9 @@ def main(name, size, radius, stiffness, friction, plot_path, half_length=None):
         print("  steps: median %.1f ms, p99 %.1f ms; SH_WARN_NOT_CONVERGED %d; largest tick-to-tick change %.0f %% of peak"
               % (np.median(times), np.percentile(times, 99), world.warnings["SH_WARN_NOT_CONVERGED"], 100 * jump))
     if plot_path:
-        title = ("%s (%.0f cm), sphere r = %g mm, %g N/m^1.5, friction %g\nlargest tick-to-tick change %.1f %% of peak"
-                 % (os.path.basename(name), 100 * size, 1e3 * radius, stiffness, friction, 100 * jump))
+        tool_name = "sphere" if half_length is None else "capsule (half length %g mm)" % (1e3 * half_length)
+        title = ("%s (%.0f cm), %s r = %g mm, %g N/m^1.5, friction %g\nlargest tick-to-tick change %.1f %% of peak"
+                 % (os.path.basename(name), 100 * size, tool_name, 1e3 * radius, stiffness, friction, 100 * jump))
         plot(plot_path, title, travel_full, full, travel_ticks, rendered)
 
 

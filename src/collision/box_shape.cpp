@@ -9,6 +9,14 @@
 namespace sh {
 namespace {
 
+bool box_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth, double normal[3]);
+
+// Local point x's depth (m, 0 outside).
+double box_local_depth(const ShapeGeometry& g, const double* x) {
+    double depth = 0.0, normal[3];
+    return box_penetrate(g, Pose{}, x, depth, normal) ? depth : 0.0;
+}
+
 void box_init(const sh_shape& def, ShapeGeometry& g) {
     for (int k = 0; k < 3; ++k) {
         SH_REQUIRE(std::isfinite(def.half_extents[k]) && def.half_extents[k] > 0.0, SH_ERR_INVALID_ARGUMENT,
@@ -16,6 +24,10 @@ void box_init(const sh_shape& def, ShapeGeometry& g) {
         g.half_extents[k] = def.half_extents[k];
     }
     g.inner_radius = std::min({g.half_extents[0], g.half_extents[1], g.half_extents[2]});
+    double corners[8][3];
+    for (int c = 0; c < 8; ++c)
+        for (int k = 0; k < 3; ++k) corners[c][k] = (c >> k & 1) ? g.half_extents[k] : -g.half_extents[k];
+    inscribe_ball_core(g.balls, corners[0], 8, box_local_depth, g);
 }
 
 void box_bounds(const ShapeGeometry& g, const Pose& pose, double margin, double lo[3], double hi[3]) {
@@ -59,9 +71,11 @@ bool box_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3], 
 
 }  // namespace
 
-// No balls: a box is no union of balls (the ball inscribed in a cube misses its corners), and
-// an exact excess over its facets' arrangement jumps or kinks where its maximiser changes,
-// which Newton does not survive; the nodes carry its contact.
-extern const ShapeKind kBoxShape = {SH_SHAPE_BOX, "box", false, box_init, box_bounds, box_support, box_penetrate, nullptr, nullptr};
+// Between nodes, a box's contact takes the balls of its largest inscribed capsule: an exact
+// excess over its facets' arrangement would jump or kink where its maximiser changes, which
+// Newton does not survive. The capsule misses its edges and corners (a cube's is its inscribed
+// ball): those sink between nodes until the capsule meets the face.
+extern const ShapeKind kBoxShape = {SH_SHAPE_BOX,  "box",           false,          box_init,        box_bounds,
+                                    box_support,   box_penetrate,   core_balls_near, core_ball_centre};
 
 }  // namespace sh

@@ -10,12 +10,21 @@
 namespace sh {
 namespace {
 
+bool convex_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth, double normal[3]);
+
+// Local point x's depth (m, 0 outside).
+double convex_local_depth(const ShapeGeometry& g, const double* x) {
+    double depth = 0.0, normal[3];
+    return convex_penetrate(g, Pose{}, x, depth, normal) ? depth : 0.0;
+}
+
 void convex_init(const sh_shape& def, ShapeGeometry& g) {
 #ifndef SOFTHAP_WITH_CCD
     require(false, SH_ERR_UNSUPPORTED, "convex shapes need libccd (built with SOFTHAP_WITH_CCD=OFF)");
 #endif
     g.hull.build(def.points, def.point_count);
     g.inner_radius = g.hull.inner_radius();
+    inscribe_ball_core(g.balls, g.hull.points().data(), static_cast<int>(g.hull.points().size() / 3), convex_local_depth, g);
 }
 
 void convex_bounds(const ShapeGeometry& g, const Pose& pose, double margin, double lo[3], double hi[3]) {
@@ -60,8 +69,8 @@ bool convex_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3
 
 }  // namespace
 
-// No balls, as for the box: the nodes carry a convex hull's contact.
-extern const ShapeKind kConvexShape = {SH_SHAPE_CONVEX, "convex", false,         convex_init, convex_bounds,
-                                       convex_support,  convex_penetrate, nullptr, nullptr};
+// Between nodes, as for the box, the balls of its largest inscribed capsule.
+extern const ShapeKind kConvexShape = {SH_SHAPE_CONVEX,  "convex",         false,           convex_init,     convex_bounds,
+                                       convex_support,   convex_penetrate, core_balls_near, core_ball_centre};
 
 }  // namespace sh

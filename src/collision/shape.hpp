@@ -46,15 +46,19 @@ public:
     /// True for an unbounded half-space (a plane; see ShapeKind::half_space).
     bool is_half_space() const;
 
-    /// The number of balls whose union the contact potential's excess terms take
-    /// (shape_contact.hpp): 1 for a sphere; for a capsule, balls of its radius along its axis
-    /// from end to end, at most half a radius apart; 0 for kinds whose nodes carry all of
-    /// their contact (box, convex hull, plane). A kind's balls lie evenly spaced along a
-    /// segment, in order.
-    int ball_count() const { return geometry_.ball_count; }
+    /// The number of balls whose union the contact potential's excess terms take between a
+    /// body's nodes (shape_contact.hpp), evenly spaced along a segment, in order, at most half
+    /// a radius apart (ball_core.hpp): 1 for a sphere; for a capsule, balls of its radius
+    /// along its axis; for a box or a convex hull, those of its largest inscribed capsule
+    /// along its longest axis; 0 for a plane, whose nodes carry all of its contact.
+    int ball_count() const { return geometry_.balls.count; }
 
     /// The balls' radius (m).
-    double ball_radius() const { return geometry_.radius; }
+    double ball_radius() const { return geometry_.balls.radius; }
+
+    /// True if the one ball is the shape itself (a sphere): a point's depth in the shape is
+    /// its depth in the ball.
+    bool ball_is_shape() const { return geometry_.balls.is_shape; }
 
     /// The world centre of ball i (0 <= i < ball_count()) at pose.
     void ball_centre(const Pose& pose, int i, double out[3]) const;

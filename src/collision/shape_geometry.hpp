@@ -2,6 +2,7 @@
 // read them (shape_kind.hpp).
 #pragma once
 
+#include "collision/ball_core.hpp"
 #include "collision/convex_hull.hpp"
 
 namespace sh {
@@ -9,8 +10,8 @@ namespace sh {
 /// The fields of sh_shape a kind reads, validated, and what its kind derives from them. Each
 /// kind fills and reads only its own fields.
 struct ShapeGeometry {
-    double radius = 0.0;          ///< sphere, capsule (m); their balls' radius
-    int ball_count = 0;           ///< sphere 1, capsule its axis's balls; others 0 (Shape::ball_count)
+    double radius = 0.0;          ///< sphere, capsule (m)
+    BallCore balls;               ///< the balls its contact takes between nodes (Shape::ball_count)
     double half_length = 0.0;     ///< capsule: half its axis segment, along local z (m)
     double half_extents[3] = {};  ///< box: half widths along the local axes (m)
     ConvexHull hull;              ///< convex

@@ -48,9 +48,9 @@ struct ShapeKind {
     /// True if world point x lies inside at pose: then its depth (m, > 0) and the outward
     /// normal (world) at the nearest surface point, which Shape::penetrate_point normalises.
     bool (*penetrate)(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth, double normal[3]);
-    /// The balls (of radius g.radius, g.ball_count of them) whose centres may lie within
-    /// reach (m) of local point x: those from first to last (none if first > last). Null for
-    /// a kind without balls (Shape::ball_count).
+    /// The balls (g.balls) whose centres may lie within reach (m) of local point x: those
+    /// from first to last (none if first > last). Null for a kind without balls
+    /// (Shape::ball_count).
     void (*balls_near)(const ShapeGeometry& g, const double x[3], double reach, int& first, int& last);
     /// The centre of ball i, in the local frame.
     void (*ball_centre)(const ShapeGeometry& g, int i, double centre[3]);

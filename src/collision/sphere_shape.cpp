@@ -10,7 +10,9 @@ namespace {
 void sphere_init(const sh_shape& def, ShapeGeometry& g) {
     g.radius = checked_radius(def);
     g.inner_radius = g.radius;
-    g.ball_count = 1;
+    const double centre[3] = {0.0, 0.0, 0.0}, axis[3] = {0.0, 0.0, 1.0};
+    set_ball_core(g.balls, centre, axis, 0.0, g.radius);
+    g.balls.is_shape = true;
 }
 
 void sphere_bounds(const ShapeGeometry& g, const Pose& pose, double margin, double lo[3], double hi[3]) {
@@ -32,16 +34,9 @@ bool sphere_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3
     return depth > 0.0;
 }
 
-void sphere_balls_near(const ShapeGeometry&, const double x[3], double reach, int& first, int& last) {
-    first = 0;
-    last = norm3(x) <= reach ? 0 : -1;
-}
-
-void sphere_ball_centre(const ShapeGeometry&, int, double centre[3]) { centre[0] = centre[1] = centre[2] = 0.0; }
-
 }  // namespace
 
 extern const ShapeKind kSphereShape = {SH_SHAPE_SPHERE, "sphere", false,       sphere_init,      sphere_bounds,
-                                       sphere_support,  sphere_penetrate, sphere_balls_near, sphere_ball_centre};
+                                       sphere_support,  sphere_penetrate, core_balls_near,  core_ball_centre};
 
 }  // namespace sh

@@ -65,7 +65,7 @@ double feature_bounds(const double* const points[3], int count, double centre[3]
 }
 
 void FeatureNodes::set(const Collider& collider, const double* x, const int32_t* nodes, int count) {
-    own_depths = collider.shape.ball_count() > 1;
+    own_depths = !collider.shape.ball_is_shape();
     for (int a = 0; a < count; ++a) {
         points[a] = at(x, nodes[a]);
         if (!own_depths) continue;

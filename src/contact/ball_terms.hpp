@@ -1,6 +1,6 @@
 // A ball's excess terms over a body's surface (shape_contact.hpp): a sphere's, or each of the
-// balls a capsule is made of (Shape::ball_count), for the excess of one ball
-// (excess_shape_contact) and the mix of several (BallMix).
+// balls a capsule, box or convex hull takes between nodes (Shape::ball_count), for the excess
+// of one ball (excess_shape_contact) and the mix of several (BallMix).
 #pragma once
 
 #include "collision/closest_point.hpp"
@@ -44,7 +44,7 @@ double feature_distance(const double* p, const double* const points[3], int coun
 /// balls, their depths (m, 0 outside) and push directions in it (a sphere's are its ball's).
 struct FeatureNodes {
     const double* points[3];
-    bool own_depths;  ///< depth and normal are set (the collider has several balls)
+    bool own_depths;  ///< depth and normal are set (the collider is not its one ball)
     double depth[3];
     double normal[3][3];
     /// Fills the count nodes at positions x against collider.

@@ -5,8 +5,9 @@
 // contact the mesh resolves is its nodes' own laws, the energy follows the forces' work along
 // random paths, a sphere or a capsule sliding at constant height over a curved patch feels a
 // force that changes smoothly, a tilting capsule hands its push from one end to the other
-// smoothly, and the capsule's tangent matches the forces' slope. Boxes and convex hulls have
-// node terms only (their forces are still checked against the potential).
+// smoothly, and the capsule's tangent matches the forces' slope. Boxes and convex hulls take
+// the balls of their largest inscribed capsule between nodes: its size is checked against the
+// shape's geometry, and a plate lying between nodes feels the law as the capsule does.
 #include "contact/ball_mix.hpp"
 #include "contact/collider.hpp"
 #include "contact/hunt_crossley.hpp"
@@ -226,7 +227,8 @@ void test_forces_are_the_potentials_gradient(void**) {
                 const double error = gradient_error(c, cap);
                 printf("%-8s size %.1f mm at (%.1f, %.1f) mm: |F| %.4g N, gradient error %.2e\n", names[s],
                        1e3 * size, 1e3 * spot[0], 1e3 * spot[1], std::sqrt(total[0] * total[0] + total[1] * total[1] + total[2] * total[2]), error);
-                assert_true(total[2] < 0.0 || s > 0);  // other kinds: nodes only, may miss them
+                // A tilted box's or hull's lowest corner may lie outside its inscribed capsule.
+                assert_true(total[2] < 0.0 || s > 1);
                 assert_true(error < 1e-5);
             }
 }
@@ -519,6 +521,118 @@ void test_capsule_tangent_matches_the_forces_slope(void**) {
 
 }  // namespace
 
+// The balls a box takes between nodes: its largest inscribed capsule, along its longest axis,
+// of its smallest half width, ending that far short of its ends (the depth along the axis is
+// min(r, h_long - |t|)). A convex hull of the box's corners is the box; a triangular prism
+// (equilateral section of inradius rho, length 2 l) has the capsule of radius rho ending rho
+// short of its ends.
+void expect_core(const sh::Shape& shape, double radius, const double end[3], const char* what) {
+    double a[3], b[3];
+    const sh::Pose identity;
+    const int count = shape.ball_count();
+    shape.ball_centre(identity, 0, a);
+    shape.ball_centre(identity, count - 1, b);
+    const double length = std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) + (b[2] - a[2]) * (b[2] - a[2]));
+    printf("%s: %d balls of radius %.6g mm from (%.4g, %.4g, %.4g) to (%.4g, %.4g, %.4g) mm\n", what, count,
+           1e3 * shape.ball_radius(), 1e3 * a[0], 1e3 * a[1], 1e3 * a[2], 1e3 * b[0], 1e3 * b[1], 1e3 * b[2]);
+    const double half = std::sqrt(end[0] * end[0] + end[1] * end[1] + end[2] * end[2]);
+    assert_true(std::fabs(shape.ball_radius() - radius) < 1e-9 * radius);
+    assert_true(std::fabs(0.5 * length - half) < 1e-9 * half);
+    // Centred, along the expected axis (either way round).
+    for (int k = 0; k < 3; ++k) {
+        assert_true(std::fabs(a[k] + b[k]) < 1e-9 * half);
+        assert_true(std::fabs(std::fabs(b[k]) - std::fabs(end[k])) < 1e-9 * half);
+    }
+    assert_true(count - 1 >= 4.0 * half / radius && count - 2 < 4.0 * half / radius);  // half a radius apart
+}
+
+void test_box_and_hull_take_their_inscribed_capsule(void**) {
+    sh_shape box{};
+    box.kind = SH_SHAPE_BOX;
+    box.half_extents[0] = 0.003;
+    box.half_extents[1] = 0.012;
+    box.half_extents[2] = 0.001;
+    const double box_end[3] = {0.0, 0.011, 0.0};
+    expect_core(sh::Shape(box), 0.001, box_end, "box 6 x 24 x 2 mm");
+#ifdef SOFTHAP_WITH_CCD
+    double corners[8][3];
+    for (int c = 0; c < 8; ++c)
+        for (int k = 0; k < 3; ++k) corners[c][k] = (c >> k & 1) ? box.half_extents[k] : -box.half_extents[k];
+    sh_shape hull{};
+    hull.kind = SH_SHAPE_CONVEX;
+    hull.points = &corners[0][0];
+    hull.point_count = 8;
+    expect_core(sh::Shape(hull), 0.001, box_end, "hull of its corners");
+    const double rho = 0.0005, l = 0.004;
+    double prism[6][3];
+    for (int i = 0; i < 6; ++i) {
+        const double angle = M_PI / 2 + 2.0 * M_PI * (i % 3) / 3.0;
+        prism[i][0] = i < 3 ? -l : l;
+        prism[i][1] = 2.0 * rho * std::cos(angle);  // circumradius: twice the inradius
+        prism[i][2] = 2.0 * rho * std::sin(angle) + 0.002;  // off the local origin
+    }
+    hull.points = &prism[0][0];
+    hull.point_count = 6;
+    const sh::Shape shape(hull);
+    const double prism_end[3] = {l - rho, 0.0, 0.0};
+    // On the prism's axis (2 mm above the local origin), ending rho short of its ends.
+    double first[3], last[3];
+    shape.ball_centre(sh::Pose{}, 0, first);
+    shape.ball_centre(sh::Pose{}, shape.ball_count() - 1, last);
+    printf("prism: radius %.6g mm (inradius %.6g), axis from (%.6g, %.3g, %.6g) to (%.6g, %.3g, %.6g) mm\n",
+           1e3 * shape.ball_radius(), 1e3 * rho, 1e3 * first[0], 1e3 * first[1], 1e3 * first[2], 1e3 * last[0],
+           1e3 * last[1], 1e3 * last[2]);
+    assert_true(std::fabs(shape.ball_radius() - rho) < 1e-9 * rho);
+    for (const double* end : {first, last})
+        assert_true(std::fabs(std::fabs(end[0]) - prism_end[0]) < 1e-9 * l && std::fabs(end[1]) < 1e-12 &&
+                    std::fabs(end[2] - 0.002) < 1e-12);
+    assert_true(first[0] * last[0] < 0.0);
+#endif
+}
+
+// A plate (a box 4 x 1.6 x 1 mm, and its corners' hull) lying flat 0.4 mm deep between the
+// nodes of a flat patch: its bottom face is as deep as its inscribed capsule's ridge, so it
+// feels the law lambda d^n at that depth along the normal, as the lying capsule does, with no
+// sideways force.
+void test_plate_lying_between_nodes_feels_the_law(void**) {
+    const Patch flat = hexagon(0.01, 0.0);
+    const double half[3] = {0.002, 0.0008, 0.0005}, depth = 0.0004;
+    double corners[8][3];
+    for (int c = 0; c < 8; ++c)
+        for (int k = 0; k < 3; ++k) corners[c][k] = (c >> k & 1) ? half[k] : -half[k];
+    const double spots[3][3] = {{0.004, 0.002, 0.3}, {0.005, 0.0, M_PI / 2}, {0.0, 0.0018, 0.0}};
+#ifdef SOFTHAP_WITH_CCD
+    const int kinds = 2;
+#else
+    const int kinds = 1;
+#endif
+    for (int kind = 0; kind < kinds; ++kind)
+        for (const auto& spot : spots) {
+            sh_collider_def def{};
+            def.shape.kind = kind == 0 ? SH_SHAPE_BOX : SH_SHAPE_CONVEX;
+            for (int k = 0; k < 3; ++k) def.shape.half_extents[k] = half[k];
+            def.shape.points = &corners[0][0];
+            def.shape.point_count = 8;
+            def.position[0] = spot[0];
+            def.position[1] = spot[1];
+            def.position[2] = half[2] - depth;
+            def.orientation[0] = std::cos(0.5 * spot[2]);  // turned about z by the heading
+            def.orientation[3] = std::sin(0.5 * spot[2]);
+            def.contact.stiffness = 1e4;
+            def.contact.exponent = 1.5;
+            def.contact.slip_velocity = 1e-3;
+            def.contact.capacity = 4096;
+            const Collider c(def, true);
+            double total[3];
+            forces(c, flat, flat.x.data(), total);
+            const double law = c.params.stiffness * std::pow(depth, c.params.exponent);
+            printf("lying %s at (%.1f, %.1f) mm, heading %.2f: F (%.3g, %.3g, %.6g) N, lambda d^n %.6g N\n",
+                   kind == 0 ? "box" : "hull", 1e3 * spot[0], 1e3 * spot[1], spot[2], total[0], total[1], total[2], law);
+            assert_true(std::fabs(total[2] + law) < 1e-3 * law);
+            assert_true(std::fabs(total[0]) + std::fabs(total[1]) < 1e-6 * law);
+        }
+}
+
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_forces_are_the_potentials_gradient),
@@ -529,6 +643,8 @@ int main() {
         cmocka_unit_test(test_small_capsule_lying_between_nodes_feels_the_law),
         cmocka_unit_test(test_tilting_capsule_hands_over_smoothly),
         cmocka_unit_test(test_capsule_tangent_matches_the_forces_slope),
+        cmocka_unit_test(test_box_and_hull_take_their_inscribed_capsule),
+        cmocka_unit_test(test_plate_lying_between_nodes_feels_the_law),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -137,6 +137,55 @@ def test_lying_capsule_press_force_grows(meshes):
         assert forces[-1] >= 0.30  # the press triangle's nodes 4 mm down (module docstring)
 
 
+def lowest_offset(kind, orientation, half_extents=None, points=None):
+    """How far (m) a box's or a hull's lowest point lies below its position at orientation."""
+    w, x, y, z = orientation
+    up = np.array([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)])  # world z in local axes
+    if kind == "box":
+        return np.abs(up) @ np.asarray(half_extents)
+    return -(np.asarray(points) @ up).min()
+
+
+# A plate (2 mm thick, 8 x 16 mm, lying level), a blade-like wedge (a convex hull, edge down)
+# and a 4 mm cube: all smaller than the 15 mm press triangle, so their balls between nodes
+# (their largest inscribed capsule) hold them, not the nodes.
+WEDGE = [(-0.008, 0.0, -0.002), (0.008, 0.0, -0.002), (-0.008, -0.003, 0.002), (0.008, -0.003, 0.002),
+         (-0.008, 0.003, 0.002), (0.008, 0.003, 0.002)]
+BLOCKY_TOOLS = {
+    "plate": dict(kind="box", half_extents=(0.008, 0.004, 0.001)),
+    "wedge": dict(kind="convex", points=WEDGE),
+    "cube": dict(kind="box", half_extents=(0.002, 0.002, 0.002)),
+}
+
+
+@pytest.mark.parametrize("name", list(BLOCKY_TOOLS))
+def test_small_box_and_hull_press_force_grows(meshes, name):
+    # Started 2 mm above the press triangle's highest node and pressed 12 mm: on the library
+    # whose boxes and hulls had node terms only, each passes between the nodes (0 N throughout).
+    spec = dict(BLOCKY_TOOLS[name])
+    kind = spec.pop("kind")
+    level = (1.0, 0.0, 0.0, 0.0)
+    with softhap.World(gravity=(0, 0, 0)) as world:
+        body = hanging_liver(world, meshes, "corotational")
+        mesh = softhap.Mesh.load(str(meshes / "liver2.msh")).transform(0.1)
+        centroid, _ = press_triangle(mesh)
+        tri = mesh.surface_triangles
+        centres = mesh.nodes[tri].mean(axis=1)
+        highest = mesh.nodes[tri[np.argmin(np.linalg.norm(centres - centroid, axis=1))], 2].max()
+        start = np.array([centroid[0], centroid[1], highest + 0.002 + lowest_offset(kind, level, **spec)])
+        tool = world.add_tool(kind, position=start, stiffness=4e4, exponent=1.5, friction=0.5, **spec)
+        forces = []
+        for i in range(48):
+            tool.set_pose(start - (0.0, 0.0, 0.012 * (i + 1) / 48), level)
+            world.step(HZ60)  # raises on a failed step
+            forces.append(np.linalg.norm(tool.force))
+        assert world.warnings["SH_WARN_NOT_CONVERGED"] <= 3
+        assert largest_fall(forces) <= 0.05 * max(forces)
+        # At least 8 mm into the organ: the press triangle's nodes 4 mm down meet 0.30 N
+        # (module docstring), and the contact's own depth stays below its balls' radius.
+        assert forces[-1] >= 0.30
+
+
 # ------------------------------------------------------------------------------------------
 # A thin membrane and a small fast sphere
 

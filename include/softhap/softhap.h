@@ -765,8 +765,13 @@ typedef enum sh_shape_kind {
     SH_SHAPE_SPHERE = 0,  /**< radius, centred on the pose */
     SH_SHAPE_CAPSULE = 1, /**< radius around the segment from -half_length to +half_length on
                                the local z axis */
-    SH_SHAPE_BOX = 2,     /**< half_extents along the local axes, centred on the pose */
-    SH_SHAPE_CONVEX = 3,  /**< the convex hull of points (local frame); needs SH_FEATURE_CCD */
+    SH_SHAPE_BOX = 2,     /**< half_extents along the local axes, centred on the pose; between
+                               a body's nodes its contact takes its largest inscribed capsule
+                               along its longest axis (edges and corners sink until it meets
+                               the face) */
+    SH_SHAPE_CONVEX = 3,  /**< the convex hull of points (local frame); needs SH_FEATURE_CCD;
+                               between nodes, as a box: its largest inscribed capsule along
+                               its points' principal axis */
     SH_SHAPE_PLANE = 4,   /**< obstacles only: the half-space behind the plane through the
                                pose's position with outward normal `normal` (world frame) */
     SH_SHAPE_COUNT = 5    /**< number of kinds, not a kind */

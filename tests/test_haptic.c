@@ -798,19 +798,16 @@ static void test_convex_tool_steps_without_allocating(void** state) {
 #endif
 }
 
-/* A capsule smaller than the block's 2.5 mm cells, lying level across its top between the
- * nodes (its balls' excess holds it, BallMix): the whole-body buffer pressed 0.4 mm and let to
- * settle renders the full model's static solve at that pose, as the sphere's does, and its
- * haptic steps allocate nothing. */
-static void test_lying_capsule_buffer_matches_static_solve_without_allocating(void** state) {
-    (void)state;
-    const double depth = 0.0004, radius = 0.001;
-    sh_collider_def tool = undamped_tool(radius, 1e4, 1.5);
-    tool.shape.kind = SH_SHAPE_CAPSULE;
-    tool.shape.half_length = 0.003;
-    const double level[4] = {sqrt(0.5), 0.0, sqrt(0.5), 0.0}; /* the axis along x */
+/* A tool smaller than the block's 2.5 mm cells, of thickness 2 radius (its lowest point
+ * radius below its position), lying level across its top between the nodes at orientation (its
+ * balls' excess holds it, BallMix): the whole-body buffer pressed 0.4 mm and let to settle
+ * renders the full model's static solve at that pose, as the sphere's does, and its haptic
+ * steps allocate nothing. Returns the static solve's force (N, up). */
+static double lying_tool_buffer_matches_static_solve(const char* name, sh_collider_def tool, const double orientation[4],
+                                                     double radius) {
+    const double depth = 0.0004;
     const double pressed[3] = {0.5 * kBlock[0] + 0.6e-3, 0.5 * kBlock[1] + 1.1e-3, kBlock[2] + radius - depth};
-    for (int k = 0; k < 4; ++k) tool.orientation[k] = level[k];
+    for (int k = 0; k < 4; ++k) tool.orientation[k] = orientation[k];
     for (int k = 0; k < 3; ++k) tool.position[k] = pressed[k];
 
     scene reference = make_scene(0.0, 1.0);
@@ -831,17 +828,46 @@ static void test_lying_capsule_buffer_matches_static_solve_without_allocating(vo
     assert_ok(sh_tool_create(s.world, &tool, &s.tool));
     sh_haptic* haptic = whole_block_haptic(&s, 1.0); /* everything */
     sh_haptic_output out;
-    press_watched(haptic, tool.position, depth, 300, 3000, level, &out);
-    printf("lying capsule: static solve %d iterations, %.6g N; whole-body buffer %.6g N, %d sub-steps\n",
+    press_watched(haptic, tool.position, depth, 300, 3000, orientation, &out);
+    printf("lying %s: static solve %d iterations, %.6g N; whole-body buffer %.6g N, %d sub-steps\n", name,
            report.iterations, f_static[2], out.raw_force[2], out.substeps);
     assert_int_equal(atomic_load(&g_watched_allocations), 0);
-    /* Held: no node is in the capsule (its nodes' terms alone give 0 N); the block gives way
-     * under it, so the contact is shallower than the 0.4 mm press and the force below its law. */
+    /* Held: no node is in it (its nodes' terms alone give 0 N); the block gives way under it,
+     * so the contact is shallower than the 0.4 mm press and the force below its law. */
     assert_true(f_static[2] > 0.1 * tool.contact.stiffness * pow(depth, 1.5));
     assert_close(out.raw_force[2], f_static[2], 5e-3 * f_static[2]);
     assert_ok(sh_haptic_destroy(haptic));
     sh_world_destroy(s.world);
     sh_world_destroy(reference.world);
+    return f_static[2];
+}
+
+/* A 1 mm capsule 8 mm long, its axis along x; then a 2 x 2 x 8 mm bar along x, as a box and as
+ * the convex hull of its corners. The bar's largest inscribed capsule is that capsule, and no
+ * node is inside either: the bar's static force is the capsule's. */
+static void test_lying_tools_buffer_matches_static_solve_without_allocating(void** state) {
+    (void)state;
+    sh_collider_def tool = undamped_tool(0.001, 1e4, 1.5);
+    tool.shape.kind = SH_SHAPE_CAPSULE;
+    tool.shape.half_length = 0.003;
+    const double level[4] = {sqrt(0.5), 0.0, sqrt(0.5), 0.0}; /* the axis along x */
+    const double capsule = lying_tool_buffer_matches_static_solve("capsule", tool, level, 0.001);
+
+    const double half[3] = {0.004, 0.001, 0.001};
+    tool.shape.kind = SH_SHAPE_BOX;
+    for (int k = 0; k < 3; ++k) tool.shape.half_extents[k] = half[k];
+    const double box = lying_tool_buffer_matches_static_solve("box", tool, kIdentity, half[2]);
+    assert_close(box, capsule, 1e-9 * capsule);
+#ifdef SOFTHAP_TEST_WITH_CCD
+    double corners[8][3];
+    for (int c = 0; c < 8; ++c)
+        for (int k = 0; k < 3; ++k) corners[c][k] = (c >> k & 1) ? half[k] : -half[k];
+    tool.shape.kind = SH_SHAPE_CONVEX;
+    tool.shape.points = &corners[0][0];
+    tool.shape.point_count = 8;
+    const double hull = lying_tool_buffer_matches_static_solve("hull", tool, kIdentity, half[2]);
+    assert_close(hull, capsule, 1e-9 * capsule);
+#endif
 }
 
 /* A physical blade dragged through the block with a haptic context: the haptic side moves the
@@ -908,7 +934,7 @@ int main(void) {
         cmocka_unit_test(test_first_force_one_tick_after_contact),
         cmocka_unit_test(test_capacity_overflow_keeps_the_nearest),
         cmocka_unit_test(test_convex_tool_steps_without_allocating),
-        cmocka_unit_test(test_lying_capsule_buffer_matches_static_solve_without_allocating),
+        cmocka_unit_test(test_lying_tools_buffer_matches_static_solve_without_allocating),
         cmocka_unit_test(test_physical_blade_hold_steps_without_allocating),
         cmocka_unit_test(test_haptic_thread_never_allocates_nor_locks),
     };

@@ -96,6 +96,21 @@ def test_palpation_force_grows_while_pressing_and_holds(meshes, model):
         assert hold.min() >= 0.8 * press[-1]
 
 
+def assert_press_holds(world, tool, start, travel, steps, orientation=(1.0, 0.0, 0.0, 0.0)):
+    """Presses tool straight down from start by travel (m) over steps 60 Hz steps: no stream of
+    SH_WARN_NOT_CONVERGED, a force that never falls more than 5 % of its peak, and at least
+    0.30 N at the end (the press triangle's nodes pushed 4 mm down meet that, module docstring:
+    the tool has gone deeper)."""
+    forces = []
+    for i in range(steps):
+        tool.set_pose(start - (0.0, 0.0, travel * (i + 1) / steps), orientation)
+        world.step(HZ60)  # raises on a failed step
+        forces.append(np.linalg.norm(tool.force))
+    assert world.warnings["SH_WARN_NOT_CONVERGED"] <= 3
+    assert largest_fall(forces) <= 0.05 * max(forces)
+    assert forces[-1] >= 0.30
+
+
 # Spheres of 1, 3 and 10 mm, each with a law that holds three times the press's force before
 # its depth reaches its radius (lambda r^1.5 >= 3 N; a sphere's penalty holds at most that).
 SPHERES = [(0.001, 1e5), (0.003, 2e4), (0.01, 3e3)]
@@ -105,19 +120,11 @@ SPHERES = [(0.001, 1e5), (0.003, 2e4), (0.01, 3e3)]
 def test_press_force_grows_whatever_the_sphere_size(meshes, radius, stiffness):
     # A tool smaller than the 15 mm triangles is held by the face it touches: pressed 1 cm, it
     # neither sinks between the nodes (the force would fall) nor passes through.
+    # The contact's own depth under these laws is below 0.5 mm, so the organ travels more than
+    # 9 mm.
     with softhap.World(gravity=(0, 0, 0)) as world:
         _, tool, top = liver_and_tool(world, meshes, "corotational", radius, stiffness)
-        forces = []
-        for i in range(40):
-            tool.set_pose(top - (0.0, 0.0, 0.01 * (i + 1) / 40))
-            world.step(HZ60)  # raises on a failed step
-            forces.append(np.linalg.norm(tool.force))
-        assert world.warnings["SH_WARN_NOT_CONVERGED"] <= 3
-        assert largest_fall(forces) <= 0.05 * max(forces)
-        # The press triangle's nodes pushed 4 mm straight down meet 0.30 N (module docstring);
-        # the contact's own depth under these laws is below 0.5 mm, so the organ has travelled
-        # more than 9 mm.
-        assert forces[-1] >= 0.30
+        assert_press_holds(world, tool, top, 0.01, 40)
 
 
 def test_lying_capsule_press_force_grows(meshes):
@@ -127,14 +134,7 @@ def test_lying_capsule_press_force_grows(meshes):
     # its radius, as the spheres' above.
     with softhap.World(gravity=(0, 0, 0)) as world:
         _, tool, top = liver_and_tool(world, meshes, "corotational", 0.002, 4e4, half_length=0.01)
-        forces = []
-        for i in range(40):
-            tool.set_pose(top - (0.0, 0.0, 0.01 * (i + 1) / 40), LEVEL_ALONG_X)
-            world.step(HZ60)  # raises on a failed step
-            forces.append(np.linalg.norm(tool.force))
-        assert world.warnings["SH_WARN_NOT_CONVERGED"] <= 3
-        assert largest_fall(forces) <= 0.05 * max(forces)
-        assert forces[-1] >= 0.30  # the press triangle's nodes 4 mm down (module docstring)
+        assert_press_holds(world, tool, top, 0.01, 40, LEVEL_ALONG_X)
 
 
 def lowest_offset(kind, orientation, half_extents=None, points=None):
@@ -166,7 +166,7 @@ def test_small_box_and_hull_press_force_grows(meshes, name):
     kind = spec.pop("kind")
     level = (1.0, 0.0, 0.0, 0.0)
     with softhap.World(gravity=(0, 0, 0)) as world:
-        body = hanging_liver(world, meshes, "corotational")
+        hanging_liver(world, meshes, "corotational")
         mesh = softhap.Mesh.load(str(meshes / "liver2.msh")).transform(0.1)
         centroid, _ = press_triangle(mesh)
         tri = mesh.surface_triangles
@@ -174,16 +174,7 @@ def test_small_box_and_hull_press_force_grows(meshes, name):
         highest = mesh.nodes[tri[np.argmin(np.linalg.norm(centres - centroid, axis=1))], 2].max()
         start = np.array([centroid[0], centroid[1], highest + 0.002 + lowest_offset(kind, level, **spec)])
         tool = world.add_tool(kind, position=start, stiffness=4e4, exponent=1.5, friction=0.5, **spec)
-        forces = []
-        for i in range(48):
-            tool.set_pose(start - (0.0, 0.0, 0.012 * (i + 1) / 48), level)
-            world.step(HZ60)  # raises on a failed step
-            forces.append(np.linalg.norm(tool.force))
-        assert world.warnings["SH_WARN_NOT_CONVERGED"] <= 3
-        assert largest_fall(forces) <= 0.05 * max(forces)
-        # At least 8 mm into the organ: the press triangle's nodes 4 mm down meet 0.30 N
-        # (module docstring), and the contact's own depth stays below its balls' radius.
-        assert forces[-1] >= 0.30
+        assert_press_holds(world, tool, start, 0.012, 48, level)
 
 
 # ------------------------------------------------------------------------------------------

@@ -36,7 +36,9 @@ double excess_weight(const Collider& collider, double size) {
     return std::isfinite(t) ? 1.0 - t * t * (3.0 - 2.0 * t) : 0.0;
 }
 
-double resolved_band(const Collider& collider) { return 0.02 * collider.shape.inner_radius(); }
+double resolved_band(const Collider& collider) {
+    return collider.shape.ball_is_shape() ? 0.02 * collider.shape.inner_radius() : collider.shape.ball_radius();
+}
 
 bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
                           int count, double weight, const BallMix* mix, ContactPoint& out) {

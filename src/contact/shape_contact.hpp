@@ -54,7 +54,12 @@ bool node_shape_contact(const Collider& collider, const double* x, int32_t node,
 double excess_weight(const Collider& collider, double size);
 
 /// Depth (m) over which a feature's excess fades out as its last nodes come into the collider
-/// (the mesh then resolves the contact there): a fiftieth of the collider's inner radius.
+/// (the mesh then resolves the contact there). For a sphere, a fiftieth of its radius: its
+/// excess over a feature whose nodes are all in it is the interpolant's small error. For a
+/// collider of other shape, its balls' radius: a ball's excess takes the nodes' depths in
+/// that ball, which may be 0 for a node deep in the collider, so the excess it fades is up to
+/// the law's over the radius, and a narrow band would turn it into a force spike on the node
+/// crossing it (a rendered buzz, and Newton creeping).
 double resolved_band(const Collider& collider);
 
 /// The excess term of the surface edge (count 2) or outward triangle (count 3) nodes at

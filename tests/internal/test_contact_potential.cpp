@@ -521,6 +521,42 @@ void test_capsule_tangent_matches_the_forces_slope(void**) {
 
 }  // namespace
 
+// A capsule (1 mm, 4 mm axis) lying along an edge of a flat patch of 2.5 mm triangles, 0.3 mm
+// beside it, pressed down 0.9 mm in 1 um steps: the edge's nodes come into it one after the
+// other, the centre node first, and its balls' terms over the faces and the edge between them
+// hand over to the nodes' own terms. No step changes the force by more than 1 % of its largest
+// (0.19 % measured): the balls' terms fade over their radius as the last node comes in, not
+// within a fiftieth of it as a sphere's do, where the fade's slope (a force on that node alone)
+// spikes (2.3 %, and a rendered buzz on liver2). The hand-over still loses some of the force
+// while that node's own law grows from zero: at most 8 % of the largest (6.4 % measured; 11 %
+// with the narrow band).
+void test_capsule_pressed_onto_nodes_hands_over_smoothly(void**) {
+    const Patch flat = hexagon(0.0025, 0.0);
+    const double radius = 0.001;
+    double level[4];
+    const double axis[3] = {1.0, 0.0, 0.0};
+    orientation_along(axis, level);
+    double previous = 0.0, largest = 0.0, worst_fall = 0.0, worst_step = 0.0;
+    const int steps = 900;
+    for (int i = 0; i <= steps; ++i) {
+        const double depth = 0.0009 * i / steps;
+        const double position[3] = {0.0, 0.0003, radius - depth};
+        const Collider c = make_collider(SH_SHAPE_CAPSULE, position, radius, level);
+        double total[3];
+        forces(c, flat, flat.x.data(), total);
+        const double force = -total[2];
+        largest = std::max(largest, force);
+        worst_fall = std::max(worst_fall, largest - force);
+        if (i > 0) worst_step = std::max(worst_step, std::fabs(force - previous));
+        previous = force;
+    }
+    printf("capsule pressed onto an edge's nodes: force up to %.4g N, largest fall %.2f %% and step %.3f %% of it\n",
+           largest, 100.0 * worst_fall / largest, 100.0 * worst_step / largest);
+    assert_true(largest > 0.0);
+    assert_true(worst_fall < 0.08 * largest);
+    assert_true(worst_step < 0.01 * largest);
+}
+
 // The balls a box takes between nodes: its largest inscribed capsule, along its longest axis,
 // of its smallest half width, ending that far short of its ends (the depth along the axis is
 // min(r, h_long - |t|)). A convex hull of the box's corners is the box; a triangular prism
@@ -643,6 +679,7 @@ int main() {
         cmocka_unit_test(test_small_capsule_lying_between_nodes_feels_the_law),
         cmocka_unit_test(test_tilting_capsule_hands_over_smoothly),
         cmocka_unit_test(test_capsule_tangent_matches_the_forces_slope),
+        cmocka_unit_test(test_capsule_pressed_onto_nodes_hands_over_smoothly),
         cmocka_unit_test(test_box_and_hull_take_their_inscribed_capsule),
         cmocka_unit_test(test_plate_lying_between_nodes_feels_the_law),
     };

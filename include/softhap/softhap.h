@@ -988,7 +988,8 @@ typedef struct sh_haptic_def {
     int32_t capacity_tets;    /**< most tets in the buffer, >= 1; default 2000 */
     int32_t capacity_nodes;   /**< most nodes in the buffer, >= 4; default 2000 */
     double radius;            /**< buffer radius (m): tets whose centroid lies within it of the
-                                   contact point; > 0; default 0.02 */
+                                   contact point (for a capsule, box or hull, of the line
+                                   through it along the tool's length); > 0; default 0.02 */
     int32_t rings;            /**< > 0: instead of radius, the tets within this many rings
                                    (tets sharing a node) of the tets at the contact; default 0 */
     double dt;                /**< nominal haptic step (s), > 0; default 1e-3 */

@@ -46,14 +46,33 @@ NearestSurface nearest_surface(const World& world, const double p[3]) {
     return best;
 }
 
-double centroid_distance(const FemBody& body, int32_t t, const double center[3]) {
+// Distance (m) from tet t's centroid to the segment from a to b.
+double centroid_distance(const FemBody& body, int32_t t, const double a[3], const double b[3]) {
     const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(t);
     double c[3] = {0.0, 0.0, 0.0};
-    for (int a = 0; a < 4; ++a)
-        for (int k = 0; k < 3; ++k) c[k] += 0.25 * at(body.x.data(), tet[a])[k];
-    double d[3];
-    sub3(c, center, d);
-    return norm3(d);
+    for (int v = 0; v < 4; ++v)
+        for (int k = 0; k < 3; ++k) c[k] += 0.25 * at(body.x.data(), tet[v])[k];
+    return distance_to_segment(c, a, b);
+}
+
+// The line the buffer is centred on: through the contact point, along the tool's balls (its
+// core: a capsule's axis, a box's or hull's inscribed capsule's; a sphere's is a point), as
+// long as they, so that a long tool lying on the surface has its whole length in the buffer.
+void contact_line(const Collider& tool, const double point[3], double a[3], double b[3]) {
+    const int count = tool.shape.ball_count();
+    double first[3], last[3];
+    for (int k = 0; k < 3; ++k) a[k] = b[k] = point[k];
+    if (count < 2) return;
+    tool.shape.ball_centre(tool.target, 0, first);
+    tool.shape.ball_centre(tool.target, count - 1, last);
+    double axis[3], offset[3];
+    sub3(last, first, axis);
+    sub3(point, first, offset);
+    const double s = std::min(std::max(dot3(offset, axis) / dot3(axis, axis), 0.0), 1.0);
+    for (int k = 0; k < 3; ++k) {
+        a[k] = point[k] - s * axis[k];
+        b[k] = point[k] + (1.0 - s) * axis[k];
+    }
 }
 
 // The surface node deepest inside the tool (ties: the one nearest the tool's centre), as the
@@ -99,7 +118,8 @@ void HapticContext::ensure_adjacency(const FemBody& body, Id id) {
     adjacency_version_ = body.topology_version;
 }
 
-void HapticContext::select_tets(const FemBody& body, const double center[3], int32_t seed_triangle, Buffer& out) {
+void HapticContext::select_tets(const FemBody& body, const double line_a[3], const double line_b[3],
+                               int32_t seed_triangle, Buffer& out) {
     const int32_t tet_count = body.element_count();
     const int32_t* tris = body.surface_triangles.data() + 3 * static_cast<size_t>(seed_triangle);
     ranked_.clear();
@@ -109,7 +129,7 @@ void HapticContext::select_tets(const FemBody& body, const double center[3], int
             const int32_t t = node_tet_[static_cast<size_t>(j)];
             if (in_buffer_[static_cast<size_t>(t)]) continue;
             in_buffer_[static_cast<size_t>(t)] = 1;
-            ranked_.push_back({centroid_distance(body, t, center), t});
+            ranked_.push_back({centroid_distance(body, t, line_a, line_b), t});
         }
     if (def_.rings > 0) {
         size_t frontier = 0;
@@ -122,7 +142,7 @@ void HapticContext::select_tets(const FemBody& body, const double center[3], int
                         const int32_t t = node_tet_[static_cast<size_t>(j)];
                         if (in_buffer_[static_cast<size_t>(t)]) continue;
                         in_buffer_[static_cast<size_t>(t)] = 1;
-                        ranked_.push_back({centroid_distance(body, t, center), t});
+                        ranked_.push_back({centroid_distance(body, t, line_a, line_b), t});
                     }
             }
             frontier = end;
@@ -130,7 +150,7 @@ void HapticContext::select_tets(const FemBody& body, const double center[3], int
     } else {
         for (int32_t t = 0; t < tet_count; ++t) {
             if (in_buffer_[static_cast<size_t>(t)]) continue;
-            const double d = centroid_distance(body, t, center);
+            const double d = centroid_distance(body, t, line_a, line_b);
             if (d <= def_.radius) ranked_.push_back({d, t});
         }
     }
@@ -374,7 +394,9 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
     other_contact_.assign(static_cast<size_t>(near.fem->node_count()), 0);
     if (const BodyContacts* contacts = world.contacts_of(near.body))
         contacts->mark_nodes_of_other_contacts(&tool, other_contact_.data());
-    select_tets(*near.fem, near.point, near.triangle, out);
+    double line_a[3], line_b[3];
+    contact_line(tool, near.point, line_a, line_b);
+    select_tets(*near.fem, line_a, line_b, near.triangle, out);
     fill_buffer(*near.fem, world.gravity, world.step_settings(near.body).runaway_speed, out);
     fill_held(world, tool, out);
 }

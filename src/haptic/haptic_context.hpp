@@ -75,7 +75,8 @@ private:
 
     // sim side
     void extract(World& world, double period, Buffer& out);
-    void select_tets(const FemBody& body, const double center[3], int32_t seed_triangle, Buffer& out);
+    void select_tets(const FemBody& body, const double line_a[3], const double line_b[3], int32_t seed_triangle,
+                     Buffer& out);
     void fill_buffer(const FemBody& body, const double gravity[3], double runaway_speed, Buffer& out);
     void number_nodes(const FemBody& body, Buffer& out);
     void fill_nodes(const FemBody& body, Buffer& out);

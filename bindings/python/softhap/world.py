@@ -292,7 +292,8 @@ class World(WorldContacts):
         defaults are those of sh_haptic_def_default.
 
         The buffer holds at most capacity_tets tets and capacity_nodes nodes: those whose
-        centroid lies within radius (m) of the tool's nearest surface point, or, with
+        centroid lies within radius (m) of the tool's nearest surface point (for a capsule,
+        box or hull, of the line through it along the tool's length), or, with
         rings > 0, the tets within that many rings of the contact. dt is the nominal haptic
         step (s). The rendered force is at most max_force (N), moves at most max_force_rate
         (N/s) times dt per step, ramps in over ramp_time (s) and ramps out once the full-model

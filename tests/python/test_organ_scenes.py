@@ -177,6 +177,38 @@ def test_small_box_and_hull_press_force_grows(meshes, name):
         assert_press_holds(world, tool, start, 0.012, 48, level)
 
 
+def test_haptic_capsule_pressed_onto_the_top_node_renders_no_buzz(meshes):
+    # scripts/press_probe.py's capsule scene: liver2 at 21 cm (5 kPa, its lowest 1.5 cm fixed,
+    # no gravity), a 2 mm capsule 2.4 cm long lying along x across its highest node (4e4
+    # N/m^1.5, friction 0.5), pressed 1.5 cm in 1 s while a haptic context renders it at 1 kHz.
+    # Nodes come into the capsule, and its push runs along it. Two faults made the rendered
+    # force buzz here (largest tick-to-tick change 38 % of its peak): the balls' terms faded
+    # within a fiftieth of their radius as a feature's last node came in (34 % with that
+    # mended), and the buffer was centred on the contact point alone, so that one end of the
+    # capsule lay outside it. Now 0.9 %: 2 %, as for a sphere.
+    mesh = softhap.Mesh.load(str(meshes / "liver2.msh")).transform(0.1)
+    x = mesh.nodes
+    with softhap.World(gravity=(0, 0, 0)) as world:
+        body = world.add_fem_body(mesh, model="corotational", young=5e3, poisson=0.45, integrator="implicit_euler")
+        body.fix_nodes(np.flatnonzero(x[:, 2] < x[:, 2].min() + 0.015))
+        top = x[np.argmax(x[:, 2])] + (0.0, 0.0, 0.002)
+        tool = world.add_tool("capsule", position=top, radius=0.002, half_length=0.01, orientation=LEVEL_ALONG_X,
+                              stiffness=4e4, exponent=1.5, friction=0.5)
+        haptic = world.add_haptic(tool, dt=1e-3)
+        rendered, steps = [], 0
+        for k in range(1, 1001):
+            pose = top - (0.0, 0.0, 0.015 * k / 1000)
+            rendered.append(np.linalg.norm(haptic.step(pose, LEVEL_ALONG_X).force))
+            if k * 1e-3 >= (steps + 1) * HZ60 - 1e-12:
+                tool.set_pose(pose, LEVEL_ALONG_X)
+                world.step(HZ60)  # raises on a failed step
+                steps += 1
+        rendered = np.array(rendered)
+        assert world.warnings["SH_WARN_NOT_CONVERGED"] <= 3
+        assert rendered.max() > 0.1
+        assert np.abs(np.diff(rendered)).max() <= 0.02 * rendered.max()
+
+
 # ------------------------------------------------------------------------------------------
 # A thin membrane and a small fast sphere
 
@@ -275,17 +307,26 @@ def test_quasi_static_press_of_a_block_follows_hertz_and_the_static_solve():
 # A sphere's penalty holds at most lambda r^n, its force when its centre reaches the surface:
 # 0.16 N for a 3 mm probe under the 1 cm sphere's law, which lets it through this press. The
 # probe takes the library's default law (1e4 N/m^1.5: 0.35 N at 1.1 mm).
-@pytest.mark.parametrize("radius, stiffness", [(0.01, 1e3), (0.003, 1e4)], ids=["sphere-1cm", "probe-3mm"])
-def test_haptic_press_renders_a_smooth_force_and_the_model_holds_the_tool(meshes, radius, stiffness):
+# The lying capsule of test_lying_capsule_press_force_grows. The largest tick-to-tick change
+# allowed: 2 % of the peak for a sphere (below); a capsule's push handing over from the balls
+# over one face to those over the next steps by up to 6.2 % in one tick while the press moves
+# at 1.5 cm/s (the buffer's implicit contact takes the smooth maximum's curvature as an
+# isotropic bound per node, and the tool feels the implicit step's correction h K v: README,
+# Limits), so 8 %.
+@pytest.mark.parametrize("radius, stiffness, half_length, jump",
+                         [(0.01, 1e3, None, 0.02), (0.003, 1e4, None, 0.02), (0.002, 4e4, 0.01, 0.08)],
+                         ids=["sphere-1cm", "probe-3mm", "capsule-2mm"])
+def test_haptic_press_renders_a_smooth_force_and_the_model_holds_the_tool(meshes, radius, stiffness, half_length, jump):
+    orientation = (1.0, 0.0, 0.0, 0.0) if half_length is None else LEVEL_ALONG_X
     with softhap.World(gravity=(0, 0, 0)) as world:
-        _, tool, top = liver_and_tool(world, meshes, "corotational", radius, stiffness)
+        _, tool, top = liver_and_tool(world, meshes, "corotational", radius, stiffness, half_length)
         haptic = world.add_haptic(tool, dt=1e-3)
         rendered, full, faults = [], [], set()
         steps = 0
         for k in range(1, 2001):
             pose = pose_at(top, k * 1e-3)
-            tool.set_pose(pose)
-            result = haptic.step(pose)
+            tool.set_pose(pose, orientation)
+            result = haptic.step(pose, orientation)
             rendered.append(np.linalg.norm(result.force))
             faults |= result.faults
             if k * 1e-3 >= (steps + 1) * HZ60 - 1e-12:  # 16 or 17 ticks per full-model step
@@ -299,9 +340,9 @@ def test_haptic_press_renders_a_smooth_force_and_the_model_holds_the_tool(meshes
         # (dF/dx) v dt = 1.5 F v dt / x per tick: 0.3 % of F with the sphere's law 7 mm deep,
         # 1.1 % for the probe's 10x stiffer law 2 mm deep. The full model's 60 Hz steps must
         # add no jump of their own as the buffer's boundary follows them (measured: 1.2 % for
-        # the sphere, 1.8 % for the probe). 2 % bounds a jump.
+        # the sphere, 1.8 % for the probe). 2 % bounds a jump (see above for the capsule).
         rendered = np.array(rendered)
-        assert np.abs(np.diff(rendered)).max() <= 0.02 * rendered.max()
+        assert np.abs(np.diff(rendered)).max() <= jump * rendered.max()
         # The full model, pressed slowly into a body whose reaction grows with depth: its force
         # grows while the tool goes deeper, whatever the tool's size, to the palpation test's
         # 0.35 N at least (the same triangle, pressed as deep), and holds.

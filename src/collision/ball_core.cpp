@@ -65,9 +65,10 @@ void set_ball_core(BallCore& core, const double centre[3], const double axis[3],
         core.centre[k] = centre[k];
         core.axis[k] = axis[k];
     }
-    core.half_length = half_length;
+    // A segment within round-off of a point (a cube's inscribed capsule) is one ball.
+    core.half_length = half_length > 1e-9 * radius ? half_length : 0.0;
     core.radius = radius;
-    core.count = 1 + static_cast<int>(std::ceil(4.0 * half_length / radius));
+    core.count = 1 + static_cast<int>(std::ceil(4.0 * core.half_length / radius));
 }
 
 void inscribe_ball_core(BallCore& core, const double* points, int count, double (*depth)(const ShapeGeometry&, const double*),

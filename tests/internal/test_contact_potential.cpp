@@ -559,7 +559,7 @@ void test_capsule_pressed_onto_nodes_hands_over_smoothly(void**) {
 
 // The balls a box takes between nodes: its largest inscribed capsule, along its longest axis,
 // of its smallest half width, ending that far short of its ends (the depth along the axis is
-// min(r, h_long - |t|)). A convex hull of the box's corners is the box; a triangular prism
+// min(r, h_long - |t|)); a cube's is its inscribed ball. A convex hull of the box's corners is the box; a triangular prism
 // (equilateral section of inradius rho, length 2 l) has the capsule of radius rho ending rho
 // short of its ends.
 void expect_core(const sh::Shape& shape, double radius, const double end[3], const char* what) {
@@ -590,6 +590,13 @@ void test_box_and_hull_take_their_inscribed_capsule(void**) {
     box.half_extents[2] = 0.001;
     const double box_end[3] = {0.0, 0.011, 0.0};
     expect_core(sh::Shape(box), 0.001, box_end, "box 6 x 24 x 2 mm");
+    // A cube's is its inscribed ball: one ball, however round-off places its axis.
+    sh_shape cube = box;
+    for (int k = 0; k < 3; ++k) cube.half_extents[k] = 0.003;
+    const sh::Shape cube_shape(cube);
+    printf("cube 6 mm: %d ball of radius %.6g mm\n", cube_shape.ball_count(), 1e3 * cube_shape.ball_radius());
+    assert_int_equal(cube_shape.ball_count(), 1);
+    assert_true(std::fabs(cube_shape.ball_radius() - 0.003) < 1e-12);
 #ifdef SOFTHAP_WITH_CCD
     double corners[8][3];
     for (int c = 0; c < 8; ++c)

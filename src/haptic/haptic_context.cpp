@@ -40,7 +40,7 @@ void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3
     }
     w.force = arena.take<double>(3 * n);
     w.contact = arena.take<double>(3 * n);
-    w.contact_tangent = arena.take<double>(18 * n);
+    w.contact_tangent = arena.take<double>(HapticContext::kTangentStride * n);
     w.contacted = arena.take<int32_t>(n);
     w.in_contact = arena.take<uint8_t>(n);
     w.saved_x = arena.take<double>(3 * n);

@@ -31,6 +31,10 @@ void validate_haptic_def(const sh_haptic_def& def);
 /// One tool's haptic context; the world calls it around each full step.
 class HapticContext final : public StepHook {
 public:
+    /// Doubles per buffer node in the contact tangent workspace: stiffness (9), damping (9)
+    /// and the stiffness's mixed-bound part (1).
+    static constexpr size_t kTangentStride = 19;
+
     /// Bytes of the arena a context made from (validated) def holds.
     static size_t memory_bytes(const sh_haptic_def& def);
 
@@ -102,6 +106,9 @@ private:
     double substep_limit(const Buffer& b) const;
     void clear_contact();
     void add_contact_tangent(int32_t node, const double direction[3], double stiffness, double damping);
+    /// Adds a mixed term's stiffness bound (N/m) to node's contact stiffness on every axis, and
+    /// notes it apart: it steadies the node but is not felt (integrate()).
+    void add_mixed_bound(int32_t node, double bound);
     void integrate(const Buffer& b, double h, double* x, double* v, double force[3], double torque[3]) const;
 
     sh_haptic_def def_;
@@ -127,8 +134,10 @@ private:
     Id state_body_ = kNullId;
     double* force_ = nullptr;  ///< 3 per node
     double* contact_ = nullptr;  ///< 3 per node: the sub-step's contact force on it
-    double* contact_tangent_ = nullptr;  ///< 18 per node: the sub-step's contact stiffness (3x3, N/m) and
-                                         ///< damping (3x3, N s/m) on it, lumped (integrate())
+    /// Per node, kTangentStride doubles: the sub-step's contact stiffness (3x3, N/m) and
+    /// damping (3x3, N s/m) on it, lumped (integrate()), and the part of that stiffness that
+    /// is a mixed term's isotropic bound (N/m, on every axis; add_mixed_bound).
+    double* contact_tangent_ = nullptr;
     int32_t* contacted_ = nullptr;       ///< the nodes the sub-step's contact acts on
     int32_t contacted_count_ = 0;
     uint8_t* in_contact_ = nullptr;      ///< 1 per node: 1 if on contacted_

@@ -308,13 +308,13 @@ def test_quasi_static_press_of_a_block_follows_hertz_and_the_static_solve():
 # 0.16 N for a 3 mm probe under the 1 cm sphere's law, which lets it through this press. The
 # probe takes the library's default law (1e4 N/m^1.5: 0.35 N at 1.1 mm).
 # The lying capsule of test_lying_capsule_press_force_grows. The largest tick-to-tick change
-# allowed: 2 % of the peak for a sphere (below); a capsule's push handing over from the balls
-# over one face to those over the next steps by up to 6.2 % in one tick while the press moves
-# at 1.5 cm/s (the buffer's implicit contact takes the smooth maximum's curvature as an
-# isotropic bound per node, and the tool feels the implicit step's correction h K v: README,
-# Limits), so 8 %.
+# allowed: 2 % of the peak for a sphere (below), 3 % for the capsule, whose law is stiffer
+# and which is shallower (1.2 mm at 1.6 N): where the device stops dead, (dF/dx) v dt =
+# 1.5 F v dt / x is 1.9 % of F (2.2 % measured). (Had the tool felt the isotropic bound on
+# the smooth maximum's curvature the buffer's nodes take, it would step by 6.2 % where the
+# push hands over between balls, and drag: 1.24 N at the end of the press, not 1.62.)
 @pytest.mark.parametrize("radius, stiffness, half_length, jump",
-                         [(0.01, 1e3, None, 0.02), (0.003, 1e4, None, 0.02), (0.002, 4e4, 0.01, 0.08)],
+                         [(0.01, 1e3, None, 0.02), (0.003, 1e4, None, 0.02), (0.002, 4e4, 0.01, 0.03)],
                          ids=["sphere-1cm", "probe-3mm", "capsule-2mm"])
 def test_haptic_press_renders_a_smooth_force_and_the_model_holds_the_tool(meshes, radius, stiffness, half_length, jump):
     orientation = (1.0, 0.0, 0.0, 0.0) if half_length is None else LEVEL_ALONG_X

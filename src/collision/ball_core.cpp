@@ -35,16 +35,17 @@ void principal_axis(const double* points, int count, double mean[3], double axis
     }
 }
 
-// The shape's depth along the line mean + t axis.
+// The shape's depth (m, 0 outside) along the line mean + t axis of its local frame.
 struct DepthProfile {
     const double* mean;
     const double* axis;
-    double (*depth)(const ShapeGeometry&, const double*);
+    PenetrateFn penetrate;
     const ShapeGeometry& g;
 
     double operator()(double t) const {
         const double x[3] = {mean[0] + t * axis[0], mean[1] + t * axis[1], mean[2] + t * axis[2]};
-        return depth(g, x);
+        double depth = 0.0, normal[3];
+        return penetrate(g, Pose{}, x, depth, normal) ? depth : 0.0;
     }
 
     // Where the profile (concave) crosses level between t_out (below it) and t_in (at or above
@@ -71,8 +72,7 @@ void set_ball_core(BallCore& core, const double centre[3], const double axis[3],
     core.count = 1 + static_cast<int>(std::ceil(4.0 * core.half_length / radius));
 }
 
-void inscribe_ball_core(BallCore& core, const double* points, int count, double (*depth)(const ShapeGeometry&, const double*),
-                        const ShapeGeometry& g) {
+void inscribe_ball_core(BallCore& core, const double* points, int count, PenetrateFn penetrate, const ShapeGeometry& g) {
     core = BallCore{};
     double mean[3], axis[3];
     principal_axis(points, count, mean, axis);
@@ -83,7 +83,7 @@ void inscribe_ball_core(BallCore& core, const double* points, int count, double 
         lo = std::min(lo, dot3(d, axis));
         hi = std::max(hi, dot3(d, axis));
     }
-    const DepthProfile profile{mean, axis, depth, g};
+    const DepthProfile profile{mean, axis, penetrate, g};
     double t[kDepthSamples + 1], m[kDepthSamples + 1], deepest = 0.0;
     for (int i = 0; i <= kDepthSamples; ++i) {
         t[i] = lo + (hi - lo) * i / kDepthSamples;

@@ -3,9 +3,16 @@
 // axis; a box's or a convex hull's is its largest inscribed capsule along its longest axis.
 #pragma once
 
+#include "collision/pose.hpp"
+
 namespace sh {
 
 struct ShapeGeometry;
+
+/// A kind's point query (ShapeKind::penetrate): true if world point x lies inside the shape
+/// at pose, with its depth (m) and outward normal.
+using PenetrateFn = bool (*)(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth,
+                             double normal[3]);
 
 /// A segment of balls in a shape's local frame.
 struct BallCore {
@@ -27,12 +34,11 @@ constexpr double kMaxCoreHalfLength = 1024.0;
 /// kMaxCoreHalfLength radii.
 void set_ball_core(BallCore& core, const double centre[3], const double axis[3], double half_length, double radius);
 
-/// Sets core to the largest (by volume) capsule inside a convex shape, along the principal
-/// axis of its count points (3 coordinates each, local frame) through their mean: depth(x)
-/// is the shape's depth (m, <= 0 outside) at local point x, concave along any line. No balls
-/// if the capsule would be longer than kMaxCoreHalfLength radii.
-void inscribe_ball_core(BallCore& core, const double* points, int count, double (*depth)(const ShapeGeometry&, const double*),
-                        const ShapeGeometry& g);
+/// Sets core to the largest (by volume) capsule inside the convex shape g, along the principal
+/// axis of its count points (3 coordinates each, local frame) through their mean; penetrate
+/// is its kind's point query (its depth is concave along any line). No balls if the capsule
+/// would be longer than kMaxCoreHalfLength radii.
+void inscribe_ball_core(BallCore& core, const double* points, int count, PenetrateFn penetrate, const ShapeGeometry& g);
 
 /// The balls (ShapeKind::balls_near) whose centres may lie within reach (m) of local point x:
 /// those from first to last (none if first > last).

@@ -11,12 +11,6 @@ namespace {
 
 bool box_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth, double normal[3]);
 
-// Local point x's depth (m, 0 outside).
-double box_local_depth(const ShapeGeometry& g, const double* x) {
-    double depth = 0.0, normal[3];
-    return box_penetrate(g, Pose{}, x, depth, normal) ? depth : 0.0;
-}
-
 void box_init(const sh_shape& def, ShapeGeometry& g) {
     for (int k = 0; k < 3; ++k) {
         SH_REQUIRE(std::isfinite(def.half_extents[k]) && def.half_extents[k] > 0.0, SH_ERR_INVALID_ARGUMENT,
@@ -27,7 +21,7 @@ void box_init(const sh_shape& def, ShapeGeometry& g) {
     double corners[8][3];
     for (int c = 0; c < 8; ++c)
         for (int k = 0; k < 3; ++k) corners[c][k] = (c >> k & 1) ? g.half_extents[k] : -g.half_extents[k];
-    inscribe_ball_core(g.balls, corners[0], 8, box_local_depth, g);
+    inscribe_ball_core(g.balls, corners[0], 8, box_penetrate, g);
 }
 
 void box_bounds(const ShapeGeometry& g, const Pose& pose, double margin, double lo[3], double hi[3]) {

@@ -12,19 +12,13 @@ namespace {
 
 bool convex_penetrate(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth, double normal[3]);
 
-// Local point x's depth (m, 0 outside).
-double convex_local_depth(const ShapeGeometry& g, const double* x) {
-    double depth = 0.0, normal[3];
-    return convex_penetrate(g, Pose{}, x, depth, normal) ? depth : 0.0;
-}
-
 void convex_init(const sh_shape& def, ShapeGeometry& g) {
 #ifndef SOFTHAP_WITH_CCD
     require(false, SH_ERR_UNSUPPORTED, "convex shapes need libccd (built with SOFTHAP_WITH_CCD=OFF)");
 #endif
     g.hull.build(def.points, def.point_count);
     g.inner_radius = g.hull.inner_radius();
-    inscribe_ball_core(g.balls, g.hull.points().data(), static_cast<int>(g.hull.points().size() / 3), convex_local_depth, g);
+    inscribe_ball_core(g.balls, g.hull.points().data(), static_cast<int>(g.hull.points().size() / 3), convex_penetrate, g);
 }
 
 void convex_bounds(const ShapeGeometry& g, const Pose& pose, double margin, double lo[3], double hi[3]) {

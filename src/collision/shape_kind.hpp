@@ -47,7 +47,7 @@ struct ShapeKind {
     void (*support)(const ShapeGeometry& g, const Pose& pose, const double dir[3], double out[3]);
     /// True if world point x lies inside at pose: then its depth (m, > 0) and the outward
     /// normal (world) at the nearest surface point, which Shape::penetrate_point normalises.
-    bool (*penetrate)(const ShapeGeometry& g, const Pose& pose, const double x[3], double& depth, double normal[3]);
+    PenetrateFn penetrate;
     /// The balls (g.balls) whose centres may lie within reach (m) of local point x: those
     /// from first to last (none if first > last). Null for a kind without balls
     /// (Shape::ball_count).

@@ -60,6 +60,10 @@ public:
     /// its depth in the ball.
     bool ball_is_shape() const { return geometry_.balls.is_shape; }
 
+    /// True if the shape's excess is a smooth maximum over several balls (BallMix): two
+    /// passes per evaluation, the balls' totals first.
+    bool mixes_balls() const { return geometry_.balls.count > 1; }
+
     /// The world centre of ball i (0 <= i < ball_count()) at pose.
     void ball_centre(const Pose& pose, int i, double out[3]) const;
 

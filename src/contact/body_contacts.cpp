@@ -63,7 +63,7 @@ StepLaw BodyContacts::step_law(const ContactCandidate& c) const {
 const Collider* BodyContacts::ball_mix_collider(const Group& group) const {
     if (group.end <= group.begin) return nullptr;
     const Collider* collider = candidates_[static_cast<size_t>(group.begin)].collider;
-    return collider && collider->shape.ball_count() > 1 ? collider : nullptr;
+    return collider && collider->shape.mixes_balls() ? collider : nullptr;
 }
 
 void BodyContacts::mix_balls(const Group& group, const double* x) const {

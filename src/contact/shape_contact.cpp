@@ -42,7 +42,7 @@ double resolved_band(const Collider& collider) {
 
 bool excess_shape_contact(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes,
                           int count, double weight, const BallMix* mix, ContactPoint& out) {
-    if (collider.shape.ball_count() > 1) return mix && mix->term(collider, law, x, nodes, count, weight, out);
+    if (collider.shape.mixes_balls()) return mix && mix->term(collider, law, x, nodes, count, weight, out);
     bool found = false;
     for_each_ball_term(collider, law, x, nodes, count, weight, [&](int, const ContactPoint& term) {
         out = term;

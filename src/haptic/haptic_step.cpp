@@ -296,7 +296,7 @@ void HapticContext::add_contact_forces(const Buffer& b, const double* x, const d
     tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
     const sh_contact_params& law = tool_.params;
     clear_contact();
-    if (tool_.shape.ball_count() > 1) {  // a tool of several balls: their mix first (BallMix)
+    if (tool_.shape.mixes_balls()) {  // their mix first (BallMix)
         balls_.sum(tool_, [&](auto&& add) {
             visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
                 if (count > 1) add(hunt_crossley_step_law(law, 0.0, 0.0), x, nodes, count, excess_weight(tool_, size));

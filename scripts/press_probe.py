@@ -2,7 +2,7 @@
 """Press a sphere into the top of a tetrahedral mesh, as a new user would, and print the force.
 
     python3 scripts/press_probe.py MESH SIZE RADIUS [--stiffness L] [--friction MU] [--plot PNG]
-                                   [--capsule HALF_LENGTH]
+                                   [--capsule HALF_LENGTH | --box HALF_X HALF_Y]
 
 MESH is a file under ../shared/meshes (or a path), scaled so that its largest extent is SIZE (m);
 RADIUS is the sphere's (m). Corotational, 5 kPa, nu 0.45, implicit Euler at 60 Hz, no gravity,
@@ -12,7 +12,8 @@ while a haptic context renders it at 1 kHz (16-17 ticks per full step). Prints t
 edge lengths against the radius, the full model's and the rendered force every 10 steps, the step
 times, the count of SH_WARN_NOT_CONVERGED and the largest tick-to-tick change of the rendered
 force; with --plot, draws both forces against the tool's travel into PNG (needs matplotlib). With
---capsule the tool is a capsule of that half length (m) lying along x instead of the sphere.
+--capsule the tool is a capsule of that half length (m) lying along x instead of the sphere; with
+--box a level box of those half widths along x and y (m) and half thickness RADIUS.
 Needs the library (SOFTHAP_LIBRARY) and bindings/python on PYTHONPATH.
 """
 
@@ -59,22 +60,30 @@ def plot(path, title, travel_full, full, travel_ticks, rendered):
     fig.savefig(path, dpi=120)
 
 
-def main(name, size, radius, stiffness, friction, plot_path, half_length=None):
+def tool_shape(radius, half_length, box):
+    """The tool's kind, shape arguments, orientation and name (for the plot)."""
+    if box is not None:
+        return "box", dict(half_extents=(box[0], box[1], radius)), (1.0, 0.0, 0.0, 0.0), \
+            "box (half widths %g x %g mm)" % (1e3 * box[0], 1e3 * box[1])
+    if half_length is not None:  # lying along x: the local z axis turned onto x
+        orientation = (np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0)
+        return "capsule", dict(radius=radius, half_length=half_length, orientation=orientation), orientation, \
+            "capsule (half length %g mm)" % (1e3 * half_length)
+    return "sphere", dict(radius=radius), (1.0, 0.0, 0.0, 0.0), "sphere"
+
+
+def main(name, size, radius, stiffness, friction, plot_path, half_length=None, box=None):
     mesh = load(name, size)
     x = mesh.nodes
     edges = surface_edges(mesh)
     print("%s: %d tets, surface edges median %.1f mm (max %.1f), tool radius %.1f mm"
           % (name, len(mesh.tets), 1e3 * np.median(edges), 1e3 * edges.max(), 1e3 * radius))
-    shape, orientation = dict(radius=radius), (1.0, 0.0, 0.0, 0.0)
-    if half_length is not None:  # lying along x: the local z axis turned onto x
-        orientation = (np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0)
-        shape.update(half_length=half_length, orientation=orientation)
+    kind, shape, orientation, tool_name = tool_shape(radius, half_length, box)
     with softhap.World(gravity=(0, 0, 0)) as world:
         body = world.add_fem_body(mesh, model="corotational", young=5e3, poisson=0.45, integrator="implicit_euler")
         body.fix_nodes(np.flatnonzero(x[:, 2] < x[:, 2].min() + 0.015))
         top = x[np.argmax(x[:, 2])] + (0.0, 0.0, radius)
-        tool = world.add_tool("sphere" if half_length is None else "capsule", position=top, stiffness=stiffness,
-                              exponent=1.5, friction=friction, **shape)
+        tool = world.add_tool(kind, position=top, stiffness=stiffness, exponent=1.5, friction=friction, **shape)
         haptic = world.add_haptic(tool, dt=1e-3)
         rendered, times, travel_ticks, travel_full, full = [], [], [], [], []
         steps = int(round((PRESS_TIME + HOLD_TIME) / STEP))
@@ -99,7 +108,6 @@ def main(name, size, radius, stiffness, friction, plot_path, half_length=None):
         print("  steps: median %.1f ms, p99 %.1f ms; SH_WARN_NOT_CONVERGED %d; largest tick-to-tick change %.0f %% of peak"
               % (np.median(times), np.percentile(times, 99), world.warnings["SH_WARN_NOT_CONVERGED"], 100 * jump))
     if plot_path:
-        tool_name = "sphere" if half_length is None else "capsule (half length %g mm)" % (1e3 * half_length)
         title = ("%s (%.0f cm), %s r = %g mm, %g N/m^1.5, friction %g\nlargest tick-to-tick change %.1f %% of peak"
                  % (os.path.basename(name), 100 * size, tool_name, 1e3 * radius, stiffness, friction, 100 * jump))
         plot(plot_path, title, travel_full, full, travel_ticks, rendered)
@@ -113,6 +121,8 @@ if __name__ == "__main__":
     parser.add_argument("--stiffness", type=float, default=1e3)
     parser.add_argument("--friction", type=float, default=0.0)
     parser.add_argument("--plot")
-    parser.add_argument("--capsule", type=float, metavar="HALF_LENGTH")
+    shapes = parser.add_mutually_exclusive_group()
+    shapes.add_argument("--capsule", type=float, metavar="HALF_LENGTH")
+    shapes.add_argument("--box", type=float, nargs=2, metavar=("HALF_X", "HALF_Y"))
     args = parser.parse_args()
-    main(args.mesh, args.size, args.radius, args.stiffness, args.friction, args.plot, args.capsule)
+    main(args.mesh, args.size, args.radius, args.stiffness, args.friction, args.plot, args.capsule, args.box)

@@ -140,6 +140,13 @@ public:
     /// of each candidate's lagged friction).
     double dissipation(const double* v) const override;
     bool does_work() const override;
+    /// The most nodes whose pairs one collider's links ask for: they form a dense block of
+    /// the factorisation, whose cost grows with their cube.
+    static constexpr size_t kMaxLinkedNodes = 96;
+    /// The node pairs a collider made of several balls couples through its smooth maximum
+    /// (BallMix::tangent): every pair of the nodes of its candidate edges and faces, for
+    /// colliders whose candidates have at most kMaxLinkedNodes nodes.
+    void add_tangent_links(vec<int32_t>& pairs) const override;
     /// The blocks between this body's node and the other body's face of each kNodeFace
     /// candidate against other.
     void add_coupling_pattern(const Body& other, const int32_t* own_index, const int32_t* other_index,

@@ -89,6 +89,25 @@ void BodyContacts::add_tangent(const double* x, const double* v, double stiffnes
     });
 }
 
+void BodyContacts::add_tangent_links(vec<int32_t>& pairs) const {
+    vec<int32_t> nodes;
+    for (const Group& group : groups_) {
+        if (!ball_mix_collider(group)) continue;
+        nodes.clear();
+        for_each_excess_candidate(group, [&](const ContactCandidate& c, int count) {
+            nodes.insert(nodes.end(), c.face, c.face + count);
+        });
+        std::sort(nodes.begin(), nodes.end());
+        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+        if (nodes.size() > kMaxLinkedNodes) continue;
+        for (size_t a = 0; a < nodes.size(); ++a)
+            for (size_t b = a + 1; b < nodes.size(); ++b) {
+                pairs.push_back(nodes[a]);
+                pairs.push_back(nodes[b]);
+            }
+    }
+}
+
 void BodyContacts::add_ball_mix_tangent(const Group& group, const double* x, double stiffness_scale,
                                         const int32_t* free_index, SparseSystem& system) const {
     const Collider* collider = ball_mix_collider(group);
@@ -98,8 +117,11 @@ void BodyContacts::add_ball_mix_tangent(const Group& group, const double* x, dou
     for_each_excess_candidate(group, [&](const ContactCandidate& c, int count) {
         mix.add_tangent_term(*collider, step_law(c), x, c.face, count, c.excess_weight);
     });
-    // A block between nodes that share no element has no place in the system: it goes onto
-    // both nodes' own blocks as its norm times the identity, which bounds it from above.
+    // The pattern holds the blocks between the nodes of the collider's candidates
+    // (add_tangent_links). A block it lacks (more candidate nodes than kMaxLinkedNodes) goes
+    // onto both nodes' own blocks as its norm times the identity, which bounds it from above
+    // but slows Newton to a linear rate: the smooth maximum couples the nodes under a lying
+    // capsule about as strongly as each node's own stiffness.
     mix.tangent([&](int32_t a, int32_t b, const double* block) {
         const int32_t fa = free_index[a], fb = free_index[b];
         if (fa < 0 || fb < 0) return;

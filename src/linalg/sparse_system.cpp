@@ -17,22 +17,23 @@ std::atomic<uint64_t> g_next_pattern_id{1};
 // Largest nodes per element: local indices (3k)^2 - 1 must fit a uint16_t.
 constexpr int kMaxNodesPerElement = 85;
 
-// Checks build_pattern's arguments (see the header).
+// Checks build_pattern's arguments (see the header) for its elements or its links: what names
+// them in messages.
 void check_pattern_input(const int32_t* elements, size_t element_count, int nodes_per_element,
-                         const int32_t* free_index, int32_t node_count, int32_t free_count) {
+                         const int32_t* free_index, int32_t node_count, int32_t free_count, const char* what) {
     SH_REQUIRE(nodes_per_element >= 1 && nodes_per_element <= kMaxNodesPerElement, SH_ERR_INVALID_ARGUMENT,
                "sparse system: nodes_per_element %d is not in [1, %d]", nodes_per_element, kMaxNodesPerElement);
     SH_REQUIRE(node_count >= 0 && free_count >= 0 && free_count <= node_count, SH_ERR_INVALID_ARGUMENT,
                "sparse system: free_count %d is not in [0, node_count = %d]", free_count, node_count);
     SH_REQUIRE(free_count <= INT32_MAX / 3, SH_ERR_CAPACITY, "sparse system: %d free nodes exceed %d",
                free_count, INT32_MAX / 3);
-    SH_REQUIRE(element_count == 0 || elements, SH_ERR_INVALID_ARGUMENT, "sparse system: elements is NULL");
+    SH_REQUIRE(element_count == 0 || elements, SH_ERR_INVALID_ARGUMENT, "sparse system: %ss is NULL", what);
     SH_REQUIRE(node_count == 0 || free_index, SH_ERR_INVALID_ARGUMENT, "sparse system: free_index is NULL");
     const size_t k = static_cast<size_t>(nodes_per_element);
-    SH_REQUIRE(element_count <= SIZE_MAX / k, SH_ERR_INVALID_ARGUMENT, "sparse system: element count overflows");
+    SH_REQUIRE(element_count <= SIZE_MAX / k, SH_ERR_INVALID_ARGUMENT, "sparse system: %s count overflows", what);
     for (size_t i = 0; i < element_count * k; ++i)
         SH_REQUIRE(elements[i] >= 0 && elements[i] < node_count, SH_ERR_INVALID_ARGUMENT,
-                   "sparse system: element %zu node %zu is %d, not in [0, %d)", i / k, i % k, elements[i], node_count);
+                   "sparse system: %s %zu node %zu is %d, not in [0, %d)", what, i / k, i % k, elements[i], node_count);
 }
 
 // Free DOF -> global DOF, checking that free_index is one-to-one onto [0, free_count).
@@ -63,20 +64,22 @@ struct NodeBlocks {
 };
 
 NodeBlocks upper_node_blocks(const int32_t* elements, size_t element_count, size_t k, const int32_t* free_index,
-                             size_t nfree) {
+                             size_t nfree, const int32_t* links, size_t link_count) {
     NodeBlocks blocks;
     blocks.start.assign(nfree + 1, 0);
     auto for_each_pair = [&](auto&& visit) {
+        const auto pair = [&](int32_t i, int32_t j) {
+            const int32_t fa = free_index[i], fb = free_index[j];
+            if (fa >= 0 && fb > fa) visit(fa, fb);  // row fa < column fb
+        };
         for (size_t e = 0; e < element_count; ++e) {
             const int32_t* en = elements + e * k;
-            for (size_t a = 0; a < k; ++a) {
-                const int32_t fa = free_index[en[a]];
-                if (fa < 0) continue;
-                for (size_t b = 0; b < k; ++b) {
-                    const int32_t fb = free_index[en[b]];
-                    if (fb > fa) visit(fa, fb);  // row fa < column fb
-                }
-            }
+            for (size_t a = 0; a < k; ++a)
+                for (size_t b = 0; b < k; ++b) pair(en[a], en[b]);
+        }
+        for (size_t l = 0; l < link_count; ++l) {
+            pair(links[2 * l], links[2 * l + 1]);
+            pair(links[2 * l + 1], links[2 * l]);
         }
     };
     // Counted, filled, then sorted and deduplicated per column.
@@ -165,16 +168,18 @@ void SparseSystem::build_scatter_map(const int32_t* elements, size_t element_cou
 }
 
 void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, int nodes_per_element,
-                                 const int32_t* free_index, int32_t node_count, int32_t free_count) {
+                                 const int32_t* free_index, int32_t node_count, int32_t free_count,
+                                 const int32_t* links, size_t link_count) {
     // Start empty, so a failure below (bad input, std::bad_alloc) leaves an empty system.
     {
         SparseSystem empty;
         std::swap(*this, empty);
     }
-    check_pattern_input(elements, element_count, nodes_per_element, free_index, node_count, free_count);
+    check_pattern_input(elements, element_count, nodes_per_element, free_index, node_count, free_count, "element");
+    check_pattern_input(links, link_count, 2, free_index, node_count, free_count, "link");
     const size_t k = static_cast<size_t>(nodes_per_element), nfree = static_cast<size_t>(free_count);
     vec<int32_t> dof_to_global = free_dofs(free_index, node_count, free_count);
-    const NodeBlocks blocks = upper_node_blocks(elements, element_count, k, free_index, nfree);
+    const NodeBlocks blocks = upper_node_blocks(elements, element_count, k, free_index, nfree, links, link_count);
     const uint64_t nnz = 6 * static_cast<uint64_t>(nfree) + 9 * static_cast<uint64_t>(blocks.rows.size());
     SH_REQUIRE(nnz <= static_cast<uint64_t>(INT32_MAX), SH_ERR_CAPACITY,
                "sparse system: %" PRIu64 " stored entries exceed 2^31 - 1", nnz);

@@ -28,8 +28,12 @@ public:
     /// Throws SH_ERR_INVALID_ARGUMENT for a node index out of range or a free_index that is not a
     /// one-to-one map onto [0, free_count), SH_ERR_CAPACITY if the matrix would exceed 2^31 - 1
     /// stored entries. Values are zero afterwards. Allocates; on failure the system is empty.
+    /// links: link_count node pairs (links[2l], links[2l + 1]) whose blocks the pattern holds
+    /// too, though they may share no element (a field's coupling, e.g. a contact that spans
+    /// several faces); add_block reaches them, add_element does not.
     void build_pattern(const int32_t* elements, size_t element_count, int nodes_per_element,
-                       const int32_t* free_index, int32_t node_count, int32_t free_count);
+                       const int32_t* free_index, int32_t node_count, int32_t free_count,
+                       const int32_t* links = nullptr, size_t link_count = 0);
     int32_t dof_count() const { return dof_count_; }  ///< 3 * free_count
     int64_t nonzero_count() const { return static_cast<int64_t>(row_indices_.size()); }  ///< stored (upper) entries
     void clear_values();                 ///< all values to 0
@@ -40,9 +44,9 @@ public:
     void add_element(size_t element, const double* Ke, double scale);
     /// Adds scale * B (3x3, row-major) to the block of free nodes (I, J) and, for I != J, its
     /// transpose to (J, I): only the stored upper triangle is touched. The nodes must share an
-    /// element (or be equal); otherwise throws SH_ERR_INTERNAL.
+    /// element or a link (or be equal); otherwise throws SH_ERR_INTERNAL.
     void add_block(int32_t free_i, int32_t free_j, const double* B, double scale);
-    /// True if the pattern holds the block of free nodes I and J (they share an element).
+    /// True if the pattern holds the block of free nodes I and J (they share an element or a link).
     bool has_block(int32_t free_i, int32_t free_j) const;
     /// Adds diag[d] to diagonal entry d, for d < dof_count() (lumped mass, per-DOF terms).
     void add_diagonal(const double* diag, double scale);

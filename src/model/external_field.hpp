@@ -60,6 +60,13 @@ public:
         (void)h, (void)move_positions, (void)x, (void)v;
     }
 
+    /// Appends to pairs, as two node indices each, the pairs of the body's own nodes whose
+    /// tangent blocks add_tangent fills though they may share no element (a contact whose
+    /// terms span several faces), for the step's contacts as detected. The Newton matrix's
+    /// pattern holds them; a block it lacks goes onto both nodes' diagonals as a bound. None
+    /// by default.
+    virtual void add_tangent_links(vec<int32_t>& pairs) const { (void)pairs; }
+
     /// For bodies solved together (one Newton problem over several bodies): appends to pairs, as (own_index[i],
     /// other_index[j]), every pair of this body's node i and other's node j that an interaction
     /// this field holds links, both indices >= 0 (each interaction is held by one of the two

@@ -2,20 +2,12 @@
 
 #include "core/error.hpp"
 #include "model/external_field.hpp"
+#include "solver/node_links.hpp"
 
 #include <algorithm>
 #include <utility>
 
 namespace sh {
-namespace {
-
-// The key of the joint node pair {i, j}: (min << 32) | max.
-uint64_t link_key(int32_t i, int32_t j) {
-    if (i > j) std::swap(i, j);
-    return (static_cast<uint64_t>(static_cast<uint32_t>(i)) << 32) | static_cast<uint32_t>(j);
-}
-
-}  // namespace
 
 void map_joint_nodes(vec<CoupledMember>& members) {
     for (CoupledMember& member : members) {
@@ -29,18 +21,14 @@ void map_joint_nodes(vec<CoupledMember>& members) {
 }
 
 void collect_coupled_links(const vec<CoupledMember>& members, vec<int32_t>& pairs, vec<uint64_t>& needed) {
-    needed.clear();
+    pairs.clear();
     for (const CoupledMember& a : members) {
         if (!a.body().field) continue;
-        for (const CoupledMember& b : members) {
-            if (&a == &b) continue;
-            pairs.clear();
-            a.body().field->add_coupling_pattern(b.body(), a.joint_index.data(), b.joint_index.data(), pairs);
-            for (size_t p = 0; p < pairs.size(); p += 2) needed.push_back(link_key(pairs[p], pairs[p + 1]));
-        }
+        for (const CoupledMember& b : members)
+            if (&a != &b)
+                a.body().field->add_coupling_pattern(b.body(), a.joint_index.data(), b.joint_index.data(), pairs);
     }
-    std::sort(needed.begin(), needed.end());
-    needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
+    collect_link_keys(pairs, needed);
 }
 
 SparseSystem build_joint_pattern(const vec<CoupledMember>& members, const vec<uint64_t>& links) {
@@ -62,14 +50,13 @@ SparseSystem build_joint_pattern(const vec<CoupledMember>& members, const vec<ui
             }
         nodes += own.dof_count() / 3;
     }
-    for (const uint64_t key : links) {
-        elements.push_back(static_cast<int32_t>(key >> 32));
-        elements.push_back(static_cast<int32_t>(key & 0xffffffffu));
-    }
+    vec<int32_t> link_pairs;
+    link_key_pairs(links, link_pairs);
     vec<int32_t> identity(static_cast<size_t>(nodes));
     for (int32_t i = 0; i < nodes; ++i) identity[static_cast<size_t>(i)] = i;
     SparseSystem joint;
-    joint.build_pattern(elements.data(), elements.size() / 2, 2, identity.data(), nodes, nodes);
+    joint.build_pattern(elements.data(), elements.size() / 2, 2, identity.data(), nodes, nodes, link_pairs.data(),
+                        link_pairs.size() / 2);
     return joint;
 }
 

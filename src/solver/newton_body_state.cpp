@@ -1,6 +1,7 @@
 #include "solver/newton_body_state.hpp"
 
 #include "model/external_field.hpp"
+#include "solver/node_links.hpp"
 
 #include <utility>
 
@@ -55,7 +56,11 @@ int32_t NewtonBodyState::prepare(const Body& body, const sh_implicit_settings& s
     int32_t count = 0;
     if (!changed)
         for (int32_t i = 0; i < n && !changed; ++i) changed = (free_index[static_cast<size_t>(i)] >= 0) != body.is_free(i);
-    if (!changed) {
+    link_pairs.clear();
+    if (body.field) body.field->add_tangent_links(link_pairs);
+    collect_link_keys(link_pairs, needed_links);
+    vec<uint64_t> grown;
+    if (!links_to_build(links, needed_links, changed, grown)) {
         if (own_solver && !matrix.solver) matrix.solver = make_analysed_solver(matrix.system, s);
         return 3 * free_count;
     }
@@ -63,9 +68,10 @@ int32_t NewtonBodyState::prepare(const Body& body, const sh_implicit_settings& s
     vec<int32_t> index(static_cast<size_t>(n), -1);
     for (int32_t i = 0; i < n; ++i)
         if (body.is_free(i)) index[static_cast<size_t>(i)] = count++;
+    link_key_pairs(grown, link_pairs);
     SparseSystem pattern;
     pattern.build_pattern(body.element_nodes(), static_cast<size_t>(body.element_count()), body.nodes_per_element(),
-                          index.data(), n, count);
+                          index.data(), n, count, link_pairs.data(), link_pairs.size() / 2);
     EliminationOrder suggested;
     const bool suggest = own_solver && carried_order(body, elimination, index, count, suggested);
     LinearSolverPtr solver = own_solver ? make_analysed_solver(pattern, s, suggest ? &suggested : nullptr) : nullptr;
@@ -76,6 +82,7 @@ int32_t NewtonBodyState::prepare(const Body& body, const sh_implicit_settings& s
     matrix.reset(std::move(pattern), std::move(solver));
     free_index.swap(index);
     diagonal.swap(diag);
+    links.swap(grown);
     if (ordered) std::swap(elimination, chosen);  // else the last order stays for the next analysis
     free_count = count;
     return 3 * count;

@@ -24,10 +24,14 @@ struct NewtonBodyState {
     NewtonMatrix matrix;      ///< the body's own matrix over its free DOFs (3 per free node)
     vec<double> diagonal;     ///< per free DOF: the diagonal added to the tangent (scratch)
     EliminationOrder elimination;  ///< its solver's elimination order, as the body's node indices (empty: none)
+    vec<uint64_t> links;           ///< node links the pattern holds beyond the elements (node_links.hpp)
+    vec<uint64_t> needed_links;    ///< scratch: the links the body's field asks for now
+    vec<int32_t> link_pairs;       ///< scratch: node pairs as the field reports them
 
     /// Rebuilds free_index and the matrix's pattern (and, with own_solver, its solver and
-    /// symbolic analysis) if body's free nodes changed since the last call; makes the solver if
-    /// own_solver and there is none yet. Returns the number of free DOFs.
+    /// symbolic analysis) if body's free nodes changed since the last call, or if its field
+    /// asks for a link (ExternalField::add_tangent_links) the pattern lacks; makes the solver
+    /// if own_solver and there is none yet. Returns the number of free DOFs.
     int32_t prepare(const Body& body, const sh_implicit_settings& settings, bool own_solver = true);
 
     /// The body's topology changed: the next prepare rebuilds the pattern and the analysis,

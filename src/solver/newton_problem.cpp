@@ -2,9 +2,9 @@
 
 #include "core/error.hpp"
 #include "model/external_field.hpp"
+#include "solver/node_links.hpp"
 
 #include <algorithm>
-#include <iterator>
 #include <utility>
 
 namespace sh {
@@ -27,13 +27,8 @@ void NewtonProblem::prepare(SteppedBody* const* bodies, int32_t count, const sh_
     }
     if (rebuild) map_joint_nodes(members_);
     collect_coupled_links(members_, pairs_, needed_);
-    if (!rebuild && std::includes(links_.begin(), links_.end(), needed_.begin(), needed_.end())) return;
-    // Keep the blocks of earlier contacts too (contacts come and go from step to step), unless
-    // they have grown well beyond what the current ones need.
     vec<uint64_t> links;
-    if (!rebuild) std::set_union(links_.begin(), links_.end(), needed_.begin(), needed_.end(), std::back_inserter(links));
-    if (rebuild || links.size() > 2 * needed_.size() + 64) links = needed_;
-    build_joint(links, settings);
+    if (links_to_build(links_, needed_, rebuild, links)) build_joint(links, settings);
 }
 
 void NewtonProblem::build_joint(vec<uint64_t>& links, const sh_implicit_settings& settings) {

@@ -308,7 +308,9 @@ def test_indented_body_supports_carry_the_tool_force(kind, shape, angle):
         orientation = (math.cos(half), 0.6 * math.sin(half), 0.8 * math.sin(half), 0.0)
         position = np.array([0.0113, 0.0087, height + 0.0015])
         tool = world.add_tool(kind, position=position, orientation=orientation, **shape)
-        world.solve_static(max_iterations=400)  # face contacts converge linearly (approximate tangent)
+        # 24 iterations for the box, 38 for the capsule (225 with the couplings between the nodes
+        # under it bounded on their diagonals, not in the matrix).
+        world.solve_static(max_iterations=60)
         state = tool.contact_state
         assert state.contact_count >= 1 and state.max_depth > 0.0
         assert state.penetration_volume > 0.0

@@ -559,9 +559,9 @@ void test_capsule_pressed_onto_nodes_hands_over_smoothly(void**) {
 
 // The balls a box takes between nodes: its largest inscribed capsule, along its longest axis,
 // of its smallest half width, ending that far short of its ends (the depth along the axis is
-// min(r, h_long - |t|)); a cube's is its inscribed ball. A convex hull of the box's corners is the box; a triangular prism
-// (equilateral section of inradius rho, length 2 l) has the capsule of radius rho ending rho
-// short of its ends.
+// min(r, h_long - |t|)); a cube's is its inscribed ball. A convex hull of the box's corners is
+// the box; a triangular prism (equilateral section of inradius rho, length 2 l) has the capsule
+// of radius rho ending rho short of its ends.
 void expect_core(const sh::Shape& shape, double radius, const double end[3], const char* what) {
     double a[3], b[3];
     const sh::Pose identity;

@@ -26,25 +26,38 @@ namespace sh {
 /// line searches allow a potential to rise by and still count as not raised.
 inline double sum_roundoff(double scale) { return 64.0 * std::numeric_limits<double>::epsilon() * scale; }
 
-/// Extends a full Newton update the potential still falls steeply beyond (its slope there,
-/// slope_here(), above half the start's slope0 < 0): such an update came from a tangent
-/// stiffer than the potential along it, as where a contact's projected curvature drops a
-/// negative part. move_to(s) goes to s times the update and returns the potential there
-/// (non-finite: unusable); from value, the potential at the full update, the update doubles
-/// while the potential keeps falling, at most 6 times (64x), and ends on the last one that
-/// fell. Each try costs an evaluation; Newton's own updates near convergence end flat and
-/// take none. The static solve and the implicit step share it.
+/// Extends a full Newton update along which the potential still falls steeply (its slope there,
+/// slope_here(), below a quarter of the start's slope0 < 0). Such an update came from a tangent
+/// stiffer than the potential along it, as where a contact's tangent drops a negative part (an
+/// edge's excess, a rounded tool's sideways -F / r), along which Newton creeps by the slope
+/// ratio per iteration (0.5 over a whole step of a capsule drawn through its slit). Each try goes where the slope, taken as linear through the
+/// last two points (a secant), vanishes, at most 8 times further than the last point and 64
+/// times the update in all; move_to(s) goes to s times the update and returns the potential
+/// there (non-finite: unusable). A try is kept if the potential fell by more than roundoff, or
+/// stayed within it with a smaller slope (closer to the minimum along the update, where the
+/// potential is too flat to tell); the update ends on the last one kept. Each try costs an
+/// evaluation; Newton's own updates near convergence end flat and take none. The static solve
+/// and the implicit step share it.
 template <class SlopeHere, class MoveTo>
-void extend_update_while_falling(double slope0, double value, SlopeHere&& slope_here, MoveTo&& move_to) {
-    double scale = 1.0;
-    for (int k = 0; k < 6 && slope_here() < 0.5 * slope0; ++k) {
-        const double next = move_to(2.0 * scale);
-        if (!(std::isfinite(next) && next < value)) {
+void extend_update_while_falling(double slope0, double value, double roundoff, SlopeHere&& slope_here, MoveTo&& move_to) {
+    constexpr double kSteepRatio = 0.25, kFurthest = 64.0, kFurthestStride = 8.0;
+    constexpr int kMaxTries = 6;
+    double scale = 1.0, slope = slope_here(), last_scale = 0.0, last_slope = slope0;
+    for (int k = 0; k < kMaxTries && slope < kSteepRatio * slope0 && scale < kFurthest; ++k) {
+        // Where the secant's slope vanishes, if the slope grew (the potential curves upward
+        // along the update); else twice as far.
+        const double secant = scale - slope * (scale - last_scale) / (slope - last_slope);
+        const bool curves_up = slope > last_slope && std::isfinite(secant);
+        const double next = std::min(curves_up ? std::min(secant, kFurthestStride * scale) : 2.0 * scale, kFurthest);
+        const double there = move_to(next), slope_there = slope_here();
+        const bool fell = std::isfinite(there) && (there < value - roundoff ||
+                                                   (there <= value + roundoff && std::fabs(slope_there) < std::fabs(slope)));
+        if (!fell) {
             move_to(scale);
             return;
         }
-        scale *= 2.0;
-        value = next;
+        last_scale = scale, last_slope = slope;
+        scale = next, slope = slope_there, value = there;
     }
 }
 

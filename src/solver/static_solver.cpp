@@ -115,7 +115,7 @@ double search_along_step(NewtonProblem& problem, const double g[3], double facto
     }
     if (2.0 * alpha < 1.0) return r;  // the accepted step (alpha is the one after it) was halved
     extend_update_while_falling(
-        slope, energy, [&] { return slope_along_step(matrix); },
+        slope, energy, sum_roundoff(scale), [&] { return slope_along_step(matrix); },
         [&](double s) {
             place_along_step(problem, s);
             r = out_of_balance(problem, g, factor, matrix.residual) / load_norm;

@@ -45,19 +45,43 @@ void nearest_node_offset(const Body& body, const double p[3], double out[3]) {
     for (int k = 0; k < 3; ++k) out[k] = at(body.rest.data(), nearest)[k] + p[k] - at(body.x.data(), nearest)[k];
 }
 
-}  // namespace
-
-void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
-    if (body.nodes_per_element() != 4 || body.element_count() == 0) {
-        for (int i = 0; i < count; ++i) out[i] = RestPoint{}, nearest_node_offset(body, &p[3 * i], out[i].position);
-        return;
+/// Flags (one per tet) the tets whose box meets the box around the count points p grown by
+/// half its diagonal: every tet that contains a point, and those near the points that an
+/// outside point may be least outside of. One pass over the nodes and one over the tets'
+/// corners, not the tets' maps.
+vec<uint8_t> tets_near(const Body& body, const double* p, int count) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < count; ++i)
+        for (int k = 0; k < 3; ++k) lo[k] = std::fmin(lo[k], p[3 * i + k]), hi[k] = std::fmax(hi[k], p[3 * i + k]);
+    const double grow = 0.5 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    // Per node, a bit for each of the box's six planes it lies beyond; a tet misses the box
+    // exactly when all its corners lie beyond one plane.
+    vec<uint8_t> beyond(static_cast<size_t>(body.node_count()));
+    for (int32_t n = 0; n < body.node_count(); ++n) {
+        uint8_t bits = 0;
+        for (int k = 0; k < 3; ++k)
+            bits |= static_cast<uint8_t>((at(body.x.data(), n)[k] < lo[k] - grow ? 1 : 0) << k |
+                                         (at(body.x.data(), n)[k] > hi[k] + grow ? 1 : 0) << (k + 3));
+        beyond[static_cast<size_t>(n)] = bits;
     }
-    // Per point: the first tet that contains it, else the one it is least outside of.
-    vec<double> best_w(4 * static_cast<size_t>(count), 0.0);
-    for (int i = 0; i < count; ++i) out[i] = RestPoint{}, out[i].inside = -INFINITY;
-    int found_inside = 0;
+    vec<uint8_t> near(static_cast<size_t>(body.element_count()));
+    for (int32_t t = 0; t < body.element_count(); ++t) {
+        const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(t);
+        near[static_cast<size_t>(t)] = (beyond[static_cast<size_t>(tet[0])] & beyond[static_cast<size_t>(tet[1])] &
+                                        beyond[static_cast<size_t>(tet[2])] & beyond[static_cast<size_t>(tet[3])]) == 0;
+    }
+    return near;
+}
+
+/// For each point i of p with out[i].inside < 0 (not yet inside a tet): the first tet among
+/// those flagged in only (null: all) that contains it, else the one it is least outside of
+/// if less than out[i].inside, with its barycentric weights in best_w (4 per point).
+void search_tets(const Body& body, const double* p, int count, const uint8_t* only, RestPoint* out, double* best_w) {
+    int left = 0;
+    for (int i = 0; i < count; ++i) left += out[i].inside < 0.0 ? 1 : 0;
     TetMap map;
-    for (int32_t t = 0; t < body.element_count() && found_inside < count; ++t) {
+    for (int32_t t = 0; t < body.element_count() && left > 0; ++t) {
+        if (only && !only[t]) continue;
         if (!map.form(body.x.data(), body.element_nodes() + 4 * static_cast<size_t>(t))) continue;
         for (int i = 0; i < count; ++i) {
             if (out[i].inside >= 0.0) continue;
@@ -67,9 +91,26 @@ void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
             if (inside <= out[i].inside) continue;
             out[i].inside = inside, out[i].tet = t;
             std::copy(w, w + 4, &best_w[4 * static_cast<size_t>(i)]);
-            found_inside += inside >= 0.0 ? 1 : 0;
+            left -= inside >= 0.0 ? 1 : 0;
         }
     }
+}
+
+}  // namespace
+
+void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
+    if (body.nodes_per_element() != 4 || body.element_count() == 0) {
+        for (int i = 0; i < count; ++i) out[i] = RestPoint{}, nearest_node_offset(body, &p[3 * i], out[i].position);
+        return;
+    }
+    // The tets near the points first; a point that none of them reaches (outside, and far
+    // from the others) looks through them all.
+    vec<double> best_w(4 * static_cast<size_t>(count), 0.0);
+    for (int i = 0; i < count; ++i) out[i] = RestPoint{}, out[i].inside = -INFINITY;
+    search_tets(body, p, count, tets_near(body, p, count).data(), out, best_w.data());
+    bool unreached = false;
+    for (int i = 0; i < count; ++i) unreached = unreached || out[i].tet < 0;
+    if (unreached) search_tets(body, p, count, nullptr, out, best_w.data());
     for (int i = 0; i < count; ++i) {
         if (out[i].tet < 0) {
             nearest_node_offset(body, &p[3 * i], out[i].position);

@@ -109,9 +109,9 @@ private:
     bool line_search(double slope, bool fresh);
     /// d Phi / d scale along delta at the current iterate: the residual (grad Phi) dotted with it.
     double slope_along_update() const;
-    /// After a fresh full update: extends it while Phi keeps falling steeply
-    /// (extend_update_while_falling; roundoff: Phi's round-off along the update).
-    void extend_update(double slope, double roundoff);
+    /// After a fresh full update Phi accepted: moves it towards Phi's minimum along it where it
+    /// ends far from it (move_update_towards_line_minimum; roundoff: Phi's round-off along it).
+    void settle_update(double slope, double roundoff);
     /// Newton iterations the step may take.
     int iteration_cap() const;
     /// The scale the residual's tolerance is relative to.
@@ -333,8 +333,8 @@ double NewtonStep::slope_along_update() const {
     return slope;
 }
 
-void NewtonStep::extend_update(double slope, double roundoff) {
-    extend_update_while_falling(
+void NewtonStep::settle_update(double slope, double roundoff) {
+    move_update_towards_line_minimum(
         slope, phi_.value, roundoff, [&] { return slope_along_update(); },
         [&](double scale) {
             take_update(scale);
@@ -364,7 +364,7 @@ bool NewtonStep::line_search(double slope, bool fresh) {
             phi_.value <= phi0.value + kBlindRoundoffFactor * roundoff)
             return true;  // Phi is blind along this update: the residual judges it
         if (phi_.value > phi0.value + kArmijo * scale * slope + roundoff) continue;
-        if (fresh && halving == 0) extend_update(slope, roundoff);
+        if (fresh && halving == 0) settle_update(slope, roundoff);
         if (fresh) return true;
         const double floor = matrix_.kept.roundoff_floor;
         if (r_ <= std::max(kStaleContraction * r0, floor) && r_max_ <= std::max(kStaleContraction * r0_max, floor)) return true;

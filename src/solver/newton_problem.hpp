@@ -26,23 +26,39 @@ namespace sh {
 /// line searches allow a potential to rise by and still count as not raised.
 inline double sum_roundoff(double scale) { return 64.0 * std::numeric_limits<double>::epsilon() * scale; }
 
-/// Extends a full Newton update along which the potential still falls steeply (its slope there,
-/// slope_here(), below a quarter of the start's slope0 < 0). Such an update came from a tangent
-/// stiffer than the potential along it, as where a contact's tangent drops a negative part (an
-/// edge's excess, a rounded tool's sideways -F / r), along which Newton creeps by the slope
-/// ratio per iteration (0.5 over a whole step of a capsule drawn through its slit). Each try goes where the slope, taken as linear through the
-/// last two points (a secant), vanishes, at most 8 times further than the last point and 64
-/// times the update in all; move_to(s) goes to s times the update and returns the potential
-/// there (non-finite: unusable). A try is kept if the potential fell by more than roundoff, or
-/// stayed within it with a smaller slope (closer to the minimum along the update, where the
-/// potential is too flat to tell); the update ends on the last one kept. Each try costs an
-/// evaluation; Newton's own updates near convergence end flat and take none. The static solve
-/// and the implicit step share it.
+/// Moves a full Newton update towards the minimum of the potential along it, when the update
+/// ends far from it: still falling steeply (its slope there, slope_here(), below a quarter of
+/// the start's slope0 < 0), or rising steeply (above a quarter of -slope0: past the minimum).
+/// Either comes from a tangent that is wrong along the update: too stiff where it leaves out a
+/// negative part (an edge's excess, a rounded tool's sideways -F / r), too soft where it
+/// leaves out a positive one (how an excess term's maximiser moves with the nodes). Newton
+/// then creeps by the slope ratio per iteration (0.5 over a whole step of a capsule drawn
+/// through its slit), or swings across the minimum, with the line search accepting each swing
+/// for its small fall. Each try goes where the slope, taken as linear through the last two
+/// points (a secant), vanishes: past the minimum one try, back between the start and the full
+/// update; else further out, at most 8 times further than the last point and 64 times the
+/// update in all. move_to(s) goes to s times the update and returns the potential there
+/// (non-finite: unusable); value is the potential at the full update. A try is kept if the
+/// potential fell by more than roundoff, or stayed within it with a smaller slope (closer to
+/// the minimum, where the potential is too flat to tell); the update ends on the last one kept.
+/// Each try costs an evaluation; Newton's own updates near convergence end flat and take none.
+/// The static solve and the implicit step share it.
 template <class SlopeHere, class MoveTo>
-void extend_update_while_falling(double slope0, double value, double roundoff, SlopeHere&& slope_here, MoveTo&& move_to) {
+void move_update_towards_line_minimum(double slope0, double value, double roundoff, SlopeHere&& slope_here,
+                                      MoveTo&& move_to) {
     constexpr double kSteepRatio = 0.25, kFurthest = 64.0, kFurthestStride = 8.0;
     constexpr int kMaxTries = 6;
     double scale = 1.0, slope = slope_here(), last_scale = 0.0, last_slope = slope0;
+    const auto kept = [&](double there, double slope_there) {
+        return std::isfinite(there) &&
+               (there < value - roundoff || (there <= value + roundoff && std::fabs(slope_there) < std::fabs(slope)));
+    };
+    if (slope > -kSteepRatio * slope0) {  // well past the minimum: back to the secant's zero
+        const double back = slope0 / (slope0 - slope);
+        const double there = move_to(back), slope_there = slope_here();
+        if (!kept(there, slope_there)) move_to(1.0);
+        return;
+    }
     for (int k = 0; k < kMaxTries && slope < kSteepRatio * slope0 && scale < kFurthest; ++k) {
         // Where the secant's slope vanishes, if the slope grew (the potential curves upward
         // along the update); else twice as far.
@@ -50,9 +66,7 @@ void extend_update_while_falling(double slope0, double value, double roundoff, S
         const bool curves_up = slope > last_slope && std::isfinite(secant);
         const double next = std::min(curves_up ? std::min(secant, kFurthestStride * scale) : 2.0 * scale, kFurthest);
         const double there = move_to(next), slope_there = slope_here();
-        const bool fell = std::isfinite(there) && (there < value - roundoff ||
-                                                   (there <= value + roundoff && std::fabs(slope_there) < std::fabs(slope)));
-        if (!fell) {
+        if (!kept(there, slope_there)) {
             move_to(scale);
             return;
         }

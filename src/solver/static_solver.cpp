@@ -89,9 +89,10 @@ double slope_along_step(const NewtonMatrix& matrix) {
 // matrix.residual and relative residual r: halves from the full step until Armijo's decrease
 // (or a smaller residual where the potential is flat to its round-off; never an iterate
 // that raises the potential: a smaller residual there can lead the iteration round in a
-// cycle over a kink of the contact potential), then extends a full step while the potential
-// falls steeply (extend_update_while_falling). Leaves the bodies there (or where they were if
-// nothing helps) and returns the relative residual.
+// cycle over a kink of the contact potential), then moves a full step towards the
+// potential's minimum along it where it ends far from it (move_update_towards_line_minimum).
+// Leaves the bodies there (or where they were if nothing helps) and returns the relative
+// residual.
 double search_along_step(NewtonProblem& problem, const double g[3], double factor, double load_norm, double r) {
     NewtonMatrix& matrix = problem.matrix();
     const double slope = slope_along_step(matrix);  // d potential / d alpha at alpha = 0
@@ -114,7 +115,7 @@ double search_along_step(NewtonProblem& problem, const double g[3], double facto
         return out_of_balance(problem, g, factor, matrix.residual) / load_norm;
     }
     if (2.0 * alpha < 1.0) return r;  // the accepted step (alpha is the one after it) was halved
-    extend_update_while_falling(
+    move_update_towards_line_minimum(
         slope, energy, sum_roundoff(scale), [&] { return slope_along_step(matrix); },
         [&](double s) {
             place_along_step(problem, s);

@@ -1,6 +1,6 @@
-// The extension of a Newton update along which the potential still falls steeply
-// (extend_update_while_falling in solver/newton_problem.hpp), on potentials of one variable s
-// (the update's scale) whose minimisers are known by hand.
+// How a Newton update that ends far from the potential's minimum along it is moved towards it
+// (move_update_towards_line_minimum in solver/newton_problem.hpp), on potentials of one
+// variable s (the update's scale) whose minimisers are known by hand.
 #include "solver/newton_problem.hpp"
 
 #include <cmath>
@@ -22,7 +22,7 @@ struct Line {
     int moves = 0;
 
     void extend(double roundoff = 1e-15) {
-        sh::extend_update_while_falling(
+        sh::move_update_towards_line_minimum(
             slope(0.0), phi(1.0), roundoff, [&] { return slope(at); },
             [&](double s) {
                 at = s;
@@ -62,6 +62,26 @@ void test_refused_try_goes_back_to_the_full_update(void**) {
     assert_true(line.at == 1.0);
 }
 
+// (s - 0.5)^2: the update went twice as far as the minimiser (slope +1 at 1 against -1 at 0,
+// as from a tangent half as stiff as the potential along it): one secant back lands on 0.5.
+void test_update_past_the_minimiser_comes_back_to_it(void**) {
+    Line line{[](double s) { return (s - 0.5) * (s - 0.5); }, [](double s) { return 2.0 * (s - 0.5); }};
+    line.extend();
+    assert_true(std::fabs(line.at - 0.5) < 1e-12);
+    assert_int_equal(line.moves, 1);
+}
+
+// phi = -s + 20 max(0, s - 0.9)^2: falling at slope -1 up to a wall at 0.9, rising at slope 3
+// at the full update. The secant's zero (0.25) lies back on the straight part, where the
+// potential (-0.25) is above the full update's (-0.8): refused, the update stays full.
+void test_update_past_a_wall_stays_where_lower(void**) {
+    Line line{[](double s) { return -s + 20.0 * std::fmax(0.0, s - 0.9) * std::fmax(0.0, s - 0.9); },
+              [](double s) { return -1.0 + 40.0 * std::fmax(0.0, s - 0.9); }};
+    line.extend();
+    assert_true(line.at == 1.0);
+    assert_int_equal(line.moves, 2);  // the try, and the way back
+}
+
 // A Newton update near convergence ends flat (slope ratio below a quarter): no try at all.
 void test_flat_end_takes_no_try(void**) {
     Line line{[](double s) { return (s - 1.1) * (s - 1.1); }, [](double s) { return 2.0 * (s - 1.1); }};
@@ -77,6 +97,8 @@ int main(void) {
         cmocka_unit_test(test_half_way_update_lands_on_the_minimiser),
         cmocka_unit_test(test_far_minimiser_is_approached_in_a_stride_of_eight),
         cmocka_unit_test(test_refused_try_goes_back_to_the_full_update),
+        cmocka_unit_test(test_update_past_the_minimiser_comes_back_to_it),
+        cmocka_unit_test(test_update_past_a_wall_stays_where_lower),
         cmocka_unit_test(test_flat_end_takes_no_try),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);

@@ -41,13 +41,18 @@ static void scalpel_tip(const liver_path* path, double t, double out[3]) {
     liver_path_point(path, along, (down - up) * kDepth - 0.01 * (1.0 - down + up), out);
 }
 
-/* Makes the scalpel: a capsule along z with its blade from the tip up 3 cm. */
+/* Makes the scalpel: a capsule along z with its blade from the tip up 3 cm. Its contact law is
+ * 2e3 N/m^1.5, not the default 1e4: a thin rounded tool softens the nodes it pushes sideways
+ * by up to stiffness * sqrt(radius) (22 N/m here, 224 with 1e4), which must stay well below
+ * the liver's own stiffness at a node, E h = 15 kPa x 15 mm = 225 N/m, for implicit Euler to
+ * converge without creeping (README, Limits). */
 static int create_scalpel(const liver_scene* scene, const liver_path* path, sh_tool_id* out) {
     sh_collider_def def;
     sh_collider_def_default(&def);
     def.shape.kind = SH_SHAPE_CAPSULE;
     def.shape.radius = 0.0005;
     def.shape.half_length = 0.015;
+    def.contact.stiffness = 2e3;
     scalpel_tip(path, 0.0, def.position);
     def.position[2] += 0.015; /* the capsule's centre is 1.5 cm above the tip */
     sh_cut_def cut;

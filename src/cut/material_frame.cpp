@@ -2,6 +2,7 @@
 
 #include "core/memory.hpp"
 #include "core/vec3.hpp"
+#include "mesh/tets_in_box.hpp"
 #include "model/body.hpp"
 
 #include <Eigen/Dense>
@@ -47,29 +48,17 @@ void nearest_node_offset(const Body& body, const double p[3], double out[3]) {
 
 /// Flags (one per tet) the tets whose box meets the box around the count points p grown by
 /// half its diagonal: every tet that contains a point, and those near the points that an
-/// outside point may be least outside of. One pass over the nodes and one over the tets'
-/// corners, not the tets' maps.
+/// outside point may be least outside of.
 vec<uint8_t> tets_near(const Body& body, const double* p, int count) {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int i = 0; i < count; ++i)
         for (int k = 0; k < 3; ++k) lo[k] = std::fmin(lo[k], p[3 * i + k]), hi[k] = std::fmax(hi[k], p[3 * i + k]);
-    const double grow = 0.5 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    // Per node, a bit for each of the box's six planes it lies beyond; a tet misses the box
-    // exactly when all its corners lie beyond one plane.
-    vec<uint8_t> beyond(static_cast<size_t>(body.node_count()));
-    for (int32_t n = 0; n < body.node_count(); ++n) {
-        uint8_t bits = 0;
-        for (int k = 0; k < 3; ++k)
-            bits |= static_cast<uint8_t>((at(body.x.data(), n)[k] < lo[k] - grow ? 1 : 0) << k |
-                                         (at(body.x.data(), n)[k] > hi[k] + grow ? 1 : 0) << (k + 3));
-        beyond[static_cast<size_t>(n)] = bits;
-    }
-    vec<uint8_t> near(static_cast<size_t>(body.element_count()));
-    for (int32_t t = 0; t < body.element_count(); ++t) {
-        const int32_t* tet = body.element_nodes() + 4 * static_cast<size_t>(t);
-        near[static_cast<size_t>(t)] = (beyond[static_cast<size_t>(tet[0])] & beyond[static_cast<size_t>(tet[1])] &
-                                        beyond[static_cast<size_t>(tet[2])] & beyond[static_cast<size_t>(tet[3])]) == 0;
-    }
+    const double grow = 0.5 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    for (int k = 0; k < 3; ++k) lo[k] -= grow, hi[k] += grow;
+    vec<uint8_t> near(static_cast<size_t>(body.element_count()), 0);
+    for_each_tet_in_box(body.x.data(), body.node_count(), body.element_nodes(), body.element_count(), lo, hi,
+                        [&](int32_t t) { near[static_cast<size_t>(t)] = 1; });
     return near;
 }
 

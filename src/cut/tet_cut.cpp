@@ -4,6 +4,7 @@
 #include "cut/edge_split.hpp"
 #include "core/vec3.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "mesh/tets_in_box.hpp"
 #include "model/fem_body.hpp"
 
 #include <algorithm>
@@ -42,24 +43,11 @@ TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* fra
 }
 
 void TetCut::find_candidates(const FemBody& body, const CutSurface& surface) {
-    // A tet's box misses the surface's exactly when all its corners lie beyond one of the
-    // box's six planes: one bit per plane and node, and the tet's corners' bits ANDed.
-    vec<uint8_t> beyond(static_cast<size_t>(body.node_count()));
-    for (int32_t n = 0; n < body.node_count(); ++n) {
-        uint8_t bits = 0;
-        for (int k = 0; k < 3; ++k)
-            bits |= static_cast<uint8_t>((at(frame_, n)[k] < surface.lower()[k] ? 1 : 0) << k |
-                                         (at(frame_, n)[k] > surface.upper()[k] ? 1 : 0) << (k + 3));
-        beyond[static_cast<size_t>(n)] = bits;
-    }
-    for (int32_t t = 0; t < body.element_count(); ++t) {
-        const int32_t* tet = corners(body, t);
-        if (beyond[static_cast<size_t>(tet[0])] & beyond[static_cast<size_t>(tet[1])] & beyond[static_cast<size_t>(tet[2])] &
-            beyond[static_cast<size_t>(tet[3])])
-            continue;
-        candidates_.push_back(t);
-        corner_.insert(corner_.end(), corners(body, t), corners(body, t) + 4);
-    }
+    for_each_tet_in_box(frame_, body.node_count(), corners(body, 0), body.element_count(), surface.lower(), surface.upper(),
+                        [&](int32_t t) {
+                            candidates_.push_back(t);
+                            corner_.insert(corner_.end(), corners(body, t), corners(body, t) + 4);
+                        });
 }
 
 void TetCut::find_edges(const FemBody& body, const CutSurface& surface) {

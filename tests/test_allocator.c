@@ -550,12 +550,13 @@ typedef struct {
     sh_body_id body;
     sh_body_info before;
     double x[3 * 128];
+    double plane_x; /* where the cut's plane x = const lies (m) */
 } cut_case;
 
 static sh_status cut_the_bar(sh_world* world, void* context) {
     const cut_case* c = context;
-    /* the plane x = 2.3 cm, crossing the bar's middle cells */
-    const double plane[18] = {0.023, -1, -1, 0.023, 1, -1, 0.023, 1, 1, 0.023, -1, -1, 0.023, 1, 1, 0.023, -1, 1};
+    const double a = c->plane_x; /* crossing the bar's cells, not its node planes */
+    const double plane[18] = {a, -1, -1, a, 1, -1, a, 1, 1, a, -1, -1, a, 1, 1, a, -1, 1};
     sh_cut_report report;
     return sh_body_cut(world, c->body, plane, 2, &report);
 }
@@ -579,10 +580,15 @@ static int uncut_and_steps_on(sh_world* world, void* context) {
  * returns SH_ERR_OUT_OF_MEMORY and leaves the body exactly as it was: same topology, same
  * positions. The body then still steps, and the cut that finally gets its memory cuts the bar
  * in two (more nodes, a new version). */
-static void check_cut_out_of_memory_changes_nothing(int cells) {
+static void check_cut_out_of_memory_changes_nothing(int cells, int earlier_cuts) {
     reset_counts();
     cut_case c;
     sh_world* world = implicit_bar(0.01 * cells, cells, &c.body);
+    for (int k = 0; k < earlier_cuts; ++k) { /* what the body keeps of them is cut with too */
+        c.plane_x = 0.023 + 0.04 * (k + 1);
+        assert_ok(cut_the_bar(world, &c));
+    }
+    c.plane_x = 0.023;
     assert_ok(sh_world_step(world, 1e-3, NULL)); /* the body's solver state exists */
     assert_ok(sh_body_get_info(world, c.body, &c.before));
     assert_true(c.before.node_count <= 128);
@@ -601,14 +607,21 @@ static void check_cut_out_of_memory_changes_nothing(int cells) {
 /* On a 4-cube bar the cut changes a third of the tets: the body rebuilds all its elements. */
 static void test_cut_out_of_memory_changes_nothing(void** state) {
     (void)state;
-    check_cut_out_of_memory_changes_nothing(4);
+    check_cut_out_of_memory_changes_nothing(4, 0);
 }
 
 /* On a 16-cube bar it changes a few: the body updates them in place (emptied lanes, new
  * blocks, its surface updated from the changed tets). */
 static void test_local_cut_out_of_memory_changes_nothing(void** state) {
     (void)state;
-    check_cut_out_of_memory_changes_nothing(16);
+    check_cut_out_of_memory_changes_nothing(16, 0);
+}
+
+/* A body's later cut is cut together with what it keeps of the earlier ones (in its rest
+ * shape): running out of memory there leaves the body, and what it keeps, as they were. */
+static void test_later_cut_out_of_memory_changes_nothing(void** state) {
+    (void)state;
+    check_cut_out_of_memory_changes_nothing(16, 1);
 }
 
 /* What the implicit-step test steps and compares. */
@@ -817,6 +830,7 @@ int main(void) {
         cmocka_unit_test(test_implicit_step_out_of_memory_changes_nothing),
         cmocka_unit_test(test_cut_out_of_memory_changes_nothing),
         cmocka_unit_test(test_local_cut_out_of_memory_changes_nothing),
+        cmocka_unit_test(test_later_cut_out_of_memory_changes_nothing),
         cmocka_unit_test(test_failing_allocator), /* last: a leak would stay behind */
     };
     return cmocka_run_group_tests(tests, setup_install, NULL);

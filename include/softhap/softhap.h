@@ -673,7 +673,12 @@ typedef struct sh_cut_report {
 /** Cut body along a surface: triangle_count triangles, 9 doubles each (three corners, world
  *  frame, m), in the body's current configuration; the triangles need not be welded or
  *  consistently oriented. The material the surface passes through separates; where its
- *  border lies inside the body, the body stays joined (a later cut extends it). FEM bodies
+ *  border lies inside the body, the body stays joined (a later cut extends it). An FEM body
+ *  keeps its cuts (the last 512 triangles, in its rest shape, so they stay with the material)
+ *  and cuts a later one together with those it continues (within 30 degrees of its plane, not
+ *  lying on it): cuts that each cross only part of an element, as a scripted blade advancing
+ *  by less than an element per call makes, add up; a later cut is then mapped to the rest
+ *  shape by its corners (the first is exact in the current configuration). FEM bodies
  *  split every edge it crosses at the crossing (a crossing within a quarter of an edge of a
  *  node, or one that would make a piece of quality below 0.05 or stiffer than 0.3 of the uncut
  *  body's critical step allows, goes through a node instead); mass-spring bodies lose the

@@ -1,13 +1,16 @@
 #include "cut/body_cut.hpp"
 
 #include "core/clock.hpp"
+#include "collision/closest_point.hpp"
 #include "core/vec3.hpp"
 #include "cut/cut_surface.hpp"
+#include "cut/material_frame.hpp"
 #include "cut/refinement.hpp"
 #include "cut/separation.hpp"
 #include "cut/tet_cut.hpp"
 #include "model/fem_body.hpp"
 #include "model/spring_body.hpp"
+#include "world/step_hook.hpp"
 #include "world/world.hpp"
 
 #include <algorithm>
@@ -36,18 +39,22 @@ void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool
     report.faces_separated = separate(cut, node_count);
     report.min_quality = cut.min_quality;
     if (cut.origins.empty() && cut.split_count == 0) return;  // the surface missed the body
+    // The nodes on the cut, grown before the body changes: nothing may fail after it.
+    vec<int32_t> grown_on;
+    if (on_nodes) {
+        grown_on = *on_nodes;
+        grown_on.insert(grown_on.end(), cut.cut_nodes.begin(), cut.cut_nodes.end());
+        std::sort(grown_on.begin(), grown_on.end());
+        grown_on.erase(std::unique(grown_on.begin(), grown_on.end()), grown_on.end());
+        extend_on_nodes(grown_on, cut.origins, node_count);  // the copies of nodes on the cut
+    }
     TopologyScratch prepared;
     world.prepare_topology_change(id, node_count + static_cast<int32_t>(cut.origins.size()), prepared);
     body.retopologize(cut.origins.data(), cut.origins.size(), std::move(cut.tets), cut.source);
     world.topology_changed(id, prepared);
     report.nodes_added = body.node_count() - node_count;
     report.tets_added = body.element_count() - tet_count;
-    if (on_nodes) {
-        on_nodes->insert(on_nodes->end(), cut.cut_nodes.begin(), cut.cut_nodes.end());
-        std::sort(on_nodes->begin(), on_nodes->end());
-        on_nodes->erase(std::unique(on_nodes->begin(), on_nodes->end()), on_nodes->end());
-        extend_on_nodes(*on_nodes, cut.origins, node_count);  // the copies of nodes on the cut
-    }
+    if (on_nodes) on_nodes->swap(grown_on);
 }
 
 void cut_springs(World& world, Id id, SpringBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report) {
@@ -84,7 +91,96 @@ void cut_in_frame(World& world, Id id, const double* triangles, int32_t count, b
     report.seconds = now_seconds() - start;
 }
 
+/// Names the world's memory of programmatic cuts.
+const char kKeptCutsKey = 0;
+
+/// The programmatic cuts of each FEM body, in its rest shape, with the nodes they went through
+/// (see cut_body). The world owns it once a body has been cut.
+class KeptCuts final : public BeforeMotionHook {
+public:
+    struct Kept {
+        Id body;
+        vec<double> triangles;  ///< 9 per triangle, rest shape
+        vec<int32_t> on_nodes;  ///< ascending
+    };
+
+    /// What is kept of body id (an empty entry if nothing), bodies gone forgotten first.
+    Kept& of(World& world, Id id) {
+        kept_.erase(std::remove_if(kept_.begin(), kept_.end(), [&](const Kept& k) { return !world.is_valid(k.body); }),
+                    kept_.end());
+        for (Kept& k : kept_)
+            if (k.body == id) return k;
+        kept_.push_back({id, vec<double>(), vec<int32_t>()});
+        return kept_.back();
+    }
+
+private:
+    vec<Kept> kept_;
+};
+
+/// The triangles of kept (9 doubles each) that a cut along added (count triangles) continues:
+/// those within 30 degrees of the plane of the added triangle nearest them (by centre) and not
+/// lying on the added ones (a cut over an earlier one, which it covers) — a blade's earlier
+/// strips, not a crossing cut — each turned, if need be, to face the way that triangle does
+/// (CutSurface orients only across shared edges).
+vec<double> continued(const vec<double>& kept, const double* added, int32_t count) {
+    constexpr double kCos30 = 0.86602540378443865;
+    const auto centre_and_normal = [](const double* t, double c[3], double n[3]) {
+        double e0[3], e1[3];
+        for (int k = 0; k < 3; ++k) c[k] = (t[k] + t[3 + k] + t[6 + k]) / 3.0, e0[k] = t[3 + k] - t[k], e1[k] = t[6 + k] - t[k];
+        cross3(e0, e1, n);
+        const double length = norm3(n);
+        for (int k = 0; k < 3; ++k) n[k] /= length;
+        return std::sqrt(length);  // about the triangle's size
+    };
+    vec<double> out;
+    for (size_t i = 0; i < kept.size(); i += 9) {
+        double c[3], n[3], best_n[3] = {0.0, 0.0, 0.0}, best = INFINITY, on = INFINITY;
+        const double size = centre_and_normal(&kept[i], c, n);
+        for (int32_t j = 0; j < count; ++j) {
+            const double* t = &added[9 * static_cast<size_t>(j)];
+            double cj[3], nj[3], d[3], w[3];
+            centre_and_normal(t, cj, nj);
+            sub3(cj, c, d);
+            if (dot3(d, d) < best) best = dot3(d, d), std::copy(nj, nj + 3, best_n);
+            on = std::fmin(on, closest_on_triangle(c, t, t + 3, t + 6, w));
+        }
+        if (std::fabs(dot3(n, best_n)) < kCos30 || on <= 1e-6 * size) continue;
+        out.insert(out.end(), &kept[i], &kept[i] + 9);
+        if (dot3(n, best_n) < 0.0) std::swap_ranges(out.end() - 6, out.end() - 3, out.end() - 3);
+    }
+    return out;
+}
+
+/// cut_body for an FEM body: along triangles with what its earlier cuts kept, which grows by
+/// them only once the cut succeeded.
+void cut_fem_keeping(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {
+    const CutSurface checked(triangles, count);  // bad input is refused before anything changes
+    (void)checked;
+    KeptCuts::Kept& kept = world.own_hook_once<KeptCuts>(&kKeptCutsKey).of(world, id);
+    vec<double> rest(9 * static_cast<size_t>(count));
+    to_rest_all(world.body(id), triangles, 3 * count, rest.data());
+    // What is kept after the cut, made before it: nothing may fail once the body changed.
+    vec<double> grown = kept.triangles;
+    grown.insert(grown.end(), rest.begin(), rest.end());
+    keep_recent(grown);
+    vec<int32_t> on_nodes = kept.on_nodes;
+    vec<double> along = continued(kept.triangles, rest.data(), count);
+    if (along.empty()) {
+        cut_in_frame(world, id, triangles, count, false, report, &on_nodes);
+    } else {
+        along.insert(along.end(), rest.begin(), rest.end());
+        cut_in_frame(world, id, along.data(), static_cast<int32_t>(along.size() / 9), true, report, &on_nodes);
+    }
+    kept.triangles.swap(grown);
+    kept.on_nodes.swap(on_nodes);
+}
+
 }  // namespace
+
+void keep_recent(vec<double>& kept) {
+    if (kept.size() > 9 * kKeptCutTriangles) kept.erase(kept.begin(), kept.end() - 9 * kKeptCutTriangles);
+}
 
 void refine_body_near(World& world, Id id, const double* segments, int32_t segment_count, double edge_length,
                       vec<int32_t>* on_nodes) {
@@ -104,7 +200,10 @@ void refine_body_near(World& world, Id id, const double* segments, int32_t segme
 }
 
 void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {
-    cut_in_frame(world, id, triangles, count, false, report, nullptr);
+    if (world.body(id).is_fem())
+        cut_fem_keeping(world, id, triangles, count, report);
+    else
+        cut_in_frame(world, id, triangles, count, false, report, nullptr);
 }
 
 void cut_body_at_rest(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report,

@@ -12,10 +12,23 @@ namespace sh {
 
 class World;
 
+/// Most triangles of a cut surface kept to be cut with again (a cutting tool's sweep, a body's
+/// programmatic cuts), per body: a blade advancing by at least 1/256 of an element per step
+/// still crosses whole elements with what is kept.
+constexpr size_t kKeptCutTriangles = 512;
+
+/// Drops the oldest triangles of kept (9 doubles each) beyond kKeptCutTriangles.
+void keep_recent(vec<double>& kept);
+
 /// Cuts body id of world along triangles[0..9 count) (three corners each, world frame, the
-/// body's current configuration), as sh_body_cut describes; fills report. Throws
-/// SH_ERR_INVALID_ARGUMENT for bad triangles and SH_ERR_INVALID_HANDLE for a bad id; a
-/// failure leaves the body as it was.
+/// body's current configuration), as sh_body_cut describes; fills report. An FEM body's
+/// earlier programmatic cuts are kept in its rest shape (the most recent kKeptCutTriangles
+/// triangles) and cut with again, so that cuts that each cross only part of an element (a
+/// scripted blade advancing by less than an element per cut) add up as a cutting tool's sweep
+/// does; the first cut of a body is exact in its current configuration, later ones map the
+/// new triangles to the rest shape by their corners. Throws SH_ERR_INVALID_ARGUMENT for bad
+/// triangles and SH_ERR_INVALID_HANDLE for a bad id; a failure leaves the body, and what is
+/// kept of it, as it was.
 void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report);
 
 /// cut_body with triangles given in body id's rest shape (the material frame) instead of its

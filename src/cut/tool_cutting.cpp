@@ -79,10 +79,6 @@ bool near(const Body& body, const double triangles[18]) {
     return true;
 }
 
-/// Most triangles of a blade's swept surface kept per body: a blade advancing by at least
-/// 1/256 of an element per step still crosses whole elements with what is kept.
-constexpr size_t kKeptTriangles = 512;
-
 /// Cuts every body along each cutting tool's swept blade before the step's motion. A blade
 /// that advances by less than an element per step crosses each tet bit by bit, so what it
 /// swept is kept and cut with whole; it is kept in each body's rest shape (the material
@@ -207,7 +203,7 @@ private:
         refine_body_near(world, body_id, quad_sides(rest).data(), 4, edge_length, &sweep.on_nodes);
         vec<double>& swept = sweep.triangles;
         swept.insert(swept.end(), rest, rest + 18);
-        if (swept.size() > 9 * kKeptTriangles) swept.erase(swept.begin(), swept.end() - 9 * kKeptTriangles);
+        keep_recent(swept);
         sh_cut_report cut{};
         cut_body_at_rest(world, body_id, swept.data(), static_cast<int32_t>(swept.size() / 9), cut, &sweep.on_nodes);
         return cut.faces_separated;

@@ -419,21 +419,39 @@ def test_progressive_cut_extends_a_partial_cut_ending_inside_a_cube(world):
     assert piece_count(body) == 2  # the header: a later cut extends it
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="library bug: each blade increment (a 4 mm strip, narrower than the 1 cm elements) "
-    "lies only in tets holding its border, so it separates nothing, and nothing remembers it: "
-    "a blade advancing less than an element per cut never cuts",
-)
+def strips_across(body, z, width=0.004, start=-0.004, end=0.024):
+    """Cuts body at the plane z in strips of width across x (each the part swept since the
+    last, as a scripted blade would), each narrower than the bar's 1 cm elements; returns the
+    faces each separated."""
+    edges = np.arange(start, end + 1e-9, width)
+    return [body.cut(rectangle((x0, x1), (-0.01, 0.03), z)).faces_separated for x0, x1 in zip(edges[:-1], edges[1:])]
+
+
 def test_blade_advancing_in_small_increments_cuts_through(world):
-    """A blade swept across the bar in 4 mm increments (each cut the strip swept since the
-    last), covering the whole section in the end, cuts the bar in two."""
+    """A blade swept across the bar in 4 mm increments, covering the whole section in the
+    end, cuts the bar in two (the header: a body keeps its programmatic cuts, so cuts narrower
+    than an element add up): two pieces of the volumes a single cut at z = 5.5 cm gives (2 x 2
+    x 5.5 cm and 2 x 2 x 4.5 cm), closed surfaces, mass and volume conserved. The first strip,
+    inside the elements at the bar's side, parts nothing yet."""
     body = bar(world)
-    edges = np.arange(-0.004, 0.0241, 0.004)
-    for x0, x1 in zip(edges[:-1], edges[1:]):
-        body.cut(rectangle((x0, x1), (-0.01, 0.03), 0.055))
-    assert piece_count(body) == 2  # the strips together cover the section
+    faces = strips_across(body, 0.055)
+    assert faces[0] == 0
+    assert piece_count(body) == 2
+    labels, _, _ = components(body.node_count, body.tets)[:3]
+    volumes = np.bincount(labels, weights=tet_volumes(body.positions, body.tets))
+    assert sorted(volumes) == pytest.approx(sorted([0.02 * 0.02 * 0.045, 0.02 * 0.02 * 0.055]), rel=1e-9)
+    assert_surface_ok(body)
+    assert_conserves(body, BAR_VOLUME, DENSITY * BAR_VOLUME)
+
+
+def test_small_increments_stopping_short_leave_the_bar_joined(world):
+    """The same strips stopped at x = 1.2 cm (0.8 cm short of the far side, inside its
+    elements) leave the bar one piece, and a later strip crossing its far side completes it."""
+    body = bar(world)
+    strips_across(body, 0.055, end=0.012)
+    assert piece_count(body) == 1
+    body.cut(rectangle((0.012, 0.024), (-0.01, 0.03), 0.055))
+    assert piece_count(body) == 2
 
 
 def test_partial_cut_with_its_border_inside_a_cube_leaves_one_piece(world):

@@ -207,8 +207,11 @@ class Body(WorldEntity):
         corners each, world frame (m), in the body's current configuration; they need not be
         welded or consistently oriented. The material the surface passes through separates
         (FEM bodies split the tets it crosses, mass-spring bodies lose the springs it crosses);
-        where the surface's border lies inside the body, it stays joined. topology_version
-        increases if anything was cut; node indices never change, new nodes are appended.
+        where the surface's border lies inside the body, it stays joined until a later cut
+        extends it: an FEM body keeps what it was cut along (in its rest shape) and cuts a
+        later cut with the earlier ones it continues, so that strips narrower than an element
+        (a scripted blade) add up. topology_version increases if anything was cut; node
+        indices never change, new nodes are appended.
 
         A wrong shape raises ValueError; non-finite coordinates, a zero-area triangle or k = 0
         raise softhap.Error (SH_ERR_INVALID_ARGUMENT), and the body is left as it was.

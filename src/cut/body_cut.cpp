@@ -31,10 +31,10 @@ void extend_on_nodes(vec<int32_t>& on_nodes, const vec<NodeOrigin>& origins, int
 }
 
 void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report,
-             vec<int32_t>* on_nodes) {
+             vec<int32_t>* on_nodes, const double* focus) {
     // A surface in the material frame is a tool's growing sweep, cut with again at every step;
     // the nodes it went through (on_nodes) keep the quality guard's earlier choices.
-    TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data(), true, on_nodes);
+    TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data(), true, on_nodes, focus);
     const int32_t node_count = body.node_count(), tet_count = body.element_count();
     report.faces_separated = separate(cut, node_count);
     report.min_quality = cut.min_quality;
@@ -76,16 +76,20 @@ void cut_springs(World& world, Id id, SpringBody& body, const CutSurface& surfac
     world.topology_changed(id, prepared);
 }
 
-/// Cuts body id along triangles given against its current (at_rest false) or rest positions.
+/// Cuts body id along triangles given against its current (at_rest false) or rest positions,
+/// an FEM body only where their last focus_count triangles are (all of them if 0).
 void cut_in_frame(World& world, Id id, const double* triangles, int32_t count, bool at_rest, sh_cut_report& report,
-                  vec<int32_t>* on_nodes) {
+                  vec<int32_t>* on_nodes, int32_t focus_count = 0) {
     const double start = now_seconds();
     Body& body = world.body(id);
     const CutSurface surface(triangles, count);
     report = sh_cut_report{};
     report.min_quality = 1.0;
+    double focus[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (int32_t c = 3 * (count - focus_count); c < 3 * count && focus_count > 0; ++c)
+        for (int k = 0; k < 3; ++k) focus[k] = std::fmin(focus[k], triangles[3 * c + k]), focus[3 + k] = std::fmax(focus[3 + k], triangles[3 * c + k]);
     if (body.is_fem())
-        cut_fem(world, id, static_cast<FemBody&>(body), surface, at_rest, report, on_nodes);
+        cut_fem(world, id, static_cast<FemBody&>(body), surface, at_rest, report, on_nodes, focus_count > 0 ? focus : nullptr);
     else
         cut_springs(world, id, static_cast<SpringBody&>(body), surface, at_rest, report);
     report.seconds = now_seconds() - start;
@@ -119,12 +123,15 @@ private:
 };
 
 /// The triangles of kept (9 doubles each) that a cut along added (count triangles) continues:
-/// those within 30 degrees of the plane of the added triangle nearest them (by centre) and not
+/// those near the added ones' box, within 30 degrees of the plane of the added triangle nearest them (by centre) and not
 /// lying on the added ones (a cut over an earlier one, which it covers) — a blade's earlier
 /// strips, not a crossing cut — each turned, if need be, to face the way that triangle does
 /// (CutSurface orients only across shared edges).
 vec<double> continued(const vec<double>& kept, const double* added, int32_t count) {
     constexpr double kCos30 = 0.86602540378443865;
+    // A kept triangle whose centre lies within a tenth of its size of the added ones is one
+    // they cover (cut along again, mapped to the rest shape anew as the body moved).
+    constexpr double kCovered = 0.1;
     const auto centre_and_normal = [](const double* t, double c[3], double n[3]) {
         double e0[3], e1[3];
         for (int k = 0; k < 3; ++k) c[k] = (t[k] + t[3 + k] + t[6 + k]) / 3.0, e0[k] = t[3 + k] - t[k], e1[k] = t[6 + k] - t[k];
@@ -133,10 +140,17 @@ vec<double> continued(const vec<double>& kept, const double* added, int32_t coun
         for (int k = 0; k < 3; ++k) n[k] /= length;
         return std::sqrt(length);  // about the triangle's size
     };
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t j = 0; j < 3 * count; ++j)
+        for (int k = 0; k < 3; ++k) lo[k] = std::fmin(lo[k], added[3 * j + k]), hi[k] = std::fmax(hi[k], added[3 * j + k]);
     vec<double> out;
     for (size_t i = 0; i < kept.size(); i += 9) {
         double c[3], n[3], best_n[3] = {0.0, 0.0, 0.0}, best = INFINITY, on = INFINITY;
         const double size = centre_and_normal(&kept[i], c, n);
+        // Only a triangle within its own size of the added ones' box can continue them.
+        bool near = true;
+        for (int k = 0; k < 3; ++k) near = near && c[k] >= lo[k] - size && c[k] <= hi[k] + size;
+        if (!near) continue;
         for (int32_t j = 0; j < count; ++j) {
             const double* t = &added[9 * static_cast<size_t>(j)];
             double cj[3], nj[3], d[3], w[3];
@@ -145,7 +159,7 @@ vec<double> continued(const vec<double>& kept, const double* added, int32_t coun
             if (dot3(d, d) < best) best = dot3(d, d), std::copy(nj, nj + 3, best_n);
             on = std::fmin(on, closest_on_triangle(c, t, t + 3, t + 6, w));
         }
-        if (std::fabs(dot3(n, best_n)) < kCos30 || on <= 1e-6 * size) continue;
+        if (std::fabs(dot3(n, best_n)) < kCos30 || on <= kCovered * size) continue;
         out.insert(out.end(), &kept[i], &kept[i] + 9);
         if (dot3(n, best_n) < 0.0) std::swap_ranges(out.end() - 6, out.end() - 3, out.end() - 3);
     }
@@ -170,7 +184,7 @@ void cut_fem_keeping(World& world, Id id, const double* triangles, int32_t count
         cut_in_frame(world, id, triangles, count, false, report, &on_nodes);
     } else {
         along.insert(along.end(), rest.begin(), rest.end());
-        cut_in_frame(world, id, along.data(), static_cast<int32_t>(along.size() / 9), true, report, &on_nodes);
+        cut_in_frame(world, id, along.data(), static_cast<int32_t>(along.size() / 9), true, report, &on_nodes, count);
     }
     kept.triangles.swap(grown);
     kept.on_nodes.swap(on_nodes);
@@ -207,8 +221,8 @@ void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cu
 }
 
 void cut_body_at_rest(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report,
-                      vec<int32_t>* on_nodes) {
-    cut_in_frame(world, id, triangles, count, true, report, on_nodes);
+                      vec<int32_t>* on_nodes, int32_t focus_count) {
+    cut_in_frame(world, id, triangles, count, true, report, on_nodes, focus_count);
 }
 
 }  // namespace sh

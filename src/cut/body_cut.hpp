@@ -35,9 +35,11 @@ void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cu
 /// current configuration: a surface recorded there stays with the material as it moves.
 /// on_nodes (ascending, may be null) lists the nodes an earlier cut along part of the same
 /// surface went through: they stay on it, so cutting again along a grown surface parts the
-/// same faces; the nodes this cut goes through (and their copies) are added to it.
+/// same faces; the nodes this cut goes through (and their copies) are added to it. With
+/// focus_count > 0, only tets near the last focus_count triangles (the new part of a grown
+/// surface) are cut: away from them, cutting again along the rest parts nothing new.
 void cut_body_at_rest(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report,
-                      vec<int32_t>* on_nodes = nullptr);
+                      vec<int32_t>* on_nodes = nullptr, int32_t focus_count = 0);
 
 /// Refines FEM body id of world around the segments (segment_count of them, 6 doubles each:
 /// two points of its rest shape) to edges of at most edge_length, as refine_near describes,

@@ -27,9 +27,9 @@ const int32_t* corners(const FemBody& body, int32_t t) { return body.element_nod
 }  // namespace
 
 TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality,
-               const vec<int32_t>* known_on)
+               const vec<int32_t>* known_on, const double* focus)
     : frame_(frame) {
-    find_candidates(body, surface);
+    find_candidates(body, focus ? focus : surface.lower(), focus ? focus + 3 : surface.upper());
     find_edges(body, surface);
     snap_earlier_cut_nodes(body, surface, known_on);
     mark_cut_edges();
@@ -42,8 +42,8 @@ TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* fra
     collect_cut(body, surface);
 }
 
-void TetCut::find_candidates(const FemBody& body, const CutSurface& surface) {
-    for_each_tet_in_box(frame_, body.node_count(), corners(body, 0), body.element_count(), surface.lower(), surface.upper(),
+void TetCut::find_candidates(const FemBody& body, const double* lower, const double* upper) {
+    for_each_tet_in_box(frame_, body.node_count(), corners(body, 0), body.element_count(), lower, upper,
                         [&](int32_t t) {
                             candidates_.push_back(t);
                             corner_.insert(corner_.end(), corners(body, t), corners(body, t) + 4);

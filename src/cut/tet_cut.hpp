@@ -31,8 +31,11 @@ public:
     /// surface finds the same crossings: a sweep that is cut with again as it grows.)
     /// Nodes listed in known_on (ascending; may be null) lie on the surface whatever their
     /// distance from it: the nodes an earlier cut along a part of the same surface went through.
+    /// Only tets whose box meets focus (6 doubles: lower, then upper corner, in frame; null:
+    /// the surface's box) are cut: a surface grown by a new part, cut with again, has nothing
+    /// new to part away from that part.
     TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality,
-           const vec<int32_t>* known_on = nullptr);
+           const vec<int32_t>* known_on = nullptr, const double* focus = nullptr);
 
     /// New nodes (appended after the body's), each on a crossed edge.
     vec<NodeOrigin> origins;
@@ -68,7 +71,7 @@ private:
     /// Stands in for the node of crossed edge e (kProvisional + e) before nodes are numbered.
     static constexpr int32_t kProvisional = 1 << 30;
 
-    void find_candidates(const FemBody& body, const CutSurface& surface);
+    void find_candidates(const FemBody& body, const double* lower, const double* upper);
     void find_edges(const FemBody& body, const CutSurface& surface);
     void snap_earlier_cut_nodes(const FemBody& body, const CutSurface& surface, const vec<int32_t>* known_on);
     void settle(const FemBody& body);

@@ -1,7 +1,7 @@
 #include "cut/body_cut.hpp"
 
-#include "core/clock.hpp"
 #include "collision/closest_point.hpp"
+#include "core/clock.hpp"
 #include "core/vec3.hpp"
 #include "cut/cut_surface.hpp"
 #include "cut/material_frame.hpp"
@@ -32,8 +32,8 @@ void extend_on_nodes(vec<int32_t>& on_nodes, const vec<NodeOrigin>& origins, int
 
 void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report,
              vec<int32_t>* on_nodes, const double* focus) {
-    // A surface in the material frame is a tool's growing sweep, cut with again at every step;
-    // the nodes it went through (on_nodes) keep the quality guard's earlier choices.
+    // A surface in the material frame is a tool's growing sweep, or a body's kept cuts, cut
+    // with again; the nodes it went through (on_nodes) keep the quality guard's earlier choices.
     TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data(), true, on_nodes, focus);
     const int32_t node_count = body.node_count(), tet_count = body.element_count();
     report.faces_separated = separate(cut, node_count);
@@ -123,10 +123,10 @@ private:
 };
 
 /// The triangles of kept (9 doubles each) that a cut along added (count triangles) continues:
-/// those near the added ones' box, within 30 degrees of the plane of the added triangle nearest them (by centre) and not
-/// lying on the added ones (a cut over an earlier one, which it covers) — a blade's earlier
-/// strips, not a crossing cut — each turned, if need be, to face the way that triangle does
-/// (CutSurface orients only across shared edges).
+/// those near the added ones' box, within 30 degrees of the plane of the added triangle
+/// nearest them (by centre), and not lying on the added ones (a cut over an earlier one, which
+/// it covers): a blade's earlier strips, not a crossing cut. Each is turned, if need be, to
+/// face the way that triangle does (CutSurface orients only across shared edges).
 vec<double> continued(const vec<double>& kept, const double* added, int32_t count) {
     constexpr double kCos30 = 0.86602540378443865;
     // A kept triangle whose centre lies within a tenth of its size of the added ones is one
@@ -137,8 +137,8 @@ vec<double> continued(const vec<double>& kept, const double* added, int32_t coun
         for (int k = 0; k < 3; ++k) c[k] = (t[k] + t[3 + k] + t[6 + k]) / 3.0, e0[k] = t[3 + k] - t[k], e1[k] = t[6 + k] - t[k];
         cross3(e0, e1, n);
         const double length = norm3(n);
-        for (int k = 0; k < 3; ++k) n[k] /= length;
-        return std::sqrt(length);  // about the triangle's size
+        for (int k = 0; k < 3; ++k) n[k] = length > 0.0 ? n[k] / length : 0.0;
+        return std::sqrt(length);  // about the triangle's size; 0 for a flat one
     };
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t j = 0; j < 3 * count; ++j)
@@ -147,8 +147,9 @@ vec<double> continued(const vec<double>& kept, const double* added, int32_t coun
     for (size_t i = 0; i < kept.size(); i += 9) {
         double c[3], n[3], best_n[3] = {0.0, 0.0, 0.0}, best = INFINITY, on = INFINITY;
         const double size = centre_and_normal(&kept[i], c, n);
-        // Only a triangle within its own size of the added ones' box can continue them.
-        bool near = true;
+        // Only a triangle within its own size of the added ones' box can continue them (a
+        // flat one, which the cut would refuse, continues nothing).
+        bool near = size > 0.0;
         for (int k = 0; k < 3; ++k) near = near && c[k] >= lo[k] - size && c[k] <= hi[k] + size;
         if (!near) continue;
         for (int32_t j = 0; j < count; ++j) {

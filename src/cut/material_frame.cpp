@@ -1,5 +1,6 @@
 #include "cut/material_frame.hpp"
 
+#include "collision/aabb_tree.hpp"
 #include "core/memory.hpp"
 #include "core/vec3.hpp"
 #include "mesh/tets_in_box.hpp"
@@ -46,31 +47,31 @@ void nearest_node_offset(const Body& body, const double p[3], double out[3]) {
     for (int k = 0; k < 3; ++k) out[k] = at(body.rest.data(), nearest)[k] + p[k] - at(body.x.data(), nearest)[k];
 }
 
-/// Flags (one per tet) the tets whose box meets the box around the count points p grown by
-/// half its diagonal: every tet that contains a point, and those near the points that an
-/// outside point may be least outside of.
-vec<uint8_t> tets_near(const Body& body, const double* p, int count) {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int i = 0; i < count; ++i)
-        for (int k = 0; k < 3; ++k) lo[k] = std::fmin(lo[k], p[3 * i + k]), hi[k] = std::fmax(hi[k], p[3 * i + k]);
-    const double grow = 0.5 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    for (int k = 0; k < 3; ++k) lo[k] -= grow, hi[k] += grow;
-    vec<uint8_t> near(static_cast<size_t>(body.element_count()), 0);
-    for_each_tet_in_box(body.x.data(), body.node_count(), body.element_nodes(), body.element_count(), lo, hi,
-                        [&](int32_t t) { near[static_cast<size_t>(t)] = 1; });
+/// The tets whose box meets the box around the count points p grown by half its diagonal:
+/// every tet that contains a point, and those near the points that an outside point may be
+/// least outside of.
+vec<int32_t> tets_near(const Body& body, const double* p, int count) {
+    Aabb box;
+    for (int i = 0; i < count; ++i) box.add(&p[3 * i]);
+    double diagonal[3];
+    sub3(box.hi, box.lo, diagonal);
+    box.inflate(0.5 * norm3(diagonal));
+    vec<int32_t> near;
+    for_each_tet_in_box(body.x.data(), body.node_count(), body.element_nodes(), body.element_count(), box.lo, box.hi,
+                        [&](int32_t t) { near.push_back(t); });
     return near;
 }
 
-/// For each point i of p with out[i].inside < 0 (not yet inside a tet): the first tet among
-/// those flagged in only (null: all) that contains it, else the one it is least outside of
-/// if less than out[i].inside, with its barycentric weights in best_w (4 per point).
-void search_tets(const Body& body, const double* p, int count, const uint8_t* only, RestPoint* out, double* best_w) {
+/// For each point i of p with out[i].inside < 0 (not yet inside a tet): the first of the tets
+/// listed in only (null: all the body's) that contains it, else the one it is least outside
+/// of if less than out[i].inside, with its barycentric weights in best_w (4 per point).
+void search_tets(const Body& body, const double* p, int count, const vec<int32_t>* only, RestPoint* out, double* best_w) {
     int left = 0;
     for (int i = 0; i < count; ++i) left += out[i].inside < 0.0 ? 1 : 0;
+    const int32_t tets = only ? static_cast<int32_t>(only->size()) : body.element_count();
     TetMap map;
-    for (int32_t t = 0; t < body.element_count() && left > 0; ++t) {
-        if (only && !only[t]) continue;
+    for (int32_t k = 0; k < tets && left > 0; ++k) {
+        const int32_t t = only ? (*only)[static_cast<size_t>(k)] : k;
         if (!map.form(body.x.data(), body.element_nodes() + 4 * static_cast<size_t>(t))) continue;
         for (int i = 0; i < count; ++i) {
             if (out[i].inside >= 0.0) continue;
@@ -96,7 +97,8 @@ void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
     // from the others) looks through them all.
     vec<double> best_w(4 * static_cast<size_t>(count), 0.0);
     for (int i = 0; i < count; ++i) out[i] = RestPoint{}, out[i].inside = -INFINITY;
-    search_tets(body, p, count, tets_near(body, p, count).data(), out, best_w.data());
+    const vec<int32_t> near = tets_near(body, p, count);
+    search_tets(body, p, count, &near, out, best_w.data());
     bool unreached = false;
     for (int i = 0; i < count; ++i) unreached = unreached || out[i].tet < 0;
     if (unreached) search_tets(body, p, count, nullptr, out, best_w.data());

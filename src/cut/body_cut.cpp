@@ -1,5 +1,6 @@
 #include "cut/body_cut.hpp"
 
+#include "collision/aabb_tree.hpp"
 #include "collision/closest_point.hpp"
 #include "core/clock.hpp"
 #include "core/vec3.hpp"
@@ -31,7 +32,7 @@ void extend_on_nodes(vec<int32_t>& on_nodes, const vec<NodeOrigin>& origins, int
 }
 
 void cut_fem(World& world, Id id, FemBody& body, const CutSurface& surface, bool at_rest, sh_cut_report& report,
-             vec<int32_t>* on_nodes, const double* focus) {
+             vec<int32_t>* on_nodes, const Aabb* focus) {
     // A surface in the material frame is a tool's growing sweep, or a body's kept cuts, cut
     // with again; the nodes it went through (on_nodes) keep the quality guard's earlier choices.
     TetCut cut(body, surface, at_rest ? body.rest.data() : body.x.data(), true, on_nodes, focus);
@@ -76,20 +77,19 @@ void cut_springs(World& world, Id id, SpringBody& body, const CutSurface& surfac
     world.topology_changed(id, prepared);
 }
 
-/// Cuts body id along triangles given against its current (at_rest false) or rest positions,
-/// an FEM body only where their last focus_count triangles are (all of them if 0).
-void cut_in_frame(World& world, Id id, const double* triangles, int32_t count, bool at_rest, sh_cut_report& report,
+/// Cuts body id along surface, given against its current (at_rest false) or rest positions;
+/// an FEM body only where the surface's last focus_count triangles are (all of it if 0).
+void cut_in_frame(World& world, Id id, const CutSurface& surface, bool at_rest, sh_cut_report& report,
                   vec<int32_t>* on_nodes, int32_t focus_count = 0) {
     const double start = now_seconds();
     Body& body = world.body(id);
-    const CutSurface surface(triangles, count);
     report = sh_cut_report{};
     report.min_quality = 1.0;
-    double focus[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
-    for (int32_t c = 3 * (count - focus_count); c < 3 * count && focus_count > 0; ++c)
-        for (int k = 0; k < 3; ++k) focus[k] = std::fmin(focus[k], triangles[3 * c + k]), focus[3 + k] = std::fmax(focus[3 + k], triangles[3 * c + k]);
+    Aabb focus;
+    for (int32_t i = surface.triangle_count() - focus_count; i < surface.triangle_count(); ++i)
+        for (int c = 0; c < 3; ++c) focus.add(surface.corner(i, c));
     if (body.is_fem())
-        cut_fem(world, id, static_cast<FemBody&>(body), surface, at_rest, report, on_nodes, focus_count > 0 ? focus : nullptr);
+        cut_fem(world, id, static_cast<FemBody&>(body), surface, at_rest, report, on_nodes, focus_count > 0 ? &focus : nullptr);
     else
         cut_springs(world, id, static_cast<SpringBody&>(body), surface, at_rest, report);
     report.seconds = now_seconds() - start;
@@ -122,6 +122,17 @@ private:
     vec<Kept> kept_;
 };
 
+/// A triangle's centre and unit normal (zero for a flat one); returns about its size (the
+/// square root of twice its area; 0 if flat).
+double centre_and_normal(const double* t, double c[3], double n[3]) {
+    double e0[3], e1[3];
+    for (int k = 0; k < 3; ++k) c[k] = (t[k] + t[3 + k] + t[6 + k]) / 3.0, e0[k] = t[3 + k] - t[k], e1[k] = t[6 + k] - t[k];
+    cross3(e0, e1, n);
+    const double length = norm3(n);
+    for (int k = 0; k < 3; ++k) n[k] = length > 0.0 ? n[k] / length : 0.0;
+    return std::sqrt(length);
+}
+
 /// The triangles of kept (9 doubles each) that a cut along added (count triangles) continues:
 /// those near the added ones' box, within 30 degrees of the plane of the added triangle
 /// nearest them (by centre), and not lying on the added ones (a cut over an earlier one, which
@@ -132,37 +143,32 @@ vec<double> continued(const vec<double>& kept, const double* added, int32_t coun
     // A kept triangle whose centre lies within a tenth of its size of the added ones is one
     // they cover (cut along again, mapped to the rest shape anew as the body moved).
     constexpr double kCovered = 0.1;
-    const auto centre_and_normal = [](const double* t, double c[3], double n[3]) {
-        double e0[3], e1[3];
-        for (int k = 0; k < 3; ++k) c[k] = (t[k] + t[3 + k] + t[6 + k]) / 3.0, e0[k] = t[3 + k] - t[k], e1[k] = t[6 + k] - t[k];
-        cross3(e0, e1, n);
-        const double length = norm3(n);
-        for (int k = 0; k < 3; ++k) n[k] = length > 0.0 ? n[k] / length : 0.0;
-        return std::sqrt(length);  // about the triangle's size; 0 for a flat one
-    };
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int32_t j = 0; j < 3 * count; ++j)
-        for (int k = 0; k < 3; ++k) lo[k] = std::fmin(lo[k], added[3 * j + k]), hi[k] = std::fmax(hi[k], added[3 * j + k]);
+    Aabb box;
+    vec<double> centres(3 * static_cast<size_t>(count)), normals(3 * static_cast<size_t>(count));
+    for (int32_t j = 0; j < count; ++j) {
+        centre_and_normal(&added[9 * static_cast<size_t>(j)], &centres[3 * static_cast<size_t>(j)], &normals[3 * static_cast<size_t>(j)]);
+        for (int c = 0; c < 3; ++c) box.add(&added[9 * static_cast<size_t>(j) + 3 * static_cast<size_t>(c)]);
+    }
     vec<double> out;
     for (size_t i = 0; i < kept.size(); i += 9) {
-        double c[3], n[3], best_n[3] = {0.0, 0.0, 0.0}, best = INFINITY, on = INFINITY;
-        const double size = centre_and_normal(&kept[i], c, n);
+        double c[3], n[3], w[3];
         // Only a triangle within its own size of the added ones' box can continue them (a
         // flat one, which the cut would refuse, continues nothing).
-        bool near = size > 0.0;
-        for (int k = 0; k < 3; ++k) near = near && c[k] >= lo[k] - size && c[k] <= hi[k] + size;
-        if (!near) continue;
+        const double size = centre_and_normal(&kept[i], c, n);
+        if (!(size > 0.0) || box.distance2(c) > size * size) continue;
+        int32_t nearest = 0;
+        double best = INFINITY, on = INFINITY;
         for (int32_t j = 0; j < count; ++j) {
             const double* t = &added[9 * static_cast<size_t>(j)];
-            double cj[3], nj[3], d[3], w[3];
-            centre_and_normal(t, cj, nj);
-            sub3(cj, c, d);
-            if (dot3(d, d) < best) best = dot3(d, d), std::copy(nj, nj + 3, best_n);
+            double d[3];
+            sub3(&centres[3 * static_cast<size_t>(j)], c, d);
+            if (dot3(d, d) < best) best = dot3(d, d), nearest = j;
             on = std::fmin(on, closest_on_triangle(c, t, t + 3, t + 6, w));
         }
-        if (std::fabs(dot3(n, best_n)) < kCos30 || on <= kCovered * size) continue;
+        const double facing = dot3(n, &normals[3 * static_cast<size_t>(nearest)]);
+        if (std::fabs(facing) < kCos30 || on <= kCovered * size) continue;
         out.insert(out.end(), &kept[i], &kept[i] + 9);
-        if (dot3(n, best_n) < 0.0) std::swap_ranges(out.end() - 6, out.end() - 3, out.end() - 3);
+        if (facing < 0.0) std::swap_ranges(out.end() - 6, out.end() - 3, out.end() - 3);
     }
     return out;
 }
@@ -170,8 +176,7 @@ vec<double> continued(const vec<double>& kept, const double* added, int32_t coun
 /// cut_body for an FEM body: along triangles with what its earlier cuts kept, which grows by
 /// them only once the cut succeeded.
 void cut_fem_keeping(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report) {
-    const CutSurface checked(triangles, count);  // bad input is refused before anything changes
-    (void)checked;
+    const CutSurface surface(triangles, count);  // bad input is refused before anything changes
     KeptCuts::Kept& kept = world.own_hook_once<KeptCuts>(&kKeptCutsKey).of(world, id);
     vec<double> rest(9 * static_cast<size_t>(count));
     to_rest_all(world.body(id), triangles, 3 * count, rest.data());
@@ -182,10 +187,11 @@ void cut_fem_keeping(World& world, Id id, const double* triangles, int32_t count
     vec<int32_t> on_nodes = kept.on_nodes;
     vec<double> along = continued(kept.triangles, rest.data(), count);
     if (along.empty()) {
-        cut_in_frame(world, id, triangles, count, false, report, &on_nodes);
+        cut_in_frame(world, id, surface, false, report, &on_nodes);
     } else {
         along.insert(along.end(), rest.begin(), rest.end());
-        cut_in_frame(world, id, along.data(), static_cast<int32_t>(along.size() / 9), true, report, &on_nodes, count);
+        cut_in_frame(world, id, CutSurface(along.data(), static_cast<int32_t>(along.size() / 9)), true, report, &on_nodes,
+                     count);
     }
     kept.triangles.swap(grown);
     kept.on_nodes.swap(on_nodes);
@@ -218,12 +224,12 @@ void cut_body(World& world, Id id, const double* triangles, int32_t count, sh_cu
     if (world.body(id).is_fem())
         cut_fem_keeping(world, id, triangles, count, report);
     else
-        cut_in_frame(world, id, triangles, count, false, report, nullptr);
+        cut_in_frame(world, id, CutSurface(triangles, count), false, report, nullptr);
 }
 
 void cut_body_at_rest(World& world, Id id, const double* triangles, int32_t count, sh_cut_report& report,
                       vec<int32_t>* on_nodes, int32_t focus_count) {
-    cut_in_frame(world, id, triangles, count, true, report, on_nodes, focus_count);
+    cut_in_frame(world, id, CutSurface(triangles, count), true, report, on_nodes, focus_count);
 }
 
 }  // namespace sh

@@ -1,6 +1,7 @@
 #include "cut/tet_cut.hpp"
 
 #include "cut/cut_surface.hpp"
+#include "collision/aabb_tree.hpp"
 #include "cut/edge_split.hpp"
 #include "core/vec3.hpp"
 #include "mesh/tet_mesh.hpp"
@@ -27,9 +28,9 @@ const int32_t* corners(const FemBody& body, int32_t t) { return body.element_nod
 }  // namespace
 
 TetCut::TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality,
-               const vec<int32_t>* known_on, const double* focus)
+               const vec<int32_t>* known_on, const Aabb* focus)
     : frame_(frame) {
-    find_candidates(body, focus ? focus : surface.lower(), focus ? focus + 3 : surface.upper());
+    find_candidates(body, focus ? focus->lo : surface.lower(), focus ? focus->hi : surface.upper());
     find_edges(body, surface);
     snap_earlier_cut_nodes(body, surface, known_on);
     mark_cut_edges();

@@ -10,6 +10,7 @@
 
 namespace sh {
 
+struct Aabb;
 class CutSurface;
 class FemBody;
 
@@ -31,11 +32,10 @@ public:
     /// surface finds the same crossings: a sweep that is cut with again as it grows.)
     /// Nodes listed in known_on (ascending; may be null) lie on the surface whatever their
     /// distance from it: the nodes an earlier cut along a part of the same surface went through.
-    /// Only tets whose box meets focus (6 doubles: lower, then upper corner, in frame; null:
-    /// the surface's box) are cut: a surface grown by a new part, cut with again, has nothing
-    /// new to part away from that part.
+    /// Only tets whose box meets focus (in frame; null: the surface's box) are cut: a surface
+    /// grown by a new part, cut with again, has nothing new to part away from that part.
     TetCut(const FemBody& body, const CutSurface& surface, const double* frame, bool guard_quality,
-           const vec<int32_t>* known_on = nullptr, const double* focus = nullptr);
+           const vec<int32_t>* known_on = nullptr, const Aabb* focus = nullptr);
 
     /// New nodes (appended after the body's), each on a crossed edge.
     vec<NodeOrigin> origins;

@@ -21,6 +21,14 @@ struct Line {
     double at = 1.0;  // the full update: where the extension starts
     int moves = 0;
 
+    /// Extends, then checks that the update ends at `expected` (to 1e-12) after `tries` moves
+    /// (-1: any number).
+    void settles_at(double expected, int tries) {
+        extend();
+        assert_true(std::fabs(at - expected) < 1e-12);
+        if (tries >= 0) assert_int_equal(moves, tries);
+    }
+
     void extend(double roundoff = 1e-15) {
         sh::move_update_towards_line_minimum(
             slope(0.0), phi(1.0), roundoff, [&] { return slope(at); },
@@ -37,9 +45,7 @@ struct Line {
 // lands on s = 2 exactly, and the next try is not taken (the slope there is 0).
 void test_half_way_update_lands_on_the_minimiser(void**) {
     Line line{[](double s) { return (s - 2.0) * (s - 2.0); }, [](double s) { return 2.0 * (s - 2.0); }};
-    line.extend();
-    assert_true(std::fabs(line.at - 2.0) < 1e-12);
-    assert_int_equal(line.moves, 1);
+    line.settles_at(2.0, 1);
 }
 
 // (s - 10)^2 / 10: the secant through slopes -2 at 0 and -1.8 at 1 points at the minimiser 10
@@ -47,9 +53,7 @@ void test_half_way_update_lands_on_the_minimiser(void**) {
 // where the slope (-0.4) is flatter than a quarter of the start's, so no second try.
 void test_far_minimiser_is_approached_in_a_stride_of_eight(void**) {
     Line line{[](double s) { return (s - 10.0) * (s - 10.0) / 10.0; }, [](double s) { return (s - 10.0) / 5.0; }};
-    line.extend();
-    assert_true(line.at == 8.0);
-    assert_int_equal(line.moves, 1);
+    line.settles_at(8.0, 1);
 }
 
 // phi = -s up to a wall at s = 1.5 (1 just past it, non-finite beyond 1.6): the slope stays -1,
@@ -58,17 +62,14 @@ void test_far_minimiser_is_approached_in_a_stride_of_eight(void**) {
 void test_refused_try_goes_back_to_the_full_update(void**) {
     Line line{[](double s) { return s <= 1.5 ? -s : (s < 1.6 ? 1.0 : NAN); },
               [](double s) { return s <= 1.5 ? -1.0 : 1.0; }};
-    line.extend();
-    assert_true(line.at == 1.0);
+    line.settles_at(1.0, -1);
 }
 
 // (s - 0.5)^2: the update went twice as far as the minimiser (slope +1 at 1 against -1 at 0,
 // as from a tangent half as stiff as the potential along it): one secant back lands on 0.5.
 void test_update_past_the_minimiser_comes_back_to_it(void**) {
     Line line{[](double s) { return (s - 0.5) * (s - 0.5); }, [](double s) { return 2.0 * (s - 0.5); }};
-    line.extend();
-    assert_true(std::fabs(line.at - 0.5) < 1e-12);
-    assert_int_equal(line.moves, 1);
+    line.settles_at(0.5, 1);
 }
 
 // phi = -s + 20 max(0, s - 0.9)^2: falling at slope -1 up to a wall at 0.9, rising at slope 3
@@ -77,17 +78,13 @@ void test_update_past_the_minimiser_comes_back_to_it(void**) {
 void test_update_past_a_wall_stays_where_lower(void**) {
     Line line{[](double s) { return -s + 20.0 * std::fmax(0.0, s - 0.9) * std::fmax(0.0, s - 0.9); },
               [](double s) { return -1.0 + 40.0 * std::fmax(0.0, s - 0.9); }};
-    line.extend();
-    assert_true(line.at == 1.0);
-    assert_int_equal(line.moves, 2);  // the try, and the way back
+    line.settles_at(1.0, 2);  // the try, and the way back
 }
 
 // A Newton update near convergence ends flat (slope ratio below a quarter): no try at all.
 void test_flat_end_takes_no_try(void**) {
     Line line{[](double s) { return (s - 1.1) * (s - 1.1); }, [](double s) { return 2.0 * (s - 1.1); }};
-    line.extend();
-    assert_true(line.at == 1.0);
-    assert_int_equal(line.moves, 0);
+    line.settles_at(1.0, 0);
 }
 
 }  // namespace

@@ -243,7 +243,7 @@ void TetCut::add_pieces(const FemBody& body, const vec<Piece>& pieces) {
     for (size_t c = 0; c < candidates_.size(); ++c) split_count += split[c];
 }
 
-int8_t TetCut::side_of_tet(const FemBody& body, const CutSurface& surface, const int32_t* tet) const {
+int8_t TetCut::side_of_tet(const FemBody& body, const CutSurface& surface, const int32_t* tet, vec<double>& distance) const {
     // The corner off the surface farthest from it decides; corners on the surface (nodes the
     // cut goes through, nodes made on crossed edges) have no side. A tet whose corners are all
     // on the surface (a thin one, its nodes passed through within the snapping distance) lies
@@ -254,8 +254,9 @@ int8_t TetCut::side_of_tet(const FemBody& body, const CutSurface& surface, const
         if (node >= body.node_count()) continue;
         const size_t slot = node_slot(node);
         if (slot < nodes_.size() && nodes_[slot] == node && on_[slot]) continue;
+        double& d = distance[static_cast<size_t>(node)];
         int32_t triangle = -1;
-        const double d = surface.signed_distance(at(frame_, node), triangle);
+        if (std::isnan(d)) d = surface.signed_distance(at(frame_, node), triangle);
         if (std::fabs(d) > std::fabs(farthest)) farthest = d;
     }
     if (farthest == 0.0) {
@@ -275,7 +276,9 @@ void TetCut::collect_cut(const FemBody& body, const CutSurface& surface) {
     for (size_t i = 0; i < nodes_.size(); ++i)
         if (on_[i]) cut_nodes.push_back(nodes_[i]);
     for (size_t k = 0; k < origins.size(); ++k) cut_nodes.push_back(body.node_count() + static_cast<int32_t>(k));
-    for (auto& entry : piece_side_) entry.second = side_of_tet(body, surface, &tets[4 * static_cast<size_t>(entry.first)]);
+    // Each node's distance from the surface once, not once per tet on it.
+    vec<double> distance(static_cast<size_t>(body.node_count()), NAN);
+    for (auto& entry : piece_side_) entry.second = side_of_tet(body, surface, &tets[4 * static_cast<size_t>(entry.first)], distance);
     // Whole tets with a node the cut goes through.
     vec<uint8_t> on_node(static_cast<size_t>(body.node_count()), 0);
     for (size_t i = 0; i < nodes_.size(); ++i) on_node[static_cast<size_t>(nodes_[i])] = on_[i];
@@ -283,7 +286,7 @@ void TetCut::collect_cut(const FemBody& body, const CutSurface& surface) {
         const int32_t* tet = corners(body, t);
         const bool touches = on_node[static_cast<size_t>(tet[0])] | on_node[static_cast<size_t>(tet[1])] |
                              on_node[static_cast<size_t>(tet[2])] | on_node[static_cast<size_t>(tet[3])];
-        if (touches && source[static_cast<size_t>(t)] >= 0) piece_side_.push_back({t, side_of_tet(body, surface, tet)});
+        if (touches && source[static_cast<size_t>(t)] >= 0) piece_side_.push_back({t, side_of_tet(body, surface, tet, distance)});
     }
     std::sort(piece_side_.begin(), piece_side_.end());
     for (const auto& entry : piece_side_) {

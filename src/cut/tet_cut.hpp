@@ -86,7 +86,9 @@ private:
     void node_position(const FemBody& body, int32_t node, const double* positions, double out[3]) const;
     void number_new_nodes(int32_t node_count);
     void add_pieces(const FemBody& body, const vec<Piece>& pieces);
-    int8_t side_of_tet(const FemBody& body, const CutSurface& surface, const int32_t* tet) const;
+    /// The side of surface tet lies on; distance (per body node, NaN until known) caches the
+    /// nodes' signed distances from it.
+    int8_t side_of_tet(const FemBody& body, const CutSurface& surface, const int32_t* tet, vec<double>& distance) const;
     void collect_cut(const FemBody& body, const CutSurface& surface);
     /// The entry of nodes_ for node (a node of a candidate).
     size_t node_slot(int32_t node) const;

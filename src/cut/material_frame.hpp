@@ -18,8 +18,9 @@ struct RestPoint {
 /// The rest-shape positions of the count world points p (3 each) in body, into out[count]:
 /// each through the affine map of the tet that contains it in the current configuration (or,
 /// outside the body, of the tet it is least outside of: an extrapolation); for a body without
-/// tets, its offset from the nearest node. One pass over the tets (each tet's map is formed
-/// once for all the points).
+/// tets, its offset from the nearest node. Looks only at tets near the points: near all of
+/// them together where they lie close (a blade's samples), else near each apart (the far
+/// corners of a cut's triangles), whichever costs less.
 void rest_points(const Body& body, const double* p, int count, RestPoint* out);
 
 /// rest_points' positions alone, into out (3 each).

@@ -60,26 +60,28 @@ def whole_cycles_mean(rows):
     return force[breaks[0] + 1:breaks[-1] + 1].mean(), len(breaks) - 1
 
 
-def liver_scalpel(mesh_dir, resolution):
-    """liver2 (x0.1, corotational 5 kPa, no gravity, implicit at 60 Hz) cut by a 3.5 cm
+def liver_scalpel(mesh_dir, resolution, criterion="geometric", young=5e3, toughness=0.0):
+    """liver2 (x0.1, corotational, young Pa, no gravity, implicit at 60 Hz) cut by a 3.5 cm
     scalpel blade lowered 2 cm and dragged 8 cm in 60 steps; returns the figures."""
     mesh = softhap.Mesh.load(os.path.join(mesh_dir, "liver2.msh")).transform(0.1)
     world = softhap.World(gravity=(0.0, 0.0, 0.0))
-    body = world.add_fem_body(mesh, model="corotational", young=5e3, poisson=0.45, integrator="implicit_euler")
+    body = world.add_fem_body(mesh, model="corotational", young=young, poisson=0.45, integrator="implicit_euler",
+                              toughness=toughness)
     x = body.positions
     body.fix_nodes(np.where(x[:, 2] < x[:, 2].min() + 0.015)[0])
     centre, top = x.mean(axis=0), x[:, 2].max()
     tool = world.add_tool("sphere", radius=0.003, position=(centre[0] - 0.04, centre[1], top + 0.03))
-    tool.set_cutting(edge=((0.0, 0.0, -0.04), (0.0, 0.0, -0.005)), resolution=resolution)
-    tets0, faces, walls = body.tet_count, 0, []
+    tool.set_cutting(edge=((0.0, 0.0, -0.04), (0.0, 0.0, -0.005)), criterion=criterion, resolution=resolution)
+    tets0, faces, walls, peak = body.tet_count, 0, [], 0.0
     for k in range(70):
         s = max(0.0, (k - 10) / 60.0)
         tool.set_pose((centre[0] - 0.04 + 0.08 * s, centre[1], top + 0.03 - 0.02 * min(1.0, k / 10.0)))
         report = world.step(1.0 / 60.0)
         faces += report.cut_faces
         walls.append(report.wall_seconds)
+        peak = max(peak, float(np.linalg.norm(tool.force)))
     walls = 1e3 * np.array(walls)
-    return tets0, body.tet_count, faces, np.median(walls), np.percentile(walls, 99), walls.max()
+    return tets0, body.tet_count, faces, np.median(walls), np.percentile(walls, 99), walls.max(), peak
 
 
 def main():
@@ -110,10 +112,17 @@ def main():
     plt.legend(fontsize=7)
     plt.tight_layout()
     plt.savefig(os.path.join(out, "cutting_force.png"), dpi=120)
-    liver = ["| resolution | tets before -> after | faces parted | step median / p99 / max ms |", "|---|---|---|---|"]
-    for resolution, name in ((1.0, "none (1 m)"), (0.0, "default (blade / 4 = 8.75 mm)"), (0.015, "15 mm")):
-        before, after, faces, median, p99, worst = liver_scalpel(mesh_dir, resolution)
-        liver.append("| %s | %d -> %d | %d | %.1f / %.1f / %.1f |" % (name, before, after, faces, median, p99, worst))
+    liver = ["| criterion, tissue | resolution | tets before -> after | faces parted | step median / p99 / max ms | peak force (N) |",
+             "|---|---|---|---|---|---|"]
+    geometric = "geometric, 5 kPa"
+    for resolution, name, criterion, tissue, young, toughness in (
+            (1.0, "none (1 m)", "geometric", geometric, 5e3, 0.0),
+            (0.0, "default (blade / 4 = 8.75 mm)", "geometric", geometric, 5e3, 0.0),
+            (0.015, "15 mm", "geometric", geometric, 5e3, 0.0),
+            (0.015, "15 mm", "physical", "physical, 30 kPa, G_c 200 J/m^2", 3e4, 200.0)):
+        before, after, faces, median, p99, worst, peak = liver_scalpel(mesh_dir, resolution, criterion, young, toughness)
+        liver.append("| %s | %s | %d -> %d | %d | %.1f / %.1f / %.1f | %.2f |" % (
+            tissue, name, before, after, faces, median, p99, worst, peak))
     text = [
         "# softhap: cutting force and cost",
         "",
@@ -136,16 +145,18 @@ def main():
         "sawtooth's period is about the resolution (Chanthasopeephan et al. 2003 measured such profiles cutting liver "
         "with a scalpel). Trace of the first case: cutting_force.csv.",
         "",
-        "## Geometric criterion on a coarse organ: refinement around the blade",
+        "## A scalpel through a coarse organ: refinement around the blade",
         "",
-        "liver2 scaled to 21 cm (1,493 tets, edges 2-48 mm, median 15 mm), corotational 5 kPa, no gravity, base "
+        "liver2 scaled to 21 cm (1,493 tets, edges 2-48 mm, median 15 mm), corotational, no gravity, base "
         "fixed, implicit Euler at 60 Hz; a scalpel whose 3.5 cm blade is lowered 2 cm into the top and dragged "
         "8 cm in 60 steps (70 steps in all).",
         "",
     ] + liver + [
         "",
         "Without refinement the incision parts only faces of elements it crosses whole, which on this mesh is almost "
-        "none; the default refinement makes the opening follow the blade at a cost in tets and step time.",
+        "none; the default refinement makes the opening follow the blade at a cost in tets and step time. Under the "
+        "physical criterion the blade holds the tissue ahead of it until its work pays for the crack, so the force "
+        "peaks above its mean (liver: G_c about 200 J/m^2).",
         "",
     ]
     with open(os.path.join(out, "cutting.md"), "w") as f:

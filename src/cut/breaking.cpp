@@ -42,16 +42,18 @@ Engagement engage(const Body& body, const Collider& tool) {
     double a[3], b[3];
     tool.start.to_world(tool.cutting.edge[0], a);
     tool.start.to_world(tool.cutting.edge[1], b);
-    double samples[3 * kSamples];
-    for (int s = 0; s < kSamples; ++s) {
-        const double u = static_cast<double>(s) / (kSamples - 1);
-        for (int k = 0; k < 3; ++k) samples[3 * s + k] = (1.0 - u) * a[k] + u * b[k];
-    }
-    RestPoint mapped[kSamples];
-    rest_points(body, samples, kSamples, mapped);
+    const vec<SegmentSpan> spans = segment_in_tets(body, a, b, kSlitSlack);
+    // The samples along the edge that some stretch holds: the first and the last make the
+    // engaged length, and the one nearest their middle names the material.
+    const auto sample_at = [](int s) { return static_cast<double>(s) / (kSamples - 1); };
+    const auto holding = [&](int s) {
+        for (const SegmentSpan& span : spans)
+            if (span.from <= sample_at(s) && sample_at(s) <= span.to) return span.tet;
+        return int32_t{-1};
+    };
     int first = -1, last = -1;
     for (int s = 0; s < kSamples; ++s) {
-        if (mapped[s].inside < -kSlitSlack) continue;
+        if (holding(s) < 0) continue;
         if (first < 0) first = s;
         last = s;
     }
@@ -59,10 +61,9 @@ Engagement engage(const Body& body, const Collider& tool) {
     double d[3];
     sub3(b, a, d);
     found.length = norm3(d) * static_cast<double>(last - first) / (kSamples - 1);
-    // The material at the sample nearest the middle of the engaged part (already mapped: no
-    // second pass over the tets for the exact middle).
-    const RestPoint& at_middle = mapped[(first + last) / 2];
-    if (at_middle.tet >= 0) found.toughness = static_cast<const FemBody&>(body).material(static_cast<size_t>(at_middle.tet)).toughness;
+    int32_t middle = holding((first + last) / 2);
+    for (int s = (first + last) / 2; middle < 0 && s <= last; ++s) middle = holding(s);  // a gap: the next held one
+    found.toughness = static_cast<const FemBody&>(body).material(static_cast<size_t>(middle)).toughness;
     return found;
 }
 

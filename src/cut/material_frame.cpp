@@ -222,6 +222,33 @@ void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
     }
 }
 
+vec<SegmentSpan> segment_in_tets(const Body& body, const double a[3], const double b[3], double slack) {
+    vec<SegmentSpan> spans;
+    if (body.nodes_per_element() != 4 || body.element_count() == 0) return spans;
+    double ends[6];
+    std::copy(a, a + 3, ends), std::copy(b, b + 3, ends + 3);
+    vec<int32_t> near = tets_in(body, box_near_all(ends, 2));
+    const bool all = near.empty();
+    const int32_t count = all ? body.element_count() : static_cast<int32_t>(near.size());
+    TetMap map;
+    for (int32_t k = 0; k < count; ++k) {
+        const int32_t t = all ? k : near[static_cast<size_t>(k)];
+        if (!map.form(body.x.data(), body.element_nodes() + 4 * static_cast<size_t>(t))) continue;
+        double wa[4], wb[4];
+        map.weights(a, wa), map.weights(b, wb);
+        // Each weight w(u) = wa + u (wb - wa) must stay at least -slack: a bound on u per corner.
+        double from = 0.0, to = 1.0;
+        for (int c = 0; c < 4 && from <= to; ++c) {
+            const double slope = wb[c] - wa[c], margin = wa[c] + slack;
+            if (slope > 0.0) from = std::fmax(from, -margin / slope);
+            else if (slope < 0.0) to = std::fmin(to, -margin / slope);
+            else if (margin < 0.0) to = -1.0;
+        }
+        if (from <= to) spans.push_back(SegmentSpan{from, to, t});
+    }
+    return spans;
+}
+
 void to_rest_all(const Body& body, const double* p, int count, double* out) {
     vec<RestPoint> found(static_cast<size_t>(count));
     rest_points(body, p, count, found.data());

@@ -1,6 +1,8 @@
 // Where a point of the world lies in a body's rest shape (its material frame).
 #pragma once
 
+#include "core/memory.hpp"
+
 #include <cstdint>
 
 namespace sh {
@@ -22,6 +24,20 @@ struct RestPoint {
 /// them together where they lie close (a blade's samples), else near each apart (the far
 /// corners of a cut's triangles), whichever costs less.
 void rest_points(const Body& body, const double* p, int count, RestPoint* out);
+
+/// A stretch of a segment inside a tet, or outside it by less than some slack.
+struct SegmentSpan {
+    double from = 0.0, to = 0.0;  ///< its ends, as fractions of the segment (0 at a, 1 at b)
+    int32_t tet = -1;             ///< the tet
+};
+
+/// The stretches of the segment a-b (world, current configuration) over which it lies inside
+/// a tet of body, or outside by at most slack in barycentric weight (about that fraction of
+/// the tet's size), one per such tet, among the tets near the segment (the box around it
+/// grown by half its length; all the body's tets if none is near). Each tet's weights are
+/// linear along the segment, so a tet costs two weight evaluations, however finely the
+/// caller samples the segment. Nothing for a body without tets.
+vec<SegmentSpan> segment_in_tets(const Body& body, const double a[3], const double b[3], double slack);
 
 /// rest_points' positions alone, into out (3 each).
 void to_rest_all(const Body& body, const double* p, int count, double* out);

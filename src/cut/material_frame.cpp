@@ -99,17 +99,18 @@ double tet_size(const Body& body, int32_t t) {
     return norm3(d);
 }
 
-/// For each point i of p: the tet that contains it, else the one it is least outside of.
-/// First among the tets whose box meets the box spanned by the point and its nearest node:
+/// For each point i of p listed in all (every point, 0 to count - 1): the tet that contains
+/// it, else the one it is least outside of. First among the tets whose box meets the box spanned by the point and its nearest node:
 /// every tet that contains the point, and at least the nearest node's. A point outside but
 /// within a few elements of the body (in a slit, or just off a face) looks again within its
 /// distance to that node, which reaches the tet nearest to it; a point farther out keeps the
 /// first choice, whose extrapolation is as good as any. Two passes over the nodes and one or
 /// two over the tets per 8 points, not a pass over every tet near all of them.
-void search_near_tets(const Body& body, const double* p, int count, RestPoint* out, double* best_w) {
-    vec<double> spans(6 * static_cast<size_t>(count)), reaches(6 * static_cast<size_t>(count)), distance(static_cast<size_t>(count));
-    vec<int> all, near;
-    for (int i = 0; i < count; ++i) {
+void search_near_tets(const Body& body, const double* p, const vec<int>& all, RestPoint* out, double* best_w) {
+    const size_t count = all.size();
+    vec<double> spans(6 * count), reaches(6 * count), distance(count);
+    vec<int> near;
+    for (const int i : all) {
         const double* node = at(body.x.data(), nearest_node(body, &p[3 * i]));
         double d[3];
         sub3(&p[3 * i], node, d);
@@ -119,13 +120,24 @@ void search_near_tets(const Body& body, const double* p, int count, RestPoint* o
         reach.inflate((1.0 + 1e-9) * norm3(d));  // the node inside, despite round-off
         put_box(span, &spans[6 * static_cast<size_t>(i)]);
         put_box(reach, &reaches[6 * static_cast<size_t>(i)]);
-        all.push_back(i);
     }
     search_tets_in_boxes(body, p, all, spans, out, best_w);
-    for (int i = 0; i < count; ++i)
+    for (const int i : all)
         if (out[i].tet >= 0 && out[i].inside < 0.0 && distance[static_cast<size_t>(i)] < kNearElements * tet_size(body, out[i].tet))
             near.push_back(i);
     if (!near.empty()) search_tets_in_boxes(body, p, near, reaches, out, best_w);
+}
+
+/// Calls visit(map, t) for each non-flat tet t listed in tets (null: all the body's) with its
+/// map at the current positions, while visit returns true.
+template <class Visit>
+void for_each_mapped_tet(const Body& body, const vec<int32_t>* tets, Visit&& visit) {
+    TetMap map;
+    const int32_t count = tets ? static_cast<int32_t>(tets->size()) : body.element_count();
+    for (int32_t k = 0; k < count; ++k) {
+        const int32_t t = tets ? (*tets)[static_cast<size_t>(k)] : k;
+        if (map.form(body.x.data(), body.element_nodes() + 4 * static_cast<size_t>(t)) && !visit(map, t)) return;
+    }
 }
 
 /// For the points of p listed in which: the tet that contains it, else the one it is least
@@ -133,18 +145,15 @@ void search_near_tets(const Body& body, const double* p, int count, RestPoint* o
 /// search ends once every point is.
 void search_tets(const Body& body, const double* p, const vec<int>& which, const vec<int32_t>* tets, RestPoint* out,
                  double* best_w) {
-    TetMap map;
-    const int32_t count = tets ? static_cast<int32_t>(tets->size()) : body.element_count();
     size_t left = which.size();
-    for (int32_t k = 0; k < count && left > 0; ++k) {
-        const int32_t t = tets ? (*tets)[static_cast<size_t>(k)] : k;
-        if (!map.form(body.x.data(), body.element_nodes() + 4 * static_cast<size_t>(t))) continue;
+    for_each_mapped_tet(body, tets, [&](const TetMap& map, int32_t t) {
         for (const int i : which) {
             if (out[i].inside >= 0.0) continue;
             consider_tet(map, t, &p[3 * i], out[i], &best_w[4 * static_cast<size_t>(i)]);
             left -= out[i].inside >= 0.0 ? 1 : 0;
         }
-    }
+        return left > 0;
+    });
 }
 
 /// The box around all the count points p grown by half its diagonal: it holds every tet that
@@ -187,6 +196,18 @@ double apart_cost(const Body& body, int count) {
     return count * nodes / 3.0 + 2.0 * groups * (8.0 * nodes / 3.0 + tets / 2.0);
 }
 
+/// Narrows span (fractions of a segment) to where each barycentric weight, wa at its start
+/// and wb at its end and linear between, stays at least -slack; false if nothing is left.
+bool clip_to_weights(const double wa[4], const double wb[4], double slack, SegmentSpan& span) {
+    for (int c = 0; c < 4; ++c) {
+        const double slope = wb[c] - wa[c], margin = wa[c] + slack;
+        if (slope > 0.0) span.from = std::fmax(span.from, -margin / slope);
+        else if (slope < 0.0) span.to = std::fmin(span.to, -margin / slope);
+        else if (margin < 0.0) return false;
+    }
+    return span.from <= span.to;
+}
+
 }  // namespace
 
 void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
@@ -204,7 +225,7 @@ void rest_points(const Body& body, const double* p, int count, RestPoint* out) {
         const vec<int32_t> near = tets_in(body, together);
         search_tets(body, p, all, &near, out, best_w.data());
     } else {
-        search_near_tets(body, p, count, out, best_w.data());
+        search_near_tets(body, p, all, out, best_w.data());
     }
     for (int i = 0; i < count; ++i)
         if (out[i].tet < 0) unreached.push_back(i);
@@ -227,25 +248,14 @@ vec<SegmentSpan> segment_in_tets(const Body& body, const double a[3], const doub
     if (body.nodes_per_element() != 4 || body.element_count() == 0) return spans;
     double ends[6];
     std::copy(a, a + 3, ends), std::copy(b, b + 3, ends + 3);
-    vec<int32_t> near = tets_in(body, box_near_all(ends, 2));
-    const bool all = near.empty();
-    const int32_t count = all ? body.element_count() : static_cast<int32_t>(near.size());
-    TetMap map;
-    for (int32_t k = 0; k < count; ++k) {
-        const int32_t t = all ? k : near[static_cast<size_t>(k)];
-        if (!map.form(body.x.data(), body.element_nodes() + 4 * static_cast<size_t>(t))) continue;
+    const vec<int32_t> near = tets_in(body, box_near_all(ends, 2));
+    for_each_mapped_tet(body, near.empty() ? nullptr : &near, [&](const TetMap& map, int32_t t) {
         double wa[4], wb[4];
         map.weights(a, wa), map.weights(b, wb);
-        // Each weight w(u) = wa + u (wb - wa) must stay at least -slack: a bound on u per corner.
-        double from = 0.0, to = 1.0;
-        for (int c = 0; c < 4 && from <= to; ++c) {
-            const double slope = wb[c] - wa[c], margin = wa[c] + slack;
-            if (slope > 0.0) from = std::fmax(from, -margin / slope);
-            else if (slope < 0.0) to = std::fmin(to, -margin / slope);
-            else if (margin < 0.0) to = -1.0;
-        }
-        if (from <= to) spans.push_back(SegmentSpan{from, to, t});
-    }
+        SegmentSpan span{0.0, 1.0, t};
+        if (clip_to_weights(wa, wb, slack, span)) spans.push_back(span);
+        return true;
+    });
     return spans;
 }
 

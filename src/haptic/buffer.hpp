@@ -43,6 +43,8 @@ struct Buffer {
     double proxy_point[3] = {}, proxy_normal[3] = {};  ///< outward normal (world)
 
     TetBlock* blocks = nullptr;   ///< local node numbers
+    Mat3L* rotations = nullptr;   ///< per block of a law that keeps rotations (kRotates): its
+                                  ///< elements' rotations at x_start, the haptic side's warm start
     int32_t* node_id = nullptr;   ///< body node of each local node, ascending
     double* x_start = nullptr;    ///< full model at the start of its step (3 per node)
     double* x_end = nullptr;      ///< at its end (the boundary's mean velocity across the step
@@ -73,6 +75,7 @@ struct Buffer {
     void carve(Arena& arena, const BufferCapacity& capacity) {
         const size_t n = static_cast<size_t>(capacity.nodes);
         blocks = arena.take<TetBlock>(static_cast<size_t>(capacity.blocks()));
+        rotations = arena.take<Mat3L>(static_cast<size_t>(capacity.blocks()));
         node_id = arena.take<int32_t>(n);
         x_start = arena.take<double>(3 * n);
         x_end = arena.take<double>(3 * n);

@@ -28,6 +28,7 @@ struct WorkingArrays {
     double* path_v;
     double* held_pull;
     FrictionRecord* friction;
+    Mat3L* rotations;
 };
 
 void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3], WorkingArrays& w) {
@@ -49,6 +50,7 @@ void carve_all(Arena& arena, const BufferCapacity& capacity, Buffer (&buffers)[3
     w.path_v = arena.take<double>(3 * n);
     w.held_pull = arena.take<double>(3 * n);
     w.friction = arena.take<FrictionRecord>(static_cast<size_t>(capacity.friction_records()));
+    w.rotations = arena.take<Mat3L>(static_cast<size_t>(capacity.blocks()));
 }
 
 BufferCapacity capacity_of(const sh_haptic_def& def) { return BufferCapacity{def.capacity_tets, def.capacity_nodes}; }
@@ -117,6 +119,7 @@ HapticContext::HapticContext(World& world, const sh_haptic_def& def)
     path_v_ = w.path_v;
     held_pull_ = w.held_pull;
     friction_ = w.friction;
+    rotation_ = w.rotations;
     friction_capacity_ = capacity_of(def).friction_records();
     pose_ = tool_.target;
     try {

@@ -85,6 +85,7 @@ private:
     void number_nodes(const FemBody& body, Buffer& out);
     void fill_nodes(const FemBody& body, Buffer& out);
     void fill_blocks(const FemBody& body, Buffer& out);
+    void fill_rotations(Buffer& out) const;
     void fill_triangles(const FemBody& body, Buffer& out);
     void fill_surface_features(const FemBody& body, Buffer& out);
     void ensure_adjacency(const FemBody& body, Id id);
@@ -110,6 +111,8 @@ private:
     /// notes it apart: it steadies the node but is not felt (integrate()).
     void add_mixed_bound(int32_t node, double bound);
     void integrate(const Buffer& b, double h, double* x, double* v, double force[3], double torque[3]) const;
+    /// The buffer's elastic forces at x (damped with v) into force_, its rotations kept.
+    void add_elastic_forces(const Buffer& b, const double* x, const double* v);
 
     sh_haptic_def def_;
     World* world_;
@@ -151,6 +154,10 @@ private:
     Id broken_body_ = kNullId;     ///< and its body
     Pose held_pose_;               ///< the tool's pose when the held nodes last moved
     bool have_held_pose_ = false;
+    /// Per block of a law that keeps rotations: its elements' rotations at the last force
+    /// pass, each pass's warm start (from the buffer's own while rotations_from_buffer_).
+    Mat3L* rotation_ = nullptr;
+    bool rotations_from_buffer_ = true;
     FrictionRecord* friction_ = nullptr;  ///< the sub-step's friction contacts
     int32_t friction_capacity_ = 0;
     int32_t friction_count_ = 0;

@@ -25,6 +25,12 @@ constexpr double kSafety = 0.9;
 // A step longer than this is not a haptic step (s).
 constexpr double kLongestStep = 1.0;
 
+// The buffer's element rotations are settled when a step's last update turns none by more
+// than 1e-4 rad: R is then about 1e-8 from the polar factor, a stress error of about 2e-8 mu,
+// far below the force's resolution, and one update per step usually does it (the elements
+// turn by about 1e-4 rad per tick while pressed; the default's 1e-6 takes two).
+constexpr double kBufferRotationSettled2 = 1e-8;
+
 bool boxes_overlap(const double lo[3], const double hi[3], const double* a, const double* b, const double* c) {
     for (int k = 0; k < 3; ++k) {
         const double t_lo = std::min({a[k], b[k], c[k]}), t_hi = std::max({a[k], b[k], c[k]});
@@ -195,6 +201,7 @@ void HapticContext::add_held_reaction(const Buffer& b, const double* x, double f
 void HapticContext::adopt(const Buffer& b) {
     load_state(b, b.period > 0.0);
     held_work_ = b.held_work;  // the full model's count up to the buffer's step
+    rotations_from_buffer_ = true;  // its blocks are new
     have_held_pose_ = false;
     std::memset(held_pull_, 0, 3 * static_cast<size_t>(b.held_count) * sizeof(double));
     age_ = 0.0;
@@ -255,6 +262,18 @@ void HapticContext::integrate(const Buffer& b, double h, double* x, double* v, d
             at(x, i)[k] += h * vi[k];
         }
     }
+}
+
+void HapticContext::add_elastic_forces(const Buffer& b, const double* x, const double* v) {
+    const double* damped_v = b.damping_stiffness > 0.0 ? v : nullptr;
+    const Mat3L* near = rotations_from_buffer_ ? b.rotations : rotation_;
+    for_each_material([&](auto material, int model) {
+        const int32_t begin = b.block_begin[model], end = b.block_begin[model + 1];
+        add_fem_forces<decltype(material)>(b.blocks + begin, static_cast<size_t>(end - begin), x, damped_v,
+                                           b.damping_stiffness, force_,
+                                           KeptRotations{near + begin, rotation_ + begin, kBufferRotationSettled2});
+    });
+    rotations_from_buffer_ = false;
 }
 
 void HapticContext::clear_contact() {
@@ -392,12 +411,7 @@ bool HapticContext::step_buffer(const Buffer& b, double dt, double force[3], dou
         hold_nodes(b, x, v);
         for (int32_t i = 0; i < b.node_count; ++i)
             for (int k = 0; k < 3; ++k) at(force_, i)[k] = b.mass[i] * b.gravity[k];
-        const double* damped_v = b.damping_stiffness > 0.0 ? v : nullptr;
-        for_each_material([&](auto material, int model) {
-            const int32_t begin = b.block_begin[model], end = b.block_begin[model + 1];
-            add_fem_forces<decltype(material)>(b.blocks + begin, static_cast<size_t>(end - begin), x, damped_v,
-                                               b.damping_stiffness, force_);
-        });
+        add_elastic_forces(b, x, v);
         double f_tool[3] = {0.0, 0.0, 0.0}, t_tool[3] = {0.0, 0.0, 0.0};
         add_held_reaction(b, x, f_tool, t_tool);
         bool touching = false;
@@ -484,6 +498,7 @@ sh_status HapticContext::step(const double position[3], const double orientation
                 warnings_[SH_WARN_UNSTABLE].fetch_add(1, std::memory_order_relaxed);
                 // The state before this step led there: start again from the full model's.
                 load_state(b, false);
+                rotations_from_buffer_ = true;
             }
         } else if (b.has_proxy) {
             contact = proxy_force(b, raw_force, raw_torque);

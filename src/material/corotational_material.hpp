@@ -15,6 +15,8 @@ struct CorotationalMaterial {
     static constexpr sh_material_model kModel = SH_MATERIAL_COROTATIONAL;
     /// With R held fixed, dP/dF is a rotated isotropic tensor: positive semi-definite as it is.
     static constexpr bool kProjectTangent = false;
+    /// Its state keeps the element's rotation R, which stress_near() finds from a nearby one.
+    static constexpr bool kRotates = true;
 
     /// The polar rotation, reused by differential().
     struct State {
@@ -30,6 +32,13 @@ struct CorotationalMaterial {
     /// P(F); keeps R in state.
     static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State& state) {
         state.R = polar_rotation(F);
+        return rotated_stress(state.R, F, lambda, mu, true);
+    }
+    /// P(F) with R found from a rotation near it (polar_rotation_near, to settled2); keeps R
+    /// in state.
+    static SH_INLINE Mat3L stress_near(const Mat3L& F, Lanes lambda, Lanes mu, State& state, const Mat3L& near,
+                                       double settled2) {
+        state.R = polar_rotation_near(F, near, settled2);
         return rotated_stress(state.R, F, lambda, mu, true);
     }
     /// dP(F)[dF] with R fixed.

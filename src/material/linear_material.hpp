@@ -13,6 +13,8 @@ struct LinearMaterial {
     static constexpr sh_material_model kModel = SH_MATERIAL_LINEAR;
     /// dP/dF is the constant isotropic elasticity tensor: positive semi-definite as it is.
     static constexpr bool kProjectTangent = false;
+    /// Its state keeps no rotation (see the table's kRotates).
+    static constexpr bool kRotates = false;
 
     /// Nothing of stress() is reused by differential().
     struct State {};

@@ -8,6 +8,13 @@
 //   kProjectTangent                         true if dP/dF can be indefinite, so that the
 //                                           tangent stiffness projects it to positive
 //                                           semi-definite per element
+//   kRotates                                true if State holds the element's rotation R
+//                                           (state.R), and the law has
+//                                           stress_near(F, lambda, mu, state, near,
+//                                           settled2), the stress with R found from a
+//                                           rotation near it (polar_rotation_near): a
+//                                           caller that keeps each element's R between force
+//                                           passes warm-starts the next (fem_kernel.hpp)
 //   State                                   what stress() computes that differential() reuses
 //   jacobian(F, state)                      det F, for the inverted-element count
 //   stress(F, lambda, mu, state)            the first Piola-Kirchhoff stress P(F)

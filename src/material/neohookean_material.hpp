@@ -17,6 +17,8 @@ struct NeoHookeanMaterial {
     static constexpr sh_material_model kModel = SH_MATERIAL_NEOHOOKEAN;
     /// dP/dF is indefinite away from rest: projected per element.
     static constexpr bool kProjectTangent = true;
+    /// Its state keeps no rotation (see the table's kRotates).
+    static constexpr bool kRotates = false;
 
     /// Cofactor matrix, Ic = |F|^2 and J = det F, reused by differential().
     struct State {

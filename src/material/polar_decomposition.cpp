@@ -15,6 +15,46 @@ constexpr double kSvdThreshold = 1e-3;
 // to about 5e-17, round-off, without one more update to confirm it.
 constexpr double kConvergedChange2 = 1e-16;
 
+// A warm start's Newton iterations: past this, a lane still moving takes the cold path.
+constexpr int kMaxNearIterations = 4;
+
+// True if no lane's value reaches limit (NaN lanes count as reaching it).
+SH_INLINE bool all_below(Lanes value, double limit) {
+    bool below = true;
+    for (int l = 0; l < kLanes; ++l) below &= value[l] < limit;
+    return below;
+}
+
+// rotation_update, inlined into polar_rotation_near's loop.
+SH_INLINE Lanes update_rotation(const Mat3L& F, Mat3L& R) {
+    const Mat3L M = mul_tn(R, F);
+    const Lanes w[3] = {M.m[2][1] - M.m[1][2], M.m[0][2] - M.m[2][0], M.m[1][0] - M.m[0][1]};
+    Mat3L A;  // tr(S) I - S, symmetric
+    const Lanes tr = trace(M);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) A.m[i][j] = -0.5 * (M.m[i][j] + M.m[j][i]);
+    for (int i = 0; i < 3; ++i) A.m[i][i] += tr;
+    const Mat3L C = cofactor(A);  // A^-1 = C^T / det A = C / det A (symmetric)
+    const Lanes det_a = A.m[0][0] * C.m[0][0] + A.m[0][1] * C.m[0][1] + A.m[0][2] * C.m[0][2];
+    const LaneMask definite = A.m[0][0] > 0.0 && C.m[2][2] > 0.0 && det_a > 0.0;  // leading minors
+    const Lanes inv_det = 1.0 / det_a;
+    Lanes c[3];  // omega / 2, the Cayley vector
+    for (int i = 0; i < 3; ++i) c[i] = 0.5 * inv_det * (C.m[i][0] * w[0] + C.m[i][1] * w[1] + C.m[i][2] * w[2]);
+    const Lanes c2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    const Lanes k = 2.0 / (1.0 + c2);
+    // Q = I + k ([c] + [c]^2), [c]^2 = c c^T - |c|^2 I.
+    Mat3L Q;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) Q.m[i][j] = k * c[i] * c[j];
+    for (int i = 0; i < 3; ++i) Q.m[i][i] += 1.0 - k * c2;
+    Q.m[0][1] -= k * c[2], Q.m[1][0] += k * c[2];
+    Q.m[0][2] += k * c[1], Q.m[2][0] -= k * c[1];
+    Q.m[1][2] -= k * c[0], Q.m[2][1] += k * c[0];
+    R = mul(R, Q);
+    return select(definite, 4.0 * c2, splat(NAN));
+}
+
+
 Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& f) {
     Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
     Eigen::Matrix3d u = svd.matrixU();
@@ -85,6 +125,23 @@ Mat3L polar_rotation(const Mat3L& F) {
                 for (int j = 0; j < 3; ++j) R.m[i][j][l] = r(i, j);
         }
     return R;
+}
+
+Lanes rotation_update(const Mat3L& F, Mat3L& R) { return update_rotation(F, R); }
+
+Mat3L polar_rotation_near(const Mat3L& F, const Mat3L& near, double settled2) {
+    // Nearly flat or inverted lanes are the cold path's (its SVD branch): the warm start
+    // would converge to a rotation of the wrong sign there.
+    const Lanes d = det(F);
+    const Lanes norm2 = ddot(F, F);
+    const Lanes scale3 = norm2 * norm2 * norm2 / 27.0;
+    bool well_conditioned = true;
+    for (int l = 0; l < kLanes; ++l) well_conditioned &= d[l] > 0.0 && d[l] * d[l] >= kSvdThreshold * kSvdThreshold * scale3[l];
+    if (!well_conditioned) return polar_rotation(F);
+    Mat3L R = near;
+    for (int iteration = 0; iteration < kMaxNearIterations; ++iteration)
+        if (all_below(update_rotation(F, R), settled2)) return R;
+    return polar_rotation(F);
 }
 
 }  // namespace sh

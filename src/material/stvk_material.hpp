@@ -13,6 +13,8 @@ struct StvkMaterial {
     static constexpr sh_material_model kModel = SH_MATERIAL_STVK;
     /// dP/dF loses definiteness under compression: projected per element.
     static constexpr bool kProjectTangent = true;
+    /// Its state keeps no rotation (see the table's kRotates).
+    static constexpr bool kRotates = false;
 
     /// The second Piola stress, reused by differential().
     struct State {

@@ -12,6 +12,7 @@
 // are filled and drained one double at a time.
 #pragma once
 
+#include "material/polar_decomposition.hpp"
 #include "model/tet_block.hpp"
 
 #include <cstddef>
@@ -123,16 +124,42 @@ SH_INLINE Mat3L gather_edges(const TetBlock& b, const double* p) {
 
 #endif
 
+/// Rotations an element loop keeps per block between passes, for laws whose state holds one
+/// (the material table's kRotates; other laws ignore it): block k's rotations are found from
+/// near[k] (a warm start: the last pass's, or the ones fem_rotations gave), and written to
+/// kept[k], each to within settled2 (polar_rotation_near). near and kept may be the same
+/// array. Both null: each pass finds them from F alone.
+struct KeptRotations {
+    const Mat3L* near = nullptr;
+    Mat3L* kept = nullptr;
+    double settled2 = kRotationSettled2;
+};
+
+/// Block k's -V0 P(F) (the weights carry -V0), warm-started from rotations.near[k] where the
+/// law keeps a rotation and the caller keeps them; the rotation found goes to rotations.kept[k].
+template <class Material>
+SH_INLINE Mat3L block_stress(const Mat3L& F, const TetBlock& b, size_t k, const KeptRotations& rotations,
+                             typename Material::State& state) {
+    if constexpr (Material::kRotates) {
+        if (rotations.near) {
+            const Mat3L P = Material::stress_near(F, b.lambda_w, b.mu_w, state, rotations.near[k], rotations.settled2);
+            rotations.kept[k] = state.R;
+            return P;
+        }
+    }
+    return Material::stress(F, b.lambda_w, b.mu_w, state);
+}
+
 /// The force loop; Damped adds -beta K(x) v through the material's differential.
 template <class Material, bool Damped>
 int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const double* x, const double* v,
-                            double beta, double* f) {
+                            double beta, double* f, const KeptRotations& rotations) {
     int32_t inverted = 0;  // elements with det F <= 0 (unused lanes weigh 0)
     for (size_t k = 0; k < block_count; ++k) {
         const TetBlock& b = blocks[k];
         const Mat3L F = mul(gather_edges(b, x), b.Bm);
         typename Material::State state;
-        Mat3L P = Material::stress(F, b.lambda_w, b.mu_w, state);  // -V0 P
+        Mat3L P = block_stress<Material>(F, b, k, rotations, state);  // -V0 P
         inverted += count_non_positive(Material::jacobian(F, state), b.mu_w);
         if (Damped) {
             const Mat3L dF = mul(gather_edges(b, v), b.Bm);
@@ -150,13 +177,21 @@ int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const do
 }
 
 /// Adds the elastic forces of blocks at positions x into f; when v is not null, adds the
-/// stiffness-proportional damping force -beta K(x) v as well. Returns the number of elements
-/// with det F <= 0 (inverted or flat).
+/// stiffness-proportional damping force -beta K(x) v as well. rotations: see KeptRotations.
+/// Returns the number of elements with det F <= 0 (inverted or flat).
 template <class Material>
 int32_t add_fem_forces(const TetBlock* blocks, size_t block_count, const double* x, const double* v, double beta,
-                       double* f) {
-    if (v) return add_fem_forces_loop<Material, true>(blocks, block_count, x, v, beta, f);
-    return add_fem_forces_loop<Material, false>(blocks, block_count, x, nullptr, 0.0, f);
+                       double* f, const KeptRotations& rotations = KeptRotations{}) {
+    if (v) return add_fem_forces_loop<Material, true>(blocks, block_count, x, v, beta, f, rotations);
+    return add_fem_forces_loop<Material, false>(blocks, block_count, x, nullptr, 0.0, f, rotations);
+}
+
+/// The rotations of blocks' elements at positions x into out[k], found from F alone, for a
+/// law that keeps them (kRotates; nothing otherwise): a later pass's warm start.
+template <class Material>
+void fem_rotations(const TetBlock* blocks, size_t block_count, const double* x, Mat3L* out) {
+    if constexpr (Material::kRotates)
+        for (size_t k = 0; k < block_count; ++k) out[k] = polar_rotation(mul(gather_edges(blocks[k], x), blocks[k].Bm));
 }
 
 /// Elastic energy of blocks at positions x (J).

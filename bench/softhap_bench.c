@@ -460,7 +460,8 @@ static void cube_case(const char* scene, const body_kind* kind, double dt, const
     double* wall = (double*)xmalloc(sizeof(double) * (size_t)steps);
     sh_step_report report;
     int failed = 0;
-    long factorizations = 0, newton = 0;
+    long factorizations = 0, newton = 0, linear = 0;
+    double factorize = 0.0, solve = 0.0;
     for (int s = -1; s < steps; ++s) {
         const double t0 = now_ns();
         failed += sh_world_step(world, dt, &report) != SH_OK;
@@ -468,13 +469,17 @@ static void cube_case(const char* scene, const body_kind* kind, double dt, const
         wall[s] = now_ns() - t0;
         factorizations += report.factorizations;
         newton += report.newton_iterations;
+        linear += report.linear_iterations;
+        factorize += report.factorize_seconds;
+        solve += report.solve_seconds;
     }
     const stats t = summarize(wall, steps);
     printf("{\"case\":\"%s\",\"tets\":%d,\"dt\":%g,\"median_ms\":%.3f,\"p99_ms\":%.3f,\"max_ms\":%.3f,"
-           "\"mean_ms\":%.3f,\"factorizations_per_step\":%.2f,\"newton_per_step\":%.2f,\"steps\":%d,"
-           "\"failed_steps\":%d}\n",
+           "\"mean_ms\":%.3f,\"factorize_ms_mean\":%.3f,\"solve_ms_mean\":%.3f,\"factorizations_per_step\":%.2f,"
+           "\"newton_per_step\":%.2f,\"linear_iterations_per_step\":%.2f,\"steps\":%d,\"failed_steps\":%d}\n",
            name, 6 * kCubeCells * kCubeCells * kCubeCells, dt, t.median * 1e-6, t.p99 * 1e-6, t.max * 1e-6,
-           t.mean * 1e-6, (double)factorizations / steps, (double)newton / steps, steps, failed);
+           t.mean * 1e-6, factorize / steps * 1e3, solve / steps * 1e3, (double)factorizations / steps,
+           (double)newton / steps, (double)linear / steps, steps, failed);
     fflush(stdout);
     free(wall);
     free(fixed);

@@ -406,7 +406,15 @@ typedef struct sh_implicit_settings {
                                          with a fresh factorisation at the same state; a
                                          linearised step (newton_max_iterations = 1) takes such
                                          updates until |g| is down by factor_reuse from its
-                                         start. Changing dt, the fixed nodes, a material or node
+                                         start. Where the tangent drifts from new factorisations
+                                         faster than they pay off (large rotations: a
+                                         factorisation's updates fail within a step or two), a
+                                         step without contact candidates solves its updates
+                                         instead by conjugate gradients on the current tangent
+                                         preconditioned by the kept factorisation, to a relative
+                                         residual of 0.1 factor_reuse, and factorises afresh once
+                                         that has cost as much as a factorisation. Changing dt,
+                                         the fixed nodes, a material or node
                                          damping refactorises. 0 = a new factorisation at every
                                          Newton iteration (exact Newton); must be in [0, 1);
                                          default 0.25 */

@@ -268,6 +268,24 @@ void SparseSystem::add_diagonal(const double* diag, double scale) {
     for (int32_t d = 0; d < dof_count_; ++d) v[cs[d + 1] - 1] += scale * diag[d];
 }
 
+void SparseSystem::multiply(const double* x, double* y) const {
+    // Column j of the upper triangle holds A(i, j), i <= j: it adds A(i, j) x_j to y_i and, off
+    // the diagonal (the column's last entry), A(i, j) x_i to y_j.
+    const double* v = values_.data();
+    const int32_t* cs = column_starts_.data();
+    const int32_t* rows = row_indices_.data();
+    for (int32_t j = 0; j < dof_count_; ++j) {
+        const double xj = x[j];
+        double yj = 0.0;
+        const int32_t last = cs[j + 1] - 1;
+        for (int32_t k = cs[j]; k < last; ++k) {
+            y[rows[k]] += v[k] * xj;
+            yj += v[k] * x[rows[k]];
+        }
+        y[j] = yj + v[last] * xj;  // rows above j are done: y_j gets no more later
+    }
+}
+
 int32_t SparseSystem::first_nonfinite_column() const {
     // Integer exponent test: vectorises, unlike a floating-point reduction.
     constexpr uint64_t kExponent = 0x7ff0000000000000ull;

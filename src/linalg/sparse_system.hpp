@@ -50,6 +50,8 @@ public:
     bool has_block(int32_t free_i, int32_t free_j) const;
     /// Adds diag[d] to diagonal entry d, for d < dof_count() (lumped mass, per-DOF terms).
     void add_diagonal(const double* diag, double scale);
+    /// y = A x for the full symmetric matrix (dof_count() values each; x and y must not overlap).
+    void multiply(const double* x, double* y) const;
     const vec<int32_t>& column_starts() const { return column_starts_; }  ///< dof_count()+1
     const vec<int32_t>& row_indices() const { return row_indices_; }
     const vec<double>& values() const { return values_; }

@@ -1,7 +1,9 @@
 #include "solver/implicit_integrator.hpp"
 
+#include "core/clock.hpp"
 #include "core/error.hpp"
 #include "model/external_field.hpp"
+#include "linalg/preconditioned_cg.hpp"
 #include "solver/newton_problem.hpp"
 #include "solver/step_support.hpp"
 
@@ -20,6 +22,26 @@ constexpr double kSpeedFloor = 1e-9;
 // worth), and one factorisation serves at most kMaxStaleSolves such solves in a step.
 constexpr double kStaleContraction = 0.5;
 constexpr int kMaxStaleSolves = 4;
+
+// When an update solved with the kept factorisation fails, the step either factorises the
+// tangent afresh or, where that costs more per step (krylov_pays), solves its later updates by
+// conjugate gradients on the current tangent preconditioned by the kept factorisation, to a
+// relative residual of kKrylovForcing times factor_reuse (an inexact Newton update, more
+// accurate than the kept factorisation's accepted updates), spending at most kKrylovBudget of
+// the kept factorisation's time before it gives up and factorises afresh. A new factorisation
+// costs its assembly and factorisation once and then serves as many steps as its updates last
+// (kKeepLife weighs their mean over the factorisations before); CG costs an assembly and a few
+// preconditioner solves per step, for at most a factorisation's price on one kept
+// factorisation. Under large rotation the tangent drifts away from a new
+// factorisation within a step or two, and a factorisation costs as much as 15 solves (20 k
+// tets); where the motion is slow one serves many steps without an assembly. Not in contact:
+// contacts switch within a step, where Newton with factorisations at its iterates converges in
+// fewer iterations (a cube on a 1e9 N/m plane did not converge in 20 iterations with CG
+// updates).
+constexpr double kKrylovForcing = 0.1;
+constexpr double kKrylovBudget = 0.5;
+constexpr int kKrylovMinIterations = 2, kKrylovMaxIterations = 50;
+constexpr double kKeepLife = 0.5;
 
 // Newton iterations allowed to a body with contact candidates, whatever its settings.
 constexpr int kContactNewtonIterations = 20;
@@ -103,6 +125,14 @@ private:
     double assemble_body(Body& body, NewtonBodyState& state);
     /// Solves for the Newton update, factorising first unless a kept factorisation serves.
     bool factorize_and_solve(bool& failed);
+    /// Assembles the bodies' tangent at the current iterate into matrix_.system.
+    void assemble_tangent();
+    /// The update by conjugate gradients on the current tangent preconditioned by the kept
+    /// factorisation (see kKrylovForcing); false if they did not converge within budget.
+    bool solve_by_krylov();
+    /// After an update solved with the kept factorisation failed: true if CG preconditioned by
+    /// it costs less per step than new factorisations do, as long as they last.
+    bool krylov_pays();
     /// Sets v = previous_v + scale delta and evaluates there.
     void take_update(double scale);
     /// Backtracking line search along delta; false if no step length qualifies.
@@ -139,6 +169,11 @@ private:
     bool reuse_ = false;           // factorisations are kept
     bool factor_current_ = false;  // matrix_ holds a factorisation usable for this step
     bool fresh_ = false;           // it is of the tangent at the current iterate
+    bool krylov_ = false;          // the kept factorisation preconditions CG on the tangent
+    bool krylov_update_ = false;   // the last update came from such CG (it counts as fresh_)
+    bool krylov_failed_ = false;   // CG failed this step: no more of it
+    bool assembled_ = false;       // matrix_.system holds the tangent at the current iterate
+    bool in_contact_ = false;      // a body has contact candidates (a field) this step
     uint64_t matrix_version_ = 0;  // the bodies' matrix version at the step's start
     int stale_solves_ = 0;         // solves with the current factorisation since it was made
     Potential phi_;                // at the current iterate
@@ -196,6 +231,8 @@ double NewtonStep::extent() const {
 
 void NewtonStep::begin() {
     work_done_ = false;
+    krylov_ = krylov_update_ = krylov_failed_ = assembled_ = in_contact_ = false;
+    problem_.each([&](const SteppedBody& stepped, size_t) { in_contact_ |= stepped.body->field != nullptr; });
     energy_checked_ = false;
     first_evaluation_ = true;
     problem_.each([&](SteppedBody& stepped, size_t) {
@@ -215,6 +252,7 @@ void NewtonStep::begin() {
     matrix_version_ = problem_.matrix_version();
     factor_current_ = reuse_ && allow_stale_ && matrix_.kept.valid && matrix_.kept.dt == dt_ &&
                       matrix_.kept.matrix_version == matrix_version_;
+    if (factor_current_) ++matrix_.kept.steps_served;
 }
 
 // Moves every body to x = x0 + h v, then fills matrix_.residual with g(v), r_, r_max_ and phi_.
@@ -279,17 +317,74 @@ double NewtonStep::assemble_body(Body& body, NewtonBodyState& state) {
     return state.assemble_tangent(body, dt_ * dt_, dt_, body.v.data(), state.diagonal.data(), 1.0 / dt_);
 }
 
-// Solves the tangent system for the update delta = -H^-1 g into matrix_.delta, with a new
-// factorisation at the current iterate unless a kept one may serve. False (failed set) if the
-// factorisation or solve failed; throws what is not a solver failure.
+void NewtonStep::assemble_tangent() {
+    const double t0 = now_seconds();
+    matrix_.kept.roundoff_floor =
+        problem_.assemble([&](SteppedBody& m) { return assemble_body(*m.body, *m.newton); }, dt_ * dt_, dt_, false);
+    matrix_.kept.assemble_seconds = now_seconds() - t0;
+    assembled_ = true;
+}
+
+bool NewtonStep::krylov_pays() {
+    KeptFactorisation& kept = matrix_.kept;
+    if (!kept.failed) {  // its first failure: how long its updates served
+        kept.failed = true;
+        const double life = kept.steps_served;
+        kept.mean_life = kept.mean_life < 0.0 ? life : kKeepLife * kept.mean_life + (1.0 - kKeepLife) * life;
+    }
+    // A factorisation's price; CG pays at most that much on one before buying a new one (so
+    // that a wrong estimate of the lives costs at most a factorisation per factorisation).
+    const double price = kept.assemble_seconds + kept.factorize_seconds;
+    const double krylov = kept.assemble_seconds + kept.krylov_iterations * kept.solve_seconds;
+    return kept.mean_life >= 0.0 && krylov < price / std::max(kept.mean_life, 1.0) && kept.krylov_spent < price;
+}
+
+bool NewtonStep::solve_by_krylov() {
+    assemble_tangent();
+    KeptFactorisation& kept = matrix_.kept;
+    const double per_solve = std::max(kept.solve_seconds, 1e-9);
+    const int cap = std::clamp(static_cast<int>(kKrylovBudget * kept.factorize_seconds / per_solve),
+                               kKrylovMinIterations, kKrylovMaxIterations);
+    for (double& r_d : matrix_.residual) r_d = -r_d;
+    const PreconditionedCgResult cg = solve_preconditioned_cg(matrix_.system, *matrix_.solver, matrix_.residual.data(),
+                                                              matrix_.delta.data(), kKrylovForcing * s_.factor_reuse, cap);
+    for (double& r_d : matrix_.residual) r_d = -r_d;
+    result_.linear_iterations += cg.iterations;
+    result_.solve_seconds += cg.seconds;
+    // Out of budget on a factorisation a step old, CG cannot keep up with the tangent: the
+    // estimate goes to twice the budget, where it never pays (cap solves cost half a
+    // factorisation). On an older one, age may be the cause: the next factorisation tells.
+    const bool outpaced = !cg.converged && kept.steps_served <= 1;
+    kept.krylov_iterations = outpaced ? 2 * cap : cg.iterations;
+    kept.krylov_spent += kept.assemble_seconds + cg.seconds;
+    used_stale = true;  // the kept factorisation steered it: a failed step retries without it
+    return cg.converged;
+}
+
+// Solves the tangent system for the update delta = -H^-1 g into matrix_.delta: by CG
+// preconditioned with the kept factorisation where krylov_pays chose it this step, else with a
+// new factorisation at the current iterate unless a kept one may serve. False (failed set) if
+// the factorisation or solve failed; throws what is not a solver failure.
 bool NewtonStep::factorize_and_solve(bool& failed) {
     failed = false;
+    krylov_update_ = false;
     try {
+        if (krylov_ && factor_current_ && !krylov_failed_) {
+            if (solve_by_krylov()) {
+                fresh_ = krylov_update_ = true;
+                return true;
+            }
+            krylov_failed_ = true;  // the tangent is assembled: factorise it below
+            factor_current_ = false;
+        }
         if (!factor_current_ || stale_solves_ == kMaxStaleSolves) {
             matrix_.kept.valid = false;
-            matrix_.kept.roundoff_floor = problem_.assemble(
-                [&](SteppedBody& m) { return assemble_body(*m.body, *m.newton); }, dt_ * dt_, dt_, false);
+            if (!assembled_) assemble_tangent();
             matrix_.solver->factorize(matrix_.system);
+            matrix_.kept.factorize_seconds = matrix_.solver->factorize_seconds;
+            matrix_.kept.steps_served = 0;
+            matrix_.kept.failed = false;
+            matrix_.kept.krylov_spent = 0.0;
             result_.factorize_seconds += matrix_.solver->factorize_seconds;
             ++result_.factorizations;
             matrix_.kept.valid = reuse_;
@@ -303,6 +398,7 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
         result_.linear_iterations += matrix_.solver->solve(matrix_.system, matrix_.residual.data(), matrix_.delta.data());
         for (double& r_d : matrix_.residual) r_d = -r_d;
         result_.solve_seconds += matrix_.solver->solve_seconds;
+        matrix_.kept.solve_seconds = matrix_.solver->solve_seconds;
     } catch (const Error& e) {
         if (e.status() != SH_ERR_NOT_CONVERGED && e.status() != SH_ERR_SOLVER) throw;
         result_.status = e.status();
@@ -314,6 +410,7 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
 // v = previous_v + scale delta, then evaluate().
 void NewtonStep::take_update(double scale) {
     largest_change_ = largest_speed_ = 0.0;
+    assembled_ = false;
     problem_.each([&](SteppedBody& stepped, size_t offset) {
         Body& body = *stepped.body;
         const vec<int32_t>& global = stepped.newton->matrix.system.dof_to_global();
@@ -402,9 +499,7 @@ BodyStepResult NewtonStep::run(bool keep_best) {
 // Newton iterations the step may take. Contacts switch on and off within a step, which a
 // single update cannot follow: a body in contact iterates.
 int NewtonStep::iteration_cap() const {
-    bool in_contact = false;
-    problem_.each([&](const SteppedBody& stepped, size_t) { in_contact |= stepped.body->field != nullptr; });
-    return std::max(in_contact ? kContactNewtonIterations : 1, s_.newton_max_iterations);
+    return std::max(in_contact_ ? kContactNewtonIterations : 1, s_.newton_max_iterations);
 }
 
 // The residual's scale: the first one, or the impulse of the loads over the step, the field's
@@ -459,6 +554,12 @@ bool NewtonStep::iterate(bool& solver_failed) {
         const bool fresh = fresh_;
         if (!(slope < 0.0) || !line_search(slope, fresh)) {
             if (!fresh) {  // the kept factorisation is too far from the current tangent
+                krylov_ = !krylov_failed_ && !in_contact_ && krylov_pays();
+                factor_current_ = krylov_;
+                continue;
+            }
+            if (krylov_update_) {  // an inexact update: factorise the tangent and solve exactly
+                krylov_failed_ = true;
                 factor_current_ = false;
                 continue;
             }

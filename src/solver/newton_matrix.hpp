@@ -22,6 +22,17 @@ struct KeptFactorisation {
     double dt = 0.0;              ///< the step size it was made for (s)
     uint64_t matrix_version = 0;  ///< the bodies' matrix version it was made for
     double roundoff_floor = 0.0;  ///< the residual's round-off level at the factorised iterate
+    double factorize_seconds = 0.0;  ///< what making it took (s): the price of a new one
+    double solve_seconds = 0.0;      ///< what its last solve took (s)
+    double assemble_seconds = 0.0;   ///< what the last assembly of the tangent took (s)
+    int steps_served = 0;            ///< steps begun with it since it was made
+    bool failed = false;             ///< an update solved with it failed
+    /// Steps the factorisations' updates served before their first failure, a running mean
+    /// over the factorisations (their cost per step is the factorisation's over it); -1 before
+    /// the first failure.
+    double mean_life = -1.0;
+    int krylov_iterations = 4;       ///< CG iterations it took to precondition the last time
+    double krylov_spent = 0.0;       ///< assembly and CG time spent with it as preconditioner (s)
 };
 
 /// The sparse linear system of a Newton solve and what solving it needs.

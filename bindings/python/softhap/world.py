@@ -194,7 +194,9 @@ class World(WorldContacts):
           linearised solve per step); newton_tolerance; cg_tolerance; cg_max_iterations;
           factor_reuse (0.25: keep a direct solver's factorisation while its updates at least
           halve the residual, a linearised step taking them until the residual is down 4x;
-          0 = factorise at every Newton iteration); max_substeps.
+          under large rotation, precondition conjugate gradients on the current tangent with
+          it instead of factorising every step; 0 = factorise at every Newton iteration);
+          max_substeps.
         Unknown names raise ValueError; invalid values raise softhap.Error
         (SH_ERR_INVALID_ARGUMENT).
         """

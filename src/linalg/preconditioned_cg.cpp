@@ -1,0 +1,58 @@
+#include "linalg/preconditioned_cg.hpp"
+
+#include "core/clock.hpp"
+#include "core/memory.hpp"
+
+#include <cmath>
+
+namespace sh {
+namespace {
+
+double dot(const vec<double>& a, const vec<double>& b) {
+    double s = 0.0;
+    for (size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
+    return s;
+}
+
+}  // namespace
+
+PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolver& preconditioner, const double* b,
+                                               double* x, double tolerance, int max_iterations) {
+    const double t0 = now_seconds();
+    PreconditionedCgResult out;
+    const size_t n = static_cast<size_t>(a.dof_count());
+    vec<double> r(b, b + n), z(n), p(n), q(n);
+    for (size_t i = 0; i < n; ++i) x[i] = 0.0;
+    const double b_norm = std::sqrt(dot(r, r));
+    out.relative_residual = b_norm > 0.0 ? 1.0 : 0.0;
+    out.converged = !(b_norm > 0.0);
+    if (out.converged) return out;
+    preconditioner.solve(a, r.data(), z.data());
+    p = z;
+    double rz = dot(r, z);
+    while (out.iterations < max_iterations) {
+        a.multiply(p.data(), q.data());
+        ++out.iterations;
+        const double curvature = dot(p, q);
+        if (!(curvature > 0.0) || !(rz > 0.0)) break;
+        const double alpha = rz / curvature;
+        for (size_t i = 0; i < n; ++i) {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * q[i];
+        }
+        out.relative_residual = std::sqrt(dot(r, r)) / b_norm;
+        if (out.relative_residual <= tolerance) {
+            out.converged = true;
+            break;
+        }
+        preconditioner.solve(a, r.data(), z.data());
+        const double rz_next = dot(r, z);
+        const double beta = rz_next / rz;
+        rz = rz_next;
+        for (size_t i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];
+    }
+    out.seconds = now_seconds() - t0;
+    return out;
+}
+
+}  // namespace sh

@@ -1,0 +1,30 @@
+// Conjugate gradients preconditioned by a direct solver's factorisation of a nearby matrix: a
+// factorisation kept from an earlier Newton iterate or step serves the current tangent with a
+// few iterations instead of a new factorisation.
+#pragma once
+
+#include "linalg/linear_solver.hpp"
+#include "linalg/sparse_system.hpp"
+
+namespace sh {
+
+/// What solve_preconditioned_cg reached.
+struct PreconditionedCgResult {
+    int iterations = 0;              ///< matrix products (each with one preconditioner solve)
+    bool converged = false;          ///< |b - A x| <= tolerance |b|
+    double relative_residual = 1.0;  ///< |b - A x| / |b| at the end
+    double seconds = 0.0;            ///< wall time, preconditioner solves included
+};
+
+/// Solves A x = b for the current values of a (symmetric positive definite expected) by
+/// conjugate gradients from x = 0, each residual preconditioned by preconditioner.solve (a
+/// direct solver whose factorisation, of a matrix with a's pattern, stays as it was). Stops when
+/// |b - A x| <= tolerance |b| or after max_iterations; x then holds the last iterate. Each
+/// iterate lowers the quadratic 1/2 x^T A x - b^T x further, so for b = -g (g a gradient) every
+/// iterate is a descent direction. A curvature p^T A p that is not positive (A not positive
+/// definite along p) stops it unconverged at the iterate before. Throws what the
+/// preconditioner's solve throws. Allocates four vectors of a.dof_count().
+PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolver& preconditioner, const double* b,
+                                               double* x, double tolerance, int max_iterations);
+
+}  // namespace sh

@@ -7,7 +7,8 @@
 //   kModel                                  its sh_material_model (checked against the row)
 //   kProjectTangent                         true if dP/dF can be indefinite, so that the
 //                                           tangent stiffness projects it to positive
-//                                           semi-definite per element
+//                                           semi-definite per element (in F's singular
+//                                           frame: such a law must be isotropic)
 //   kRotates                                true if State holds the element's rotation R
 //                                           (state.R), and the law has
 //                                           stress_near(F, lambda, mu, state, near,

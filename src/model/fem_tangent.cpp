@@ -1,11 +1,12 @@
 // Tangent stiffness of FEM bodies for the implicit and static solvers:
 // K_e = V0 G^T C G with C = dP/dF (9x9, from each material's differential on the unit basis of F)
 // and G the map from nodal displacements to F (dF_kj / dx_ak = g_a[j], g_a the shape-function
-// gradients). For the laws whose C can be indefinite (kProjectTangent in the material table),
-// C is projected to positive semi-definite per element.
+// gradients). For the laws whose C can be indefinite (kProjectTangent in the material table;
+// all isotropic), C is projected to positive semi-definite per element in F's singular frame.
 #include "model/fem_body.hpp"
 
 #include "material/material_params.hpp"
+#include "material/isotropic_projection.hpp"
 #include "material/material_table.hpp"
 #include "linalg/sparse_system.hpp"
 
@@ -16,7 +17,7 @@
 namespace sh {
 namespace {
 
-using Matrix9 = Eigen::Matrix<double, 9, 9>;
+using Matrix9 = StressDerivative;
 
 // dP/dF per lane of a batch of elements of one material model.
 template <class Material>
@@ -32,13 +33,13 @@ void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, Matrix9 (&C)[kLa
     }
 }
 
-void project_positive(Matrix9& c) {
+// C projected to positive semi-definite for an element at F (the laws that need it are
+// isotropic: project_isotropic_tangent works in F's singular frame).
+void project_positive(Matrix9& c, const Eigen::Matrix3d& f) {
     // Most elements' C is already positive definite (all but the strongly compressed or
-    // inverted ones): a Cholesky factorisation proves it at a fraction of an eigensolve's cost.
+    // inverted ones): a Cholesky factorisation proves it at a fraction of the projection's cost.
     if (Eigen::LLT<Matrix9>(c).info() == Eigen::Success) return;
-    const Eigen::SelfAdjointEigenSolver<Matrix9> eigen(c);
-    if (eigen.eigenvalues()(0) >= 0.0) return;
-    c = eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * eigen.eigenvectors().transpose();
+    project_isotropic_tangent(c, f);
 }
 
 }  // namespace
@@ -74,7 +75,12 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
         for (int l = 0; l < count; ++l) {
             const size_t t = static_cast<size_t>(members[l]);
             Matrix9 c = 0.5 * (C[l] + C[l].transpose());
-            if (project) project_positive(c);
+            if (project) {
+                Eigen::Matrix3d f;
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 3; ++j) f(i, j) = F.m[i][j][l];
+                project_positive(c, f);
+            }
             const double* bm = &inverse_rest_[9 * t];
             double g[4][3];
             for (int j = 0; j < 3; ++j) {

@@ -335,7 +335,7 @@ bool NewtonStep::krylov_pays() {
     // A factorisation's price; CG pays at most that much on one before buying a new one (so
     // that a wrong estimate of the lives costs at most a factorisation per factorisation).
     const double price = kept.assemble_seconds + kept.factorize_seconds;
-    const double krylov = kept.assemble_seconds + kept.krylov_iterations * kept.solve_seconds;
+    const double krylov = kept.assemble_seconds + kept.krylov_iterations[kept.steps_served > 0] * kept.solve_seconds;
     return kept.mean_life >= 0.0 && krylov < price / std::max(kept.mean_life, 1.0) && kept.krylov_spent < price;
 }
 
@@ -351,11 +351,16 @@ bool NewtonStep::solve_by_krylov() {
     for (double& r_d : matrix_.residual) r_d = -r_d;
     result_.linear_iterations += cg.iterations;
     result_.solve_seconds += cg.seconds;
-    // Out of budget on a factorisation a step old, CG cannot keep up with the tangent: the
-    // estimate goes to twice the budget, where it never pays (cap solves cost half a
-    // factorisation). On an older one, age may be the cause: the next factorisation tells.
+    // The iterations CG takes, a running mean over its solves with factorisations of this
+    // step and of earlier ones apart (within a step the tangent moves less). Out of budget on a
+    // factorisation a step old, CG cannot keep up with the tangent: that solve counts four
+    // times the budget (cap solves cost half a factorisation), where CG costs more than a
+    // factorisation and does not pay until solves that converged bring the mean down. On an
+    // older one, age may be the cause.
     const bool outpaced = !cg.converged && kept.steps_served <= 1;
-    kept.krylov_iterations = outpaced ? 2 * cap : cg.iterations;
+    const double iterations = outpaced ? 4.0 * cap : cg.iterations;
+    double& mean = kept.krylov_iterations[kept.steps_served > 0];
+    mean = kKeepLife * mean + (1.0 - kKeepLife) * iterations;
     kept.krylov_spent += kept.assemble_seconds + cg.seconds;
     used_stale = true;  // the kept factorisation steered it: a failed step retries without it
     return cg.converged;

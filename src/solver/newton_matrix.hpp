@@ -31,7 +31,9 @@ struct KeptFactorisation {
     /// over the factorisations (their cost per step is the factorisation's over it); -1 before
     /// the first failure.
     double mean_life = -1.0;
-    int krylov_iterations = 4;       ///< CG iterations it took to precondition the last time
+    /// CG iterations per solve preconditioned with a factorisation made in the same step [0]
+    /// or an earlier one [1] (running means).
+    double krylov_iterations[2] = {4.0, 4.0};
     double krylov_spent = 0.0;       ///< assembly and CG time spent with it as preconditioner (s)
 };
 

@@ -10,6 +10,8 @@
 
 #include "core/error.hpp"
 
+#include "kuhn_block.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -33,18 +35,10 @@ struct Block {
     std::vector<int32_t> tets;     // 4 per tet
     std::vector<int32_t> parent;   // per node: the node it copies, -1 for the block's own
 
-    static int32_t grid_node(int i, int j, int k) { return (k * (kCells + 1) + j) * (kCells + 1) + i; }
+    static int32_t grid_node(int i, int j, int k) { return kuhn::grid_node(kCells, i, j, k); }
 
-    Block() {
-        node_count = (kCells + 1) * (kCells + 1) * (kCells + 1);
+    Block() : node_count(kuhn::node_count(kCells)), tets(kuhn::block_tets(kCells)) {
         parent.assign(static_cast<size_t>(node_count), -1);
-        static const int kKuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-        for (int k = 0; k < kCells; ++k)
-            for (int j = 0; j < kCells; ++j)
-                for (int i = 0; i < kCells; ++i)
-                    for (const auto& tet : kKuhn)
-                        for (const int corner : tet)
-                            tets.push_back(grid_node(i + (corner & 1), j + ((corner >> 1) & 1), k + ((corner >> 2) & 1)));
     }
 
     // Duplicates the cut's nodes; the tets above the plane that use them take the copies.

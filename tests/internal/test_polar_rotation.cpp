@@ -70,23 +70,34 @@ double worst_error(const Mat3L& r, const Eigen::Matrix3d expected[kLanes]) {
     return worst;
 }
 
-/// Blocks of random F whose warm start is the answer turned by `off` radians about a random
-/// axis; every lane of both functions must match the SVD within tolerance.
-void check_starts(double off, double low, double high, double tolerance) {
-    std::mt19937_64 rng(42);
-    for (int block = 0; block < 200; ++block) {
-        Mat3L f, near;
-        Eigen::Matrix3d expected[kLanes];
+/// kLanes random deformations F (principal stretches in [low, high]; lane `inverted`, if in
+/// range, reflected to det F < 0), their SVD rotations, and a start for each: the rotation
+/// turned by `off` radians about a random axis.
+struct Block {
+    Mat3L f, near;
+    Eigen::Matrix3d expected[kLanes];
+
+    Block(std::mt19937_64& rng, double low, double high, double off, int inverted = -1) {
         for (int l = 0; l < kLanes; ++l) {
-            const Eigen::Matrix3d a = random_deformation(rng, low, high);
+            Eigen::Matrix3d a = random_deformation(rng, low, high);
+            if (l == inverted) a.col(0) = -a.col(0);
             expected[l] = svd_rotation(a);
             put(f, l, a);
             put(near, l, expected[l] * rotation(off * random_direction(rng)));
         }
-        assert_true(worst_error(sh::polar_rotation(f), expected) < tolerance);
-        assert_true(worst_error(sh::polar_rotation_near(f, near), expected) < tolerance);
+    }
+};
+
+/// Blocks whose warm start is the answer turned by `off` radians; every lane of both
+/// functions must match the SVD within tolerance.
+void check_starts(double off, double low, double high, double tolerance) {
+    std::mt19937_64 rng(42);
+    for (int n = 0; n < 200; ++n) {
+        const Block block(rng, low, high, off);
+        assert_true(worst_error(sh::polar_rotation(block.f), block.expected) < tolerance);
+        assert_true(worst_error(sh::polar_rotation_near(block.f, block.near), block.expected) < tolerance);
         // A looser settling bound leaves R within a small multiple of it.
-        assert_true(worst_error(sh::polar_rotation_near(f, near, 1e-8), expected) < 1e-7);
+        assert_true(worst_error(sh::polar_rotation_near(block.f, block.near, 1e-8), block.expected) < 1e-7);
     }
 }
 
@@ -108,31 +119,16 @@ void strong_stretch(void**) { check_starts(1e-2, 0.1, 2.0, 1e-10); }
 /// singular value flipped, for the whole block as for that lane.
 void inverted_lane(void**) {
     std::mt19937_64 rng(7);
-    Mat3L f, near;
-    Eigen::Matrix3d expected[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-        Eigen::Matrix3d a = random_deformation(rng, 0.8, 1.2);
-        if (l == 3) a.col(0) = -a.col(0);
-        expected[l] = svd_rotation(a);
-        put(f, l, a);
-        put(near, l, expected[l]);
-    }
-    assert_true(worst_error(sh::polar_rotation_near(f, near), expected) < 1e-11);
+    const Block block(rng, 0.8, 1.2, 0.0, 3);
+    assert_true(worst_error(sh::polar_rotation_near(block.f, block.near), block.expected) < 1e-11);
 }
 
 /// An exact start stays exact: the update it computes is zero to round-off.
 void exact_start_is_kept(void**) {
     std::mt19937_64 rng(3);
-    Mat3L f, near;
-    Eigen::Matrix3d expected[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-        const Eigen::Matrix3d a = random_deformation(rng, 0.9, 1.1);
-        expected[l] = svd_rotation(a);
-        put(f, l, a);
-        put(near, l, expected[l]);
-    }
-    const Mat3L r = sh::polar_rotation_near(f, near);
-    assert_true(worst_error(r, expected) < 1e-14);
+    const Block block(rng, 0.9, 1.1, 0.0);
+    const Mat3L r = sh::polar_rotation_near(block.f, block.near);
+    assert_true(worst_error(r, block.expected) < 1e-14);
     for (int l = 0; l < kLanes; ++l) {  // and orthogonal
         const Eigen::Matrix3d q = get(r, l);
         assert_true((q.transpose() * q - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-14);
@@ -144,19 +140,13 @@ void exact_start_is_kept(void**) {
 /// angle it turned (the previous error, to first order).
 void updates_converge_quadratically(void**) {
     std::mt19937_64 rng(11);
-    Mat3L f, r;
-    Eigen::Matrix3d expected[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-        const Eigen::Matrix3d a = random_deformation(rng, 0.6, 1.6);
-        expected[l] = svd_rotation(a);
-        put(f, l, a);
-        put(r, l, expected[l] * rotation(0.05 * random_direction(rng)));
-    }
-    double error = worst_error(r, expected);
+    const Block block(rng, 0.6, 1.6, 0.05);
+    Mat3L r = block.near;
+    double error = worst_error(r, block.expected);
     assert_true(error > 0.02);
     for (int update = 0; update < 3; ++update) {
-        const sh::Lanes turned2 = sh::rotation_update(f, r);
-        const double next = worst_error(r, expected);
+        const sh::Lanes turned2 = sh::rotation_update(block.f, r);
+        const double next = worst_error(r, block.expected);
         assert_true(next <= 4.0 * error * error + 1e-15);
         for (int l = 0; l < kLanes; ++l) assert_true(std::sqrt(turned2[l]) <= 2.0 * error + 1e-15);
         error = next;

@@ -8,6 +8,8 @@
 #include "linalg/preconditioned_cg.hpp"
 #include "linalg/sparse_system.hpp"
 
+#include "kuhn_block.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -23,30 +25,14 @@ extern "C" {
 namespace {
 
 constexpr int kCells = 5;  // cubes per side
-
-int32_t grid_node(int i, int j, int k) { return (k * (kCells + 1) + j) * (kCells + 1) + i; }
-
-// kCells^3 cubes, six tets each (Kuhn split).
-std::vector<int32_t> block_tets() {
-    static const int kKuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-    std::vector<int32_t> tets;
-    for (int k = 0; k < kCells; ++k)
-        for (int j = 0; j < kCells; ++j)
-            for (int i = 0; i < kCells; ++i)
-                for (const auto& tet : kKuhn)
-                    for (const int corner : tet)
-                        tets.push_back(grid_node(i + (corner & 1), j + ((corner >> 1) & 1), k + ((corner >> 2) & 1)));
-    return tets;
-}
-
-constexpr int32_t kNodes = (kCells + 1) * (kCells + 1) * (kCells + 1);
+const int32_t kNodes = kuhn::node_count(kCells);
 
 // stiffness * (a graph Laplacian per tet, 4 I - ones per component, with an x-y coupling
 // `shear` in its off-diagonal blocks) + diagonal(d) (d_i = 1 + (i % 5) / 4): symmetric
 // positive definite for |shear| < 1. The pattern is built once: later calls only change the
 // values (a solver analysed for it stays valid).
 void assemble(sh::SparseSystem& a, double stiffness, double shear) {
-    const std::vector<int32_t> tets = block_tets();
+    const std::vector<int32_t> tets = kuhn::block_tets(kCells);
     std::vector<int32_t> identity(kNodes);
     for (int32_t i = 0; i < kNodes; ++i) identity[static_cast<size_t>(i)] = i;
     if (a.dof_count() == 0) a.build_pattern(tets.data(), tets.size() / 4, 4, identity.data(), kNodes, kNodes);
@@ -90,6 +76,14 @@ sh::LinearSolverPtr direct_solver() {
 #endif
 }
 
+// A direct solver analysed for a and holding the factorisation of its current values.
+sh::LinearSolverPtr factorised(const sh::SparseSystem& a) {
+    sh::LinearSolverPtr solver = direct_solver();
+    solver->analyze(a);
+    solver->factorize(a);
+    return solver;
+}
+
 // 1/2 x^T A x - b^T x.
 double quadratic(const sh::SparseSystem& a, const std::vector<double>& b, const std::vector<double>& x) {
     std::vector<double> ax(x.size());
@@ -119,13 +113,9 @@ void product_matches_the_dense_matrix(void**) {
 void nearby_factorisation_preconditions(void**) {
     sh::SparseSystem a;
     assemble(a, 40.0, 0.5);  // the kept factorisation's matrix
-    sh::LinearSolverPtr solver = direct_solver();
-    solver->analyze(a);
-    solver->factorize(a);
+    sh::LinearSolverPtr solver = factorised(a);
     assemble(a, 50.0, 0.2);  // the current one, same pattern
-    sh::LinearSolverPtr exact = direct_solver();
-    exact->analyze(a);
-    exact->factorize(a);
+    sh::LinearSolverPtr exact = factorised(a);
     const size_t n = static_cast<size_t>(a.dof_count());
     const std::vector<double> b = right_hand_side(n);
     std::vector<double> x(n, 7.0), reference(n, 0.0);  // CG starts from 0 whatever x held
@@ -147,9 +137,7 @@ void nearby_factorisation_preconditions(void**) {
 void iterates_descend(void**) {
     sh::SparseSystem a;
     assemble(a, 10.0, 0.6);
-    sh::LinearSolverPtr solver = direct_solver();
-    solver->analyze(a);
-    solver->factorize(a);
+    sh::LinearSolverPtr solver = factorised(a);
     assemble(a, 30.0, -0.4);
     const size_t n = static_cast<size_t>(a.dof_count());
     const std::vector<double> b = right_hand_side(n);
@@ -172,9 +160,7 @@ void iterates_descend(void**) {
 void exact_factorisation_takes_one_iteration(void**) {
     sh::SparseSystem a;
     assemble(a, 25.0, 0.1);
-    sh::LinearSolverPtr solver = direct_solver();
-    solver->analyze(a);
-    solver->factorize(a);
+    sh::LinearSolverPtr solver = factorised(a);
     const size_t n = static_cast<size_t>(a.dof_count());
     const std::vector<double> b = right_hand_side(n);
     std::vector<double> x(n);
@@ -187,9 +173,7 @@ void exact_factorisation_takes_one_iteration(void**) {
 void negative_curvature_stops(void**) {
     sh::SparseSystem a;
     assemble(a, 25.0, 0.1);
-    sh::LinearSolverPtr solver = direct_solver();
-    solver->analyze(a);
-    solver->factorize(a);
+    sh::LinearSolverPtr solver = factorised(a);
     for (double& v : a.values()) v = -v;
     const size_t n = static_cast<size_t>(a.dof_count());
     const std::vector<double> b = right_hand_side(n);

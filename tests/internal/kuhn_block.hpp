@@ -1,0 +1,28 @@
+// A block of cubes split into six tets each (Kuhn), for the linear-algebra unit tests.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace kuhn {
+
+/// Node (i, j, k) of a block of cells^3 cubes, numbered x fastest.
+inline int32_t grid_node(int cells, int i, int j, int k) { return (k * (cells + 1) + j) * (cells + 1) + i; }
+
+/// Nodes of the block.
+inline int32_t node_count(int cells) { return (cells + 1) * (cells + 1) * (cells + 1); }
+
+/// Its tets, 4 nodes each, six per cube around the cube's main diagonal.
+inline std::vector<int32_t> block_tets(int cells) {
+    static const int kKuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+    std::vector<int32_t> tets;
+    for (int k = 0; k < cells; ++k)
+        for (int j = 0; j < cells; ++j)
+            for (int i = 0; i < cells; ++i)
+                for (const auto& tet : kKuhn)
+                    for (const int corner : tet)
+                        tets.push_back(grid_node(cells, i + (corner & 1), j + ((corner >> 1) & 1), k + ((corner >> 2) & 1)));
+    return tets;
+}
+
+}  // namespace kuhn

@@ -10,6 +10,12 @@ Euler; a 5 mm sphere tool 1 cm above its highest node, so that the haptic step r
 proxy only and its C cost is small next to the wrapper's (the quantity measured here); a haptic
 context of 15 mm at 10 kHz (so each world step also extracts its buffer). Each call is timed
 on its own with time.perf_counter().
+
+"python/haptic_step_block500_stiff" is softhap_bench's haptic/rate/10000hz/stiff/500 case from
+Python: the 6 x 6 x 3 cm block (12 x 12 x 6 Kuhn-split cells, 5184 tets, corotational, 15 kPa,
+nu 0.45, mass damping 5/s, base fixed), a 1 cm sphere of 2e5 N/m^1.5 pressed 3 mm into its
+top over 0.3 s and then circling 1 mm once a second, a 500-tet buffer at 10 kHz; the full
+model is stepped once at the start and then left alone (frozen); 0.2 s of ticks warm up.
 """
 
 import argparse
@@ -69,6 +75,33 @@ def main():
         emit("python/world_step_report", steps, median, p999, tets=mesh.tet_count)
         median, p999 = timed(lambda: world.step(dt, report=False), steps)
         emit("python/world_step_no_report", steps, median, p999, tets=mesh.tet_count)
+    median, p999 = block_press(args.calls)
+    emit("python/haptic_step_block500_stiff", args.calls, median, p999, buffer_tets=500, rate_hz=10000)
+
+
+def block_press(calls):
+    """Median and p99.9 (us) of Haptic.step on the pressed block (see the module docstring)."""
+    mesh = softhap.Mesh.box((0.06, 0.06, 0.03), (12, 12, 6))
+    with softhap.World(gravity=(0.0, 0.0, 0.0)) as world:
+        body = world.add_fem_body(mesh, model="corotational", young=15e3, poisson=0.45, damping_mass=5.0)
+        body.fix_nodes(np.flatnonzero(mesh.nodes[:, 2] < 1e-9))
+        touch = np.array([0.03, 0.03, 0.03 + 0.01])
+        tool = world.add_tool("sphere", radius=0.01, position=touch, stiffness=2e5)
+        haptic = world.add_haptic(tool, capacity_tets=500, capacity_nodes=2004, radius=0.05, dt=1e-4,
+                                  stale_after=1e3)
+        world.step(1e-4)
+
+        def pose(tick):
+            t = (tick + 1) * 1e-4
+            angle = 2.0 * np.pi * (t - 0.3) if t > 0.3 else 0.0
+            return (touch[0] + 1e-3 * (np.cos(angle) - 1.0), touch[1] + 1e-3 * np.sin(angle),
+                    touch[2] - 3e-3 * min(1.0, t / 0.3))
+
+        poses = [pose(tick) for tick in range(2000 + calls)]
+        for tick in range(2000):
+            haptic.step(poses[tick])
+        ticks = iter(poses[2000:])
+        return timed(lambda: haptic.step(next(ticks)), calls)
 
 
 if __name__ == "__main__":

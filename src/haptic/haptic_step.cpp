@@ -125,6 +125,7 @@ void HapticContext::load_state(const Buffer& b, bool keep) {
     current_ = other;
     node_count_ = b.node_count;
     state_body_ = b.body;
+    rotations_from_buffer_ = true;  // the elements' rotations start again from the buffer's too
 }
 
 void HapticContext::follow_boundary(const Buffer& b, double t, double* x, double* v) const {
@@ -201,7 +202,6 @@ void HapticContext::add_held_reaction(const Buffer& b, const double* x, double f
 void HapticContext::adopt(const Buffer& b) {
     load_state(b, b.period > 0.0);
     held_work_ = b.held_work;  // the full model's count up to the buffer's step
-    rotations_from_buffer_ = true;  // its blocks are new
     have_held_pose_ = false;
     std::memset(held_pull_, 0, 3 * static_cast<size_t>(b.held_count) * sizeof(double));
     age_ = 0.0;
@@ -498,7 +498,6 @@ sh_status HapticContext::step(const double position[3], const double orientation
                 warnings_[SH_WARN_UNSTABLE].fetch_add(1, std::memory_order_relaxed);
                 // The state before this step led there: start again from the full model's.
                 load_state(b, false);
-                rotations_from_buffer_ = true;
             }
         } else if (b.has_proxy) {
             contact = proxy_force(b, raw_force, raw_torque);

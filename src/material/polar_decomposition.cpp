@@ -54,6 +54,14 @@ SH_INLINE Lanes update_rotation(const Mat3L& F, Mat3L& R) {
     return select(definite, 4.0 * c2, splat(NAN));
 }
 
+// Lanes whose F is nearly flat or inverted: det F small against |F|^3 ((|F|^2 / 3)^(3/2) is 1
+// for a rotation), or not positive. The polar iteration cannot serve them: they take the SVD.
+SH_INLINE LaneMask ill_conditioned(const Mat3L& F) {
+    const Lanes d = det(F);
+    const Lanes norm2 = ddot(F, F);
+    const Lanes scale3 = norm2 * norm2 * norm2 / 27.0;
+    return d * d < kSvdThreshold * kSvdThreshold * scale3 || d <= 0.0;
+}
 
 Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& f) {
     Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -66,11 +74,7 @@ Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& f) {
 }  // namespace
 
 Mat3L polar_rotation(const Mat3L& F) {
-    const Lanes d = det(F);
-    const Lanes norm2 = ddot(F, F);
-    // |det| vs (|F|^2/3)^(3/2): 1 for a scaled rotation, small when nearly flat.
-    const Lanes scale3 = norm2 * norm2 * norm2 / 27.0;
-    const LaneMask bad = d * d < kSvdThreshold * kSvdThreshold * scale3 || d <= 0.0;
+    const LaneMask bad = ill_conditioned(F);
     bool any_bad = false;
     for (int l = 0; l < kLanes; ++l) any_bad |= bad[l] != 0;
 
@@ -132,12 +136,9 @@ Lanes rotation_update(const Mat3L& F, Mat3L& R) { return update_rotation(F, R); 
 Mat3L polar_rotation_near(const Mat3L& F, const Mat3L& near, double settled2) {
     // Nearly flat or inverted lanes are the cold path's (its SVD branch): the warm start
     // would converge to a rotation of the wrong sign there.
-    const Lanes d = det(F);
-    const Lanes norm2 = ddot(F, F);
-    const Lanes scale3 = norm2 * norm2 * norm2 / 27.0;
-    bool well_conditioned = true;
-    for (int l = 0; l < kLanes; ++l) well_conditioned &= d[l] > 0.0 && d[l] * d[l] >= kSvdThreshold * kSvdThreshold * scale3[l];
-    if (!well_conditioned) return polar_rotation(F);
+    const LaneMask bad = ill_conditioned(F);
+    for (int l = 0; l < kLanes; ++l)
+        if (bad[l]) return polar_rotation(F);
     Mat3L R = near;
     for (int iteration = 0; iteration < kMaxNearIterations; ++iteration)
         if (all_below(update_rotation(F, R), settled2)) return R;

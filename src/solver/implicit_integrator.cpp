@@ -133,6 +133,21 @@ private:
     /// After an update solved with the kept factorisation failed: true if CG preconditioned by
     /// it costs less per step than new factorisations do, as long as they last.
     bool krylov_pays();
+    /// CG failed this step: no more of it; the next update comes with a new factorisation.
+    void give_up_krylov();
+    /// Returns solve(-g, delta), which solves for the update into matrix_.delta, with -g laid
+    /// in matrix_.residual for the call (and g back after it).
+    template <class Solve>
+    auto solve_for_update(Solve&& solve) {
+        for (double& r_d : matrix_.residual) r_d = -r_d;
+        struct Restore {  // g comes back also if the solve throws
+            vec<double>& residual;
+            ~Restore() {
+                for (double& r_d : residual) r_d = -r_d;
+            }
+        } restore{matrix_.residual};
+        return solve(matrix_.residual.data(), matrix_.delta.data());
+    }
     /// Sets v = previous_v + scale delta and evaluates there.
     void take_update(double scale);
     /// Backtracking line search along delta; false if no step length qualifies.
@@ -339,16 +354,22 @@ bool NewtonStep::krylov_pays() {
     return kept.mean_life >= 0.0 && krylov < price / std::max(kept.mean_life, 1.0) && kept.krylov_spent < price;
 }
 
+void NewtonStep::give_up_krylov() {
+    krylov_ = false;
+    krylov_failed_ = true;
+    factor_current_ = false;
+}
+
 bool NewtonStep::solve_by_krylov() {
     assemble_tangent();
     KeptFactorisation& kept = matrix_.kept;
     const double per_solve = std::max(kept.solve_seconds, 1e-9);
     const int cap = std::clamp(static_cast<int>(kKrylovBudget * kept.factorize_seconds / per_solve),
                                kKrylovMinIterations, kKrylovMaxIterations);
-    for (double& r_d : matrix_.residual) r_d = -r_d;
-    const PreconditionedCgResult cg = solve_preconditioned_cg(matrix_.system, *matrix_.solver, matrix_.residual.data(),
-                                                              matrix_.delta.data(), kKrylovForcing * s_.factor_reuse, cap);
-    for (double& r_d : matrix_.residual) r_d = -r_d;
+    const PreconditionedCgResult cg = solve_for_update([&](const double* minus_g, double* delta) {
+        return solve_preconditioned_cg(matrix_.system, *matrix_.solver, minus_g, delta, kKrylovForcing * s_.factor_reuse,
+                                       cap);
+    });
     result_.linear_iterations += cg.iterations;
     result_.solve_seconds += cg.seconds;
     // The iterations CG takes, a running mean over its solves with factorisations of this
@@ -374,13 +395,12 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
     failed = false;
     krylov_update_ = false;
     try {
-        if (krylov_ && factor_current_ && !krylov_failed_) {
+        if (krylov_ && factor_current_) {
             if (solve_by_krylov()) {
                 fresh_ = krylov_update_ = true;
                 return true;
             }
-            krylov_failed_ = true;  // the tangent is assembled: factorise it below
-            factor_current_ = false;
+            give_up_krylov();  // the tangent is assembled: factorise it below
         }
         if (!factor_current_ || stale_solves_ == kMaxStaleSolves) {
             matrix_.kept.valid = false;
@@ -399,9 +419,8 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
             fresh_ = true;
             stale_solves_ = 0;
         }
-        for (double& r_d : matrix_.residual) r_d = -r_d;
-        result_.linear_iterations += matrix_.solver->solve(matrix_.system, matrix_.residual.data(), matrix_.delta.data());
-        for (double& r_d : matrix_.residual) r_d = -r_d;
+        result_.linear_iterations += solve_for_update(
+            [&](const double* minus_g, double* delta) { return matrix_.solver->solve(matrix_.system, minus_g, delta); });
         result_.solve_seconds += matrix_.solver->solve_seconds;
         matrix_.kept.solve_seconds = matrix_.solver->solve_seconds;
     } catch (const Error& e) {
@@ -564,8 +583,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
                 continue;
             }
             if (krylov_update_) {  // an inexact update: factorise the tangent and solve exactly
-                krylov_failed_ = true;
-                factor_current_ = false;
+                give_up_krylov();
                 continue;
             }
             // No descent left along Newton's direction: converged if the residual is as small

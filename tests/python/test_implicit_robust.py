@@ -133,10 +133,12 @@ def drooping_cube_end(model, **settings):
 
 @pytest.mark.parametrize("model", ["corotational", "neohookean"])
 def test_default_step_under_large_rotation_stays_near_backward_euler(model):
-    # The default step takes one linearised update per step, solved with a kept factorisation
-    # or by CG preconditioned with it (an inexact Newton update); the converged backward Euler
-    # step (Newton to 1e-9, a factorisation per iteration) is the reference. Measured: 0.2-0.6 %
-    # of the displacement; backward Euler's own time error at this step is 10-20 %.
+    # The default step takes one linearised update per step, solved with a kept factorisation,
+    # a new one or CG preconditioned by the kept one, whichever its measured costs pick (so the
+    # path can differ between machines; CG's own correctness is test_preconditioned_cg's). The
+    # end state must stay near the converged backward Euler step (Newton to 1e-9, a
+    # factorisation per iteration) whatever the path. Measured: 0.2-0.6 % of the displacement;
+    # backward Euler's own time error at this step is 10-20 %.
     rest, reference = drooping_cube_end(model, newton_max_iterations=50, newton_tolerance=1e-9, factor_reuse=0.0)
     _, default = drooping_cube_end(model)
     displacement = np.abs(reference - rest).max()

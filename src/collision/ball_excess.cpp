@@ -19,48 +19,68 @@ double interpolated_energy(const LocalSimplex& s, const double w[3]) {
     return e;
 }
 
-// The root of f(r) = phi(r) - slope in [lo, hi], where f(lo) < 0 <= f(hi), to within tolerance:
-// regula falsi keeps the bracket, and the Illinois rule halves the value kept at an end that
-// stays put twice, so that the bracket shrinks from both sides. Bisects if a step would not
-// move (round-off), and stops after 100 steps whatever happens.
-template <class Phi>
-double refine_crossing(const Phi& phi, double slope, double lo, double f_lo, double hi, double f_hi, double tolerance) {
-    int kept = 0;  // +1: hi stayed put in a row, -1: lo did
-    for (int it = 0; it < 100 && hi - lo > tolerance; ++it) {
-        double r = hi - f_hi * (hi - lo) / (f_hi - f_lo);
-        if (!(r > lo && r < hi)) r = 0.5 * (lo + hi);
-        if (!(r > lo && r < hi)) break;
-        const double f = phi(r) - slope;
-        if (f >= 0.0) {
-            hi = r, f_hi = f;
-            f_lo *= kept < 0 ? 0.5 : 1.0;
-            kept = kept < 0 ? kept - 1 : -1;
-        } else {
-            lo = r, f_lo = f;
-            f_hi *= kept > 0 ? 0.5 : 1.0;
-            kept = kept > 0 ? kept + 1 : 1;
-        }
-    }
-    return f_hi == 0.0 ? hi : 0.5 * (lo + hi);
-}
-
 // A ball of radius R whose centre lies at distance `height` from a line or plane: along a ray
 // in that line or plane from the centre's foot, at offset r the ball's potential falls with
 // slope phi(r) = psi'(R - rho) r / rho, rho = sqrt(height^2 + r^2); phi rises from 0 and falls
-// back to 0 at the rim. The first r where phi reaches `slope` is where the potential minus a
-// linear interpolant of that slope stops rising: the local maximum. Returns -1 if phi stays
-// below slope. The first crossing is bracketed on a scan of the rim radius, then refined to
-// round-off by regula falsi with the Illinois modification (superlinear on a smooth phi: a few
-// evaluations instead of bisection's fifty; each evaluation is a contact law's power).
+// back to 0 at the rim.
+class BellSlope {
+public:
+    BellSlope(const DepthPotential& psi, double radius, double height) : psi_(psi), radius_(radius), height_(height) {}
+    double operator()(double r) const {
+        const double rho = std::sqrt(height_ * height_ + r * r);
+        return rho > 0.0 ? psi_.force(radius_ - rho) * r / rho : 0.0;
+    }
+    /// phi(r) and dphi/dr = psi' h^2 / rho^3 - psi'' r^2 / rho^2.
+    void with_rate(double r, double& value, double& rate) const {
+        const double rho = std::sqrt(height_ * height_ + r * r);
+        value = rate = 0.0;
+        if (!(rho > 0.0)) return;
+        double force, stiffness;
+        psi_.force_and_stiffness(radius_ - rho, force, stiffness);
+        value = force * r / rho;
+        rate = (force * height_ * height_ / rho - stiffness * r * r) / (rho * rho);
+    }
+
+private:
+    const DepthPotential& psi_;
+    double radius_, height_;
+};
+
+// The root of f(r) = phi(r) - slope in [lo, hi], where f(lo) < 0 <= f(hi), to within tolerance:
+// Newton's method from regula falsi's point (quadratic on a smooth phi: three or four of the
+// law's evaluations where the Illinois rule took ten), kept in the bracket, which every
+// evaluation narrows. A step that would leave the bracket, or a phi that does not rise there,
+// bisects instead. Stops when a step moves r by at most tolerance, and after 100 steps
+// whatever happens.
+double refine_crossing(const BellSlope& phi, double slope, double lo, double f_lo, double hi, double f_hi,
+                       double tolerance) {
+    double r = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+    for (int it = 0; it < 100; ++it) {
+        if (!(r > lo && r < hi)) r = 0.5 * (lo + hi);
+        if (!(r > lo && r < hi)) break;  // the bracket is at round-off
+        double value, rate;
+        phi.with_rate(r, value, rate);
+        const double f = value - slope;
+        if (f == 0.0) return r;
+        if (f > 0.0) hi = r;
+        else lo = r;
+        if (!(hi - lo > tolerance)) break;
+        const double step = rate > 0.0 ? -f / rate : 0.5 * (lo + hi) - r;
+        if (!(std::fabs(step) > tolerance)) return r + step;
+        r += step;
+    }
+    return 0.5 * (lo + hi);
+}
+
+// The first r where phi reaches `slope` is where the potential minus a linear interpolant of
+// that slope stops rising: the local maximum. Returns -1 if phi stays below slope. The first
+// crossing is bracketed on a scan of the rim radius, then refined to round-off.
 double first_crossing(const DepthPotential& psi, double radius, double height, double slope) {
     const double rim2 = radius * radius - height * height;
     if (!(rim2 > 0.0)) return -1.0;
     if (!(slope > 0.0)) return 0.0;
     const double rim = std::sqrt(rim2);
-    auto phi = [&](double r) {
-        const double rho = std::sqrt(height * height + r * r);
-        return rho > 0.0 ? psi.force(radius - rho) * r / rho : 0.0;
-    };
+    const BellSlope phi(psi, radius, height);
     constexpr int kScan = 16;
     double lo = 0.0, hi = -1.0, f_lo = -slope, f_hi = 0.0;  // phi(0) = 0
     for (int k = 1; k <= kScan; ++k) {

@@ -25,6 +25,11 @@ public:
     virtual double energy(double depth) const = 0;
     virtual double force(double depth) const = 0;
     virtual double stiffness(double depth) const = 0;
+    /// psi'(d) and psi''(d) together, for a law that finds both at the price of one.
+    virtual void force_and_stiffness(double depth, double& force, double& stiffness) const {
+        force = this->force(depth);
+        stiffness = this->stiffness(depth);
+    }
 };
 
 struct ShapeKind;

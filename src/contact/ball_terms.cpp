@@ -49,19 +49,32 @@ private:
 
 }  // namespace
 
-// The feature's bounding sphere: centre and radius (m).
-double feature_bounds(const double* const points[3], int count, double centre[3]) {
+FeatureBox::FeatureBox(const double* const points[3], int count) {
     for (int k = 0; k < 3; ++k) {
-        centre[k] = 0.0;
-        for (int a = 0; a < count; ++a) centre[k] += points[a][k] / count;
+        lo[k] = hi[k] = points[0][k];
+        for (int a = 1; a < count; ++a) {
+            lo[k] = std::min(lo[k], points[a][k]);
+            hi[k] = std::max(hi[k], points[a][k]);
+        }
     }
-    double radius = 0.0;
-    for (int a = 0; a < count; ++a) {
-        double d[3];
-        sub3(points[a], centre, d);
-        radius = std::max(radius, norm3(d));
+}
+
+double FeatureBox::bounding_sphere(double centre[3]) const {
+    double half[3];
+    for (int k = 0; k < 3; ++k) {
+        centre[k] = 0.5 * (lo[k] + hi[k]);
+        half[k] = 0.5 * (hi[k] - lo[k]);
     }
-    return radius;
+    return norm3(half);
+}
+
+double FeatureBox::distance2(const double p[3]) const {
+    double sum = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        const double gap = std::max({lo[k] - p[k], p[k] - hi[k], 0.0});
+        sum += gap * gap;
+    }
+    return sum;
 }
 
 void FeatureNodes::set(const Collider& collider, const double* x, const int32_t* nodes, int count) {

@@ -23,14 +23,27 @@ public:
     double energy(double depth) const override { return hunt_crossley_step_energy(params_, law_, depth); }
     double force(double depth) const override { return hunt_crossley_step(params_, law_, depth).force; }
     double stiffness(double depth) const override { return hunt_crossley_step(params_, law_, depth).stiffness; }
+    void force_and_stiffness(double depth, double& force, double& stiffness) const override {
+        const NormalForce fn = hunt_crossley_step(params_, law_, depth);
+        force = fn.force;
+        stiffness = fn.stiffness;
+    }
 
 private:
     const sh_contact_params& params_;
     const StepLaw& law_;
 };
 
-/// The centre (m, world) and radius (m) of the bounding sphere of a feature's count points.
-double feature_bounds(const double* const points[3], int count, double centre[3]);
+/// The axis-aligned box (world, m) around a feature's count points.
+struct FeatureBox {
+    double lo[3], hi[3];
+    FeatureBox(const double* const points[3], int count);
+    /// The centre of the box (out) and the radius (m) of the sphere around it that holds it.
+    double bounding_sphere(double centre[3]) const;
+    /// The squared distance (m^2) from p to the box (0 inside): no square root, so that a
+    /// ball that cannot reach the feature is told apart at the price of a few comparisons.
+    double distance2(const double p[3]) const;
+};
 
 /// The unit normal of the triangle of points; false (and zero) if it is a sliver or
 /// degenerate.
@@ -70,11 +83,15 @@ void for_each_ball_term(const Collider& collider, const StepLaw& law, const doub
     FeatureNodes feature;
     feature.set(collider, x, nodes, count);
     const double* const* points = feature.points;
-    double centre[3];
-    const double reach = feature_bounds(points, count, centre) + collider.shape.ball_radius();
-    int first = 0, last = -1;
-    collider.shape.balls_near(collider.pose, centre, reach, first, last);
-    if (first > last) return;
+    const FeatureBox box(points, count);
+    const double radius = collider.shape.ball_radius();
+    int first = 0, last = collider.shape.ball_count() - 1;
+    if (last > 0) {  // one ball needs no search: the box test below culls it
+        double centre[3];
+        const double reach = box.bounding_sphere(centre) + radius;
+        collider.shape.balls_near(collider.pose, centre, reach, first, last);
+        if (first > last) return;
+    }
     // The balls lie evenly spaced along a segment (Shape::ball_count): from the first's centre
     // in steps.
     double ball[3], step[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 0.0};
@@ -83,12 +100,14 @@ void for_each_ball_term(const Collider& collider, const StepLaw& law, const doub
         collider.shape.ball_centre(collider.pose, last, step);
         for (int k = 0; k < 3; ++k) step[k] = (step[k] - ball[k]) / (last - first);
     }
-    // A sliver's plane and closest point are round-off: only its bounds cull balls.
-    const bool flat = count == 3 && feature_normal(points, normal);
-    const double radius = collider.shape.ball_radius();
+    // A sliver's plane and closest point are round-off: only its bounds cull balls. The plane
+    // is found for the first ball that reaches the box.
+    bool flat = false, plane_known = count < 3;
     for (int i = first; i <= last; ++i, ball[0] += step[0], ball[1] += step[1], ball[2] += step[2]) {
         // A ball that does not reach the feature has no term there (most of those near it):
-        // first its plane, then the feature itself.
+        // first its box, then its plane, then the feature itself.
+        if (!(box.distance2(ball) < radius * radius)) continue;
+        if (!plane_known) flat = feature_normal(points, normal), plane_known = true;
         double offset[3];
         sub3(ball, points[0], offset);
         if (flat && !(std::fabs(dot3(offset, normal)) < radius)) continue;

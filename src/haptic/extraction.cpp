@@ -221,15 +221,26 @@ void HapticContext::fill_nodes(const FemBody& body, Buffer& out) {
 }
 
 // The tets' kernel blocks per material model, lanes over local numbers, spread like the full
-// model's.
+// model's. A tet all of whose nodes follow the full model (and none is held) moves nothing
+// the haptic side integrates or renders: its forces would fall on prescribed nodes only, so
+// it gets no lane (a tenth of a 500-tet buffer, its outer shell).
 void HapticContext::fill_blocks(const FemBody& body, Buffer& out) {
     const int32_t* elements = body.element_nodes();
+    moved_.assign(static_cast<size_t>(out.node_count), 0);
+    for (int32_t i = 0; i < out.node_count; ++i) moved_[static_cast<size_t>(i)] = out.inverse_mass[i] > 0.0;
+    for (int32_t h = 0; h < out.held_count; ++h) moved_[static_cast<size_t>(out.held[h])] = 1;
+    const auto moves_a_node = [&](int32_t t) {
+        bool moves = false;
+        for (int a = 0; a < 4; ++a)
+            moves = moves || moved_[static_cast<size_t>(local_of_[static_cast<size_t>(elements[4 * static_cast<size_t>(t) + a])])];
+        return moves;
+    };
     int32_t block = 0;
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         out.block_begin[model] = block;
         members_.clear();
         for (const int32_t t : chosen_)
-            if (body.material(static_cast<size_t>(t)).model == model) members_.push_back(t);
+            if (body.material(static_cast<size_t>(t)).model == model && moves_a_node(t)) members_.push_back(t);
         spread_over_lanes(members_.data(), members_.size(), [&](int32_t t, bool used, size_t k, int l) {
             int32_t local[4];
             for (int a = 0; a < 4; ++a) local[a] = local_of_[static_cast<size_t>(elements[4 * static_cast<size_t>(t) + a])];
@@ -316,18 +327,19 @@ void HapticContext::fill_surface_features(const FemBody& body, Buffer& out) {
     out.surface_node_count = surface;
 }
 
-void HapticContext::fill_buffer(const FemBody& body, const double gravity[3], double runaway_speed, Buffer& out) {
+void HapticContext::fill_buffer(const World& world, const Collider& tool, const FemBody& body, Buffer& out) {
     number_nodes(body, out);
     fill_nodes(body, out);
+    fill_held(world, tool, out);
     fill_blocks(body, out);
     fill_rotations(out);
     fill_triangles(body, out);
     fill_surface_features(body, out);
-    for (int k = 0; k < 3; ++k) out.gravity[k] = gravity[k];
+    for (int k = 0; k < 3; ++k) out.gravity[k] = world.gravity[k];
     out.damping_mass = body.damping_mass;
     out.damping_stiffness = body.damping_stiffness();
     out.dt_stable = body.stable_step_of(chosen_.data(), chosen_.size());
-    out.runaway_speed = runaway_speed;
+    out.runaway_speed = world.step_settings(out.body).runaway_speed;
 
     for (const int32_t node : ring_) local_of_[static_cast<size_t>(node)] = -1;
     for (const int32_t t : chosen_) in_buffer_[static_cast<size_t>(t)] = 0;
@@ -411,8 +423,7 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
     double line_a[3], line_b[3];
     contact_line(tool, near.point, line_a, line_b);
     select_tets(*near.fem, line_a, line_b, near.triangle, out);
-    fill_buffer(*near.fem, world.gravity, world.step_settings(near.body).runaway_speed, out);
-    fill_held(world, tool, out);
+    fill_buffer(world, tool, *near.fem, out);
 }
 
 }  // namespace sh

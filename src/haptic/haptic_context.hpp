@@ -81,7 +81,7 @@ private:
     void extract(World& world, double period, Buffer& out);
     void select_tets(const FemBody& body, const double line_a[3], const double line_b[3], int32_t seed_triangle,
                      Buffer& out);
-    void fill_buffer(const FemBody& body, const double gravity[3], double runaway_speed, Buffer& out);
+    void fill_buffer(const World& world, const Collider& tool, const FemBody& body, Buffer& out);
     void number_nodes(const FemBody& body, Buffer& out);
     void fill_nodes(const FemBody& body, Buffer& out);
     void fill_blocks(const FemBody& body, Buffer& out);
@@ -181,6 +181,7 @@ private:
     vec<int32_t> chosen_;                      ///< the buffer's tets (body numbers)
     vec<int32_t> ring_;                        ///< the buffer's body nodes, ascending
     vec<int32_t> members_;                     ///< the buffer's tets of one material model
+    vec<uint8_t> moved_;                       ///< per local node: free or held (its forces matter)
     vec<int32_t> neighbor_;                    ///< per buffer triangle side: the triangle across
     vec<uint8_t> other_contact_;               ///< per body node: in contact with something else
 };

@@ -44,6 +44,17 @@ void Shape::ball_centre(const Pose& pose, int i, double out[3]) const {
     pose.to_world(local, out);
 }
 
+BallRow Shape::ball_row(const Pose& pose) const {
+    BallRow row;
+    row.count = ball_count();
+    if (row.count == 0) return row;
+    ball_centre(pose, 0, row.first);
+    if (row.count == 1) return row;
+    ball_centre(pose, row.count - 1, row.step);
+    for (int k = 0; k < 3; ++k) row.step[k] = (row.step[k] - row.first[k]) / (row.count - 1);
+    return row;
+}
+
 void Shape::balls_near(const Pose& pose, const double x[3], double reach, int& first, int& last) const {
     first = 0;
     last = -1;

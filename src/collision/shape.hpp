@@ -34,6 +34,18 @@ public:
 
 struct ShapeKind;
 
+/// A shape's balls (Shape::ball_count) in the world at one pose: evenly spaced from the first
+/// centre by step.
+struct BallRow {
+    double first[3] = {0.0, 0.0, 0.0};  ///< ball 0's centre (m, world)
+    double step[3] = {0.0, 0.0, 0.0};   ///< from one ball's centre to the next (m)
+    int count = 0;
+    /// The centre of ball i.
+    void centre(int i, double out[3]) const {
+        for (int k = 0; k < 3; ++k) out[k] = first[k] + i * step[k];
+    }
+};
+
 /// A rigid shape in its local frame. Sphere and capsule are centred at the origin, the capsule
 /// along local z; the box is centred with half_extents; a convex hull's points are given in the
 /// local frame; a plane is the half-space below the plane z = 0 of its local frame (its
@@ -71,6 +83,9 @@ public:
 
     /// The world centre of ball i (0 <= i < ball_count()) at pose.
     void ball_centre(const Pose& pose, int i, double out[3]) const;
+
+    /// All the balls' centres at pose.
+    BallRow ball_row(const Pose& pose) const;
 
     /// The balls whose centres may lie within reach (m) of world point x at pose: from first
     /// to last (none if first > last, and for kinds without balls).

@@ -77,11 +77,15 @@ double FeatureBox::distance2(const double p[3]) const {
     return sum;
 }
 
-void FeatureNodes::set(const Collider& collider, const double* x, const int32_t* nodes, int count) {
-    own_depths = !collider.shape.ball_is_shape();
+FeatureNodes::FeatureNodes(const Collider& collider, const double* x, const int32_t* nodes, int count)
+    : count(count), own_depths(!collider.shape.ball_is_shape()), measured(false) {
+    for (int a = 0; a < count; ++a) points[a] = at(x, nodes[a]);
+}
+
+void FeatureNodes::measure(const Collider& collider) {
+    if (measured || !own_depths) return;
+    measured = true;
     for (int a = 0; a < count; ++a) {
-        points[a] = at(x, nodes[a]);
-        if (!own_depths) continue;
         Penetration pen;
         depth[a] = collider.shape.penetrate_point(collider.pose, points[a], pen) ? pen.depth : 0.0;
         for (int k = 0; k < 3; ++k) normal[a][k] = depth[a] > 0.0 ? pen.normal[k] : 0.0;

@@ -57,11 +57,16 @@ double feature_distance(const double* p, const double* const points[3], int coun
 /// balls, their depths (m, 0 outside) and push directions in it (a sphere's are its ball's).
 struct FeatureNodes {
     const double* points[3];
-    bool own_depths;  ///< depth and normal are set (the collider is not its one ball)
+    int count;
+    bool own_depths;  ///< depth and normal belong to the collider (it is not its one ball)
+    bool measured;    ///< depth and normal are set
     double depth[3];
     double normal[3][3];
-    /// Fills the count nodes at positions x against collider.
-    void set(const Collider& collider, const double* x, const int32_t* nodes, int count);
+    /// Takes the count nodes' positions from x, against collider.
+    FeatureNodes(const Collider& collider, const double* x, const int32_t* nodes, int count);
+    /// Sets depth and normal, once: the point queries are left until a ball reaches the
+    /// feature (most features near a tool have none).
+    void measure(const Collider& collider);
 };
 
 /// The excess term of the ball at centre (world; the collider's ball radius) over the edge
@@ -80,38 +85,33 @@ void for_each_ball_term(const Collider& collider, const StepLaw& law, const doub
                         double weight, Visit&& visit) {
     if (collider.shape.ball_count() == 0 || !(weight > 0.0)) return;
     const StepLawPotential psi(collider.params, law);
-    FeatureNodes feature;
-    feature.set(collider, x, nodes, count);
+    FeatureNodes feature(collider, x, nodes, count);
     const double* const* points = feature.points;
     const FeatureBox box(points, count);
     const double radius = collider.shape.ball_radius();
-    int first = 0, last = collider.shape.ball_count() - 1;
+    const BallRow& row = collider.balls();
+    int first = 0, last = row.count - 1;
     if (last > 0) {  // one ball needs no search: the box test below culls it
         double centre[3];
         const double reach = box.bounding_sphere(centre) + radius;
         collider.shape.balls_near(collider.pose, centre, reach, first, last);
         if (first > last) return;
     }
-    // The balls lie evenly spaced along a segment (Shape::ball_count): from the first's centre
-    // in steps.
-    double ball[3], step[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 0.0};
-    collider.shape.ball_centre(collider.pose, first, ball);
-    if (last > first) {
-        collider.shape.ball_centre(collider.pose, last, step);
-        for (int k = 0; k < 3; ++k) step[k] = (step[k] - ball[k]) / (last - first);
-    }
+    double ball[3], normal[3] = {0.0, 0.0, 0.0};
     // A sliver's plane and closest point are round-off: only its bounds cull balls. The plane
     // is found for the first ball that reaches the box.
     bool flat = false, plane_known = count < 3;
-    for (int i = first; i <= last; ++i, ball[0] += step[0], ball[1] += step[1], ball[2] += step[2]) {
+    for (int i = first; i <= last; ++i) {
         // A ball that does not reach the feature has no term there (most of those near it):
         // first its box, then its plane, then the feature itself.
+        row.centre(i, ball);
         if (!(box.distance2(ball) < radius * radius)) continue;
         if (!plane_known) flat = feature_normal(points, normal), plane_known = true;
         double offset[3];
         sub3(ball, points[0], offset);
         if (flat && !(std::fabs(dot3(offset, normal)) < radius)) continue;
         if (!(feature_distance(ball, points, count, flat) < radius)) continue;
+        feature.measure(collider);
         ContactPoint term;
         if (ball_term(collider, psi, feature, nodes, count, weight, ball, term)) visit(i, term);
     }

@@ -7,6 +7,8 @@
 
 #include <softhap/softhap.h>
 
+#include <cstring>
+
 namespace sh {
 
 /// Validates a contact law; messages name the field as prefix.field ("contact.stiffness").
@@ -46,6 +48,23 @@ struct Collider {
 
     /// Largest distance (m) any point of the shape travels between start and target.
     double travel() const;
+
+    /// The shape's balls at pose. A contact pass asks for them per surface feature at one
+    /// pose: they are kept for the last pose asked (so a collider serves one thread at a time,
+    /// as it does: the world's on the sim thread, a haptic context's copy on the device's).
+    const BallRow& balls() const {
+        if (!(balls_known_ && std::memcmp(&balls_pose_, &pose, sizeof(Pose)) == 0)) {
+            balls_ = shape.ball_row(pose);
+            balls_pose_ = pose;
+            balls_known_ = true;
+        }
+        return balls_;
+    }
+
+private:
+    mutable BallRow balls_;
+    mutable Pose balls_pose_;
+    mutable bool balls_known_ = false;
 };
 
 /// A normalised copy of a host quaternion (w, x, y, z); throws SH_ERR_INVALID_ARGUMENT

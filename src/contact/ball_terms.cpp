@@ -49,34 +49,6 @@ private:
 
 }  // namespace
 
-FeatureBox::FeatureBox(const double* const points[3], int count) {
-    for (int k = 0; k < 3; ++k) {
-        lo[k] = hi[k] = points[0][k];
-        for (int a = 1; a < count; ++a) {
-            lo[k] = std::min(lo[k], points[a][k]);
-            hi[k] = std::max(hi[k], points[a][k]);
-        }
-    }
-}
-
-double FeatureBox::bounding_sphere(double centre[3]) const {
-    double half[3];
-    for (int k = 0; k < 3; ++k) {
-        centre[k] = 0.5 * (lo[k] + hi[k]);
-        half[k] = 0.5 * (hi[k] - lo[k]);
-    }
-    return norm3(half);
-}
-
-double FeatureBox::distance2(const double p[3]) const {
-    double sum = 0.0;
-    for (int k = 0; k < 3; ++k) {
-        const double gap = std::max({lo[k] - p[k], p[k] - hi[k], 0.0});
-        sum += gap * gap;
-    }
-    return sum;
-}
-
 FeatureNodes::FeatureNodes(const Collider& collider, const double* x, const int32_t* nodes, int count)
     : count(count), own_depths(!collider.shape.ball_is_shape()), measured(false) {
     for (int a = 0; a < count; ++a) points[a] = at(x, nodes[a]);

@@ -10,6 +10,7 @@
 #include "contact/hunt_crossley.hpp"
 #include "core/vec3.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <cstdint>
@@ -34,15 +35,38 @@ private:
     const StepLaw& law_;
 };
 
-/// The axis-aligned box (world, m) around a feature's count points.
+/// The axis-aligned box (world, m) around a feature's count points. Inline: a contact pass
+/// builds one for every surface edge and triangle near the tool, most only to cull them.
 struct FeatureBox {
     double lo[3], hi[3];
-    FeatureBox(const double* const points[3], int count);
+    FeatureBox(const double* const points[3], int count) {
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = hi[k] = points[0][k];
+            for (int a = 1; a < count; ++a) {
+                lo[k] = std::min(lo[k], points[a][k]);
+                hi[k] = std::max(hi[k], points[a][k]);
+            }
+        }
+    }
     /// The centre of the box (out) and the radius (m) of the sphere around it that holds it.
-    double bounding_sphere(double centre[3]) const;
+    double bounding_sphere(double centre[3]) const {
+        double half[3];
+        for (int k = 0; k < 3; ++k) {
+            centre[k] = 0.5 * (lo[k] + hi[k]);
+            half[k] = 0.5 * (hi[k] - lo[k]);
+        }
+        return norm3(half);
+    }
     /// The squared distance (m^2) from p to the box (0 inside): no square root, so that a
     /// ball that cannot reach the feature is told apart at the price of a few comparisons.
-    double distance2(const double p[3]) const;
+    double distance2(const double p[3]) const {
+        double sum = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            const double gap = std::max(std::max(lo[k] - p[k], p[k] - hi[k]), 0.0);
+            sum += gap * gap;
+        }
+        return sum;
+    }
 };
 
 /// The unit normal of the triangle of points; false (and zero) if it is a sliver or

@@ -1,6 +1,7 @@
 // The haptic side of the Volumetric Buffer Model: take the newest buffer, step it explicitly
 // to the device pose in the context's fixed memory, and render the tool's force. Nothing here
 // allocates, locks, logs or throws.
+#include "contact/ball_terms.hpp"
 #include "contact/hunt_crossley.hpp"
 #include "contact/shape_contact.hpp"
 #include "core/vec3.hpp"
@@ -31,17 +32,31 @@ constexpr double kLongestStep = 1.0;
 // turn by about 1e-4 rad per tick while pressed; the default's 1e-6 takes two).
 constexpr double kBufferRotationSettled2 = 1e-8;
 
-bool boxes_overlap(const double lo[3], const double hi[3], const double* a, const double* b, const double* c) {
-    for (int k = 0; k < 3; ++k) {
-        const double t_lo = std::min({a[k], b[k], c[k]}), t_hi = std::max({a[k], b[k], c[k]});
-        if (t_hi < lo[k] || t_lo > hi[k]) return false;
+// Where the tool may touch the buffer this pass: its bounding box, and for a sphere the
+// sphere itself (its one ball is the shape: a node or feature beyond it has no term), which
+// culls about half of the surface features a box lets through.
+class ToolReach {
+public:
+    explicit ToolReach(const Collider& tool) {
+        tool.shape.bounds(tool.pose, 0.0, lo_, hi_);
+        sphere_ = tool.shape.ball_is_shape();
+        if (!sphere_) return;
+        const BallRow& row = tool.balls();
+        for (int k = 0; k < 3; ++k) centre_[k] = row.first[k];
+        radius2_ = tool.shape.ball_radius() * tool.shape.ball_radius();
     }
-    return true;
-}
+    /// False if no point of the count nodes' box can be in the tool.
+    bool may_touch(const double* const points[3], int count) const {
+        const FeatureBox box(points, count);
+        for (int k = 0; k < 3; ++k)
+            if (box.hi[k] < lo_[k] || box.lo[k] > hi_[k]) return false;
+        return !sphere_ || box.distance2(centre_) < radius2_;
+    }
 
-bool inside_box(const double lo[3], const double hi[3], const double* p) {
-    return p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] && p[2] <= hi[2];
-}
+private:
+    double lo_[3], hi_[3], centre_[3] = {0.0, 0.0, 0.0}, radius2_ = 0.0;
+    bool sphere_ = false;
+};
 
 void add_reaction(const ContactPoint& p, const double* x, const double tool_position[3], double force[3],
                   double torque[3]) {
@@ -58,24 +73,24 @@ void add_reaction(const ContactPoint& p, const double* x, const double tool_posi
 }
 
 // Calls visit(nodes, count, size) for each term of the contact potential (shape_contact.hpp)
-// over buffer b's surface whose nodes' box at x meets lo..hi: per surface node its depth's
-// term (count 1), per edge (count 2) and per triangle (count 3) their excess terms with the
+// over buffer b's surface at x that the tool may reach: per surface node its depth's term
+// (count 1), per edge (count 2) and per triangle (count 3) their excess terms with the
 // feature's size.
 template <class Visit>
-void visit_terms_in_box(const Buffer& b, const double* x, const double lo[3], const double hi[3], Visit&& visit) {
+void visit_terms_in_reach(const Buffer& b, const double* x, const ToolReach& reach, Visit&& visit) {
+    const auto near = [&](const int32_t* nodes, int count) {
+        const double* const points[3] = {at(x, nodes[0]), at(x, nodes[count > 1 ? 1 : 0]), at(x, nodes[count - 1])};
+        return reach.may_touch(points, count);
+    };
     for (int32_t s = 0; s < b.surface_node_count; ++s)
-        if (inside_box(lo, hi, at(x, b.surface_nodes[s]))) visit(&b.surface_nodes[s], 1, 0.0);
-    for (int32_t e = 0; e < b.edge_count; ++e) {
-        const int32_t* edge = b.edges + 2 * e;
-        if (boxes_overlap(lo, hi, at(x, edge[0]), at(x, edge[1]), at(x, edge[1]))) visit(edge, 2, b.edge_size[e]);
-    }
-    for (int32_t t = 0; t < b.triangle_count; ++t) {
-        const int32_t* face = b.triangles + 3 * t;
-        if (boxes_overlap(lo, hi, at(x, face[0]), at(x, face[1]), at(x, face[2]))) visit(face, 3, b.triangle_size[t]);
-    }
+        if (near(&b.surface_nodes[s], 1)) visit(&b.surface_nodes[s], 1, 0.0);
+    for (int32_t e = 0; e < b.edge_count; ++e)
+        if (near(b.edges + 2 * e, 2)) visit(b.edges + 2 * e, 2, b.edge_size[e]);
+    for (int32_t t = 0; t < b.triangle_count; ++t)
+        if (near(b.triangles + 3 * t, 3)) visit(b.triangles + 3 * t, 3, b.triangle_size[t]);
 }
 
-// The tool's term of visit_terms_in_box at rest (the buffer is explicit: the depth rate's
+// The tool's term of visit_terms_in_reach at rest (the buffer is explicit: the depth rate's
 // damping comes after, from the velocities).
 bool term_contact(const Collider& tool, const double* x, const int32_t* nodes, int count, double size,
                   const BallMix& balls, ContactPoint& out) {
@@ -311,18 +326,17 @@ void HapticContext::add_mixed_bound(int32_t node, double bound) {
 
 void HapticContext::add_contact_forces(const Buffer& b, const double* x, const double* v, double* f, double force[3],
                                        double torque[3], bool& contact) {
-    double lo[3], hi[3];
-    tool_.shape.bounds(tool_.pose, 0.0, lo, hi);
+    const ToolReach reach(tool_);
     const sh_contact_params& law = tool_.params;
     clear_contact();
     if (tool_.shape.mixes_balls()) {  // their mix first (BallMix)
         balls_.sum(tool_, [&](auto&& add) {
-            visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
+            visit_terms_in_reach(b, x, reach, [&](const int32_t* nodes, int count, double size) {
                 if (count > 1) add(hunt_crossley_step_law(law, 0.0, 0.0), x, nodes, count, excess_weight(tool_, size));
             });
         });
     }
-    visit_terms_in_box(b, x, lo, hi, [&](const int32_t* nodes, int count, double size) {
+    visit_terms_in_reach(b, x, reach, [&](const int32_t* nodes, int count, double size) {
         ContactPoint p;
         if (!term_contact(tool_, x, nodes, count, size, balls_, p)) return;
         double vrel[3];

@@ -39,6 +39,10 @@
  *  - "haptic/overhead": the fixed cost: the tool 1 m above the block, so the buffer is empty
  *    and the step renders the (untouched) proxy plane: per-call times, and the median of
  *    kBatches batches of kBatch calls timed together (no clock read per call).
+ *  - "haptic/machine/<T>us": no haptic step at all: a chain of dependent multiply-adds whose
+ *    median is calibrated to T us (15 and 25), timed like the ticks. Its p99.9 and max are the
+ *    tail this machine adds to any computation that long (interrupts, other processes): a
+ *    step's p99.9 near it is the machine's, not the step's.
  * Per case: median, p99, p99.9, max and mean of the step time (us), sub-steps per step (median
  * and max), ns per tet and per tet and sub-step (median / buffer tets [/ median sub-steps]).
  *

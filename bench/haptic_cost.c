@@ -294,8 +294,49 @@ static void overhead_case(const tissue* block, const haptic_options* options) {
 
 /* ------------------------------------------------------------------------------------------ */
 
-/* The overhead, every material at every buffer size frozen, the rate cases, then corotational
- * beside the sim thread. */
+/* The machine's own tail under a step of a given length: a chain of dependent multiply-adds
+ * (no memory, no calls, nothing to vary) timed like a tick, back to back, its length calibrated
+ * so that its median is target_us. Its p99.9 and max are what interrupts and other processes
+ * add to any step that long on this machine: the floor under a haptic step's tail. */
+static volatile double work_sink = 1.0; /* read and written, so the chain is done */
+
+static void fixed_work(long length) {
+    double a = work_sink;
+    for (long k = 0; k < length; ++k) a = a * 1.0000001 + 1e-9;
+    work_sink = a;
+}
+
+static double median_of_work(long length, int count, double* ns) {
+    for (int i = 0; i < count; ++i) {
+        const double t0 = now_ns();
+        fixed_work(length);
+        ns[i] = now_ns() - t0;
+    }
+    return summarize(ns, count).median;
+}
+
+static void machine_case(double target_us, const haptic_options* options) {
+    char name[64];
+    snprintf(name, sizeof name, "haptic/machine/%gus", target_us);
+    if (!name_matches(name, options->filter)) return;
+    const int count = options->steps > 0 ? options->steps : kTimedTicks;
+    double* ns = malloc((size_t)count * sizeof(double));
+    long length = 10000;
+    for (int round = 0; round < 3; ++round)  /* the loop's speed is the machine's: scale to it */
+        length = (long)(length * target_us * 1e3 / median_of_work(length, 2000, ns));
+    median_of_work(length, count, ns);
+    const stats t = summarize(ns, count);
+    printf("{\"study\":\"haptic_machine\",\"case\":\"%s\",\"steps\":%d,\"multiply_adds\":%ld,", name, t.count, length);
+    print_times_us("", &t);
+    printf(",\"rt\":%d}\n", options->rt);
+    fflush(stdout);
+    fprintf(stderr, "%s: a fixed %.1f us of arithmetic: p99.9 %.2f us, max %.2f us\n", name, t.median * 1e-3,
+            t.p999 * 1e-3, t.max * 1e-3);
+    free(ns);
+}
+
+/* The overhead, the machine's tail, every material at every buffer size frozen, the rate
+ * cases, then corotational beside the sim thread. */
 int haptic_run_cost(const haptic_options* options) {
     static const sh_material_model kModels[] = {SH_MATERIAL_COROTATIONAL, SH_MATERIAL_LINEAR, SH_MATERIAL_STVK,
                                                  SH_MATERIAL_NEOHOOKEAN};
@@ -304,6 +345,8 @@ int haptic_run_cost(const haptic_options* options) {
     fprintf(stderr, "haptic: block %d tets, %d nodes (%d fixed); counting allocator installed\n", block.tet_count,
             block.node_count, block.fixed_count);
     overhead_case(&block, options);
+    machine_case(15.0, options);
+    machine_case(25.0, options);
     for (size_t m = 0; m < sizeof kModels / sizeof kModels[0]; ++m)
         for (int k = 0; k < sizes; ++k) {
             const cost_setup c = material_setup(kModels[m], kCostSizes[k], 0);

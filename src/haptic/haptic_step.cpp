@@ -10,7 +10,7 @@
 #include "model/fem_kernel.hpp"
 #include "solver/substeps.hpp"
 
-#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -259,7 +259,7 @@ void HapticContext::integrate(const Buffer& b, double h, double* x, double* v, d
             const Eigen::Map<const Eigen::Matrix3d> damping_c(tangent + 9);
             const Eigen::Map<const Eigen::Vector3d> v0(vi), f(at(force_, i));
             const Eigen::Matrix3d a = Eigen::Matrix3d::Identity() + w * (h * h * stiffness + h * damping_c);
-            const Eigen::Vector3d v1 = a.llt().solve(v0 + w * h * (f + damping_c * v0));
+            const Eigen::Vector3d v1 = a.inverse() * (v0 + w * h * (f + damping_c * v0));  // SPD, near I: cofactors
             const Eigen::Vector3d received = -(h * (stiffness * v1 - tangent[18] * v1) + damping_c * (v1 - v0));
             double arm[3], t[3];
             sub3(at(x, i), tool_.pose.p, arm);

@@ -46,8 +46,10 @@ struct CorotationalMaterial {
         return rotated_stress(state.R, dF, lambda, mu, false);
     }
     /// psi(F).
-    static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) {
-        return isotropic_energy(sym_part(mul_tn(polar_rotation(F), F), 1.0), lambda, mu);
+    static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) { return energy_at(F, polar_rotation(F), lambda, mu); }
+    /// psi(F) with R, F's polar rotation, already found.
+    static SH_INLINE Lanes energy_at(const Mat3L& F, const Mat3L& R, Lanes lambda, Lanes mu) {
+        return isotropic_energy(sym_part(mul_tn(R, F), 1.0), lambda, mu);
     }
 };
 

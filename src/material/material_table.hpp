@@ -15,7 +15,8 @@
 //                                           settled2), the stress with R found from a
 //                                           rotation near it (polar_rotation_near): a
 //                                           caller that keeps each element's R between force
-//                                           passes warm-starts the next (fem_kernel.hpp)
+//                                           passes warm-starts the next (fem_kernel.hpp),
+//                                           and energy_at(F, R, lambda, mu), psi with R given
 //   State                                   what stress() computes that differential() reuses
 //   jacobian(F, state)                      det F, for the inverted-element count
 //   stress(F, lambda, mu, state)            the first Piola-Kirchhoff stress P(F)

@@ -139,6 +139,12 @@ void FemBody::element_from_source(const GrownNodes& grown, const int32_t* tet, i
     }
 }
 
+void FemBody::keep_rotating(RotatingBlocks& blocks) {
+    for_each_material([&](auto material, int model) {
+        if (!decltype(material)::kRotates) blocks[model] = 0;
+    });
+}
+
 vec<double> FemBody::lumped_mass(const ElementSet& set, size_t node_count) {
     vec<double> m(node_count, 0.0);
     for (size_t t = 0; t < set.volume.size(); ++t)
@@ -173,6 +179,10 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
         if (set.omega2[t] < 0.0) set.omega2[t] = element_max_frequency_squared(&set.inverse_rest[9 * t], set.volume[t], set.materials[t]);
         largest = std::max(largest, set.omega2[t]);
     }
+    RotatingBlocks rotating;
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) rotating[model] = new_blocks[model].size();
+    keep_rotating(rotating);
+    rotations_.reserve(rotating);
     // Commit: nothing below allocates.
     if (grown) {
         adopt_nodes(*grown);
@@ -191,6 +201,7 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
     mass.swap(new_mass);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) blocks_[model].swap(new_blocks[model]);
     lane_of_.swap(new_lane_of);
+    rotations_.fit(rotating);
     vacant_lanes_ = 0;
     ++matrix_version;
     update_inverse_mass();
@@ -262,8 +273,10 @@ void FemBody::add_internal_forces(const double* xs, const double* vs, double* f)
     const double* damped_v = damping_stiffness_ > 0.0 ? vs : nullptr;
     int32_t inverted = 0;
     for_each_material([&](auto material, int model) {
+        using Material = decltype(material);
         const vec<TetBlock>& blocks = blocks_[model];
-        inverted += add_fem_forces<decltype(material)>(blocks.data(), blocks.size(), xs, damped_v, damping_stiffness_, f);
+        const KeptRotations kept = rotations_.pass(model);
+        inverted += add_fem_forces<Material>(blocks.data(), blocks.size(), xs, damped_v, damping_stiffness_, f, kept);
     });
     inverted_elements_ = std::max(inverted_elements_, inverted);
 }
@@ -271,8 +284,10 @@ void FemBody::add_internal_forces(const double* xs, const double* vs, double* f)
 double FemBody::elastic_energy(const double* xs) const {
     double energy = 0.0;
     for_each_material([&](auto material, int model) {
+        using Material = decltype(material);
         const vec<TetBlock>& blocks = blocks_[model];
-        energy += fem_energy<decltype(material)>(blocks.data(), blocks.size(), xs);
+        const KeptRotations kept = rotations_.pass(model);
+        energy += fem_energy<Material>(blocks.data(), blocks.size(), xs, kept);
     });
     return energy;
 }

@@ -3,6 +3,7 @@
 
 #include "mesh/surface_index.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "model/block_rotations.hpp"
 #include "model/body.hpp"
 #include "model/tet_block.hpp"
 
@@ -119,6 +120,8 @@ private:
     void change_locally(GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source, const vec<int32_t>& changed);
     /// Empties the lane of body tet t (zero weights, a live tet's shape).
     void vacate_lane(size_t t);
+    /// Zeroes the block counts of the models whose law keeps no rotation (BlockRotations).
+    static void keep_rotating(RotatingBlocks& blocks);
     /// Lumped masses of set over node_count nodes.
     static vec<double> lumped_mass(const ElementSet& set, size_t node_count);
     /// fill_lane for tet t of set.
@@ -136,6 +139,7 @@ private:
     vec<double> volume_;         ///< V0 per tet
     vec<sh_material> materials_; ///< per tet
     vec<TetBlock> blocks_[SH_MATERIAL_COUNT];  ///< per sh_material_model
+    mutable BlockRotations rotations_;         ///< the corotational blocks' last rotations
     double damping_stiffness_;
     mutable double stable_step_ = 0.0;       ///< 2/omega_max at rest, with stiffness damping
     mutable bool stable_step_known_ = false; ///< false after a local change, until asked for

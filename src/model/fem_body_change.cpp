@@ -83,6 +83,10 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
     reserve_growing(materials_, new_count), reserve_growing(element_omega2_, new_count), reserve_growing(lane_of_, new_count);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
         reserve_growing(blocks_[model], blocks_[model].size() + added[model].size());
+    RotatingBlocks rotating;
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) rotating[model] = blocks_[model].size() + added[model].size();
+    keep_rotating(rotating);
+    rotations_.reserve(rotating);
     surface_index_.reserve(surface_triangles, surface, grown.node_count());
 
     // Commit: nothing below allocates.
@@ -104,6 +108,7 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
         blocks_[model].insert(blocks_[model].end(), added[model].begin(), added[model].end());
     stable_step_known_ = false;  // new pieces' frequencies are found when the step is asked for
+    rotations_.fit(rotating);    // vacated lanes now repeat other tets
     ++matrix_version;
 }
 

@@ -128,7 +128,7 @@ SH_INLINE Mat3L gather_edges(const TetBlock& b, const double* p) {
 /// (the material table's kRotates; other laws ignore it): block k's rotations are found from
 /// near[k] (a warm start: the last pass's, or the ones fem_rotations gave), and written to
 /// kept[k], each to within settled2 (polar_rotation_near). near and kept may be the same
-/// array. Both null: each pass finds them from F alone.
+/// array. near null: found from F alone, and written to kept unless it is null too.
 struct KeptRotations {
     const Mat3L* near = nullptr;
     Mat3L* kept = nullptr;
@@ -141,13 +141,27 @@ template <class Material>
 SH_INLINE Mat3L block_stress(const Mat3L& F, const TetBlock& b, size_t k, const KeptRotations& rotations,
                              typename Material::State& state) {
     if constexpr (Material::kRotates) {
-        if (rotations.near) {
-            const Mat3L P = Material::stress_near(F, b.lambda_w, b.mu_w, state, rotations.near[k], rotations.settled2);
+        if (rotations.kept) {
+            const Mat3L P = rotations.near ? Material::stress_near(F, b.lambda_w, b.mu_w, state, rotations.near[k], rotations.settled2)
+                                           : Material::stress(F, b.lambda_w, b.mu_w, state);
             rotations.kept[k] = state.R;
             return P;
         }
     }
     return Material::stress(F, b.lambda_w, b.mu_w, state);
+}
+
+/// Block k's -V0 psi(F), its rotation kept as block_stress keeps it.
+template <class Material>
+SH_INLINE Lanes block_energy(const Mat3L& F, const TetBlock& b, size_t k, const KeptRotations& rotations) {
+    if constexpr (Material::kRotates) {
+        if (rotations.kept) {
+            const Mat3L R = rotations.near ? polar_rotation_near(F, rotations.near[k], rotations.settled2) : polar_rotation(F);
+            rotations.kept[k] = R;
+            return Material::energy_at(F, R, b.lambda_w, b.mu_w);
+        }
+    }
+    return Material::energy(F, b.lambda_w, b.mu_w);
 }
 
 /// The force loop; Damped adds -beta K(x) v through the material's differential.
@@ -194,14 +208,15 @@ void fem_rotations(const TetBlock* blocks, size_t block_count, const double* x, 
         for (size_t k = 0; k < block_count; ++k) out[k] = polar_rotation(mul(gather_edges(blocks[k], x), blocks[k].Bm));
 }
 
-/// Elastic energy of blocks at positions x (J).
+/// Elastic energy of blocks at positions x (J). rotations: see KeptRotations.
 template <class Material>
-double fem_energy(const TetBlock* blocks, size_t block_count, const double* x) {
+double fem_energy(const TetBlock* blocks, size_t block_count, const double* x,
+                  const KeptRotations& rotations = KeptRotations{}) {
     Lanes sum = Lanes{};
     for (size_t k = 0; k < block_count; ++k) {
         const TetBlock& b = blocks[k];
         const Mat3L F = mul(gather_edges(b, x), b.Bm);
-        sum -= Material::energy(F, b.lambda_w, b.mu_w);  // the weights carry -V0
+        sum -= block_energy<Material>(F, b, k, rotations);  // the weights carry -V0
     }
     return lane_sum(sum);
 }

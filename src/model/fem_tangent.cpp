@@ -19,11 +19,17 @@ namespace {
 
 using Matrix9 = StressDerivative;
 
-// dP/dF per lane of a batch of elements of one material model.
+// dP/dF per lane of a batch of elements of one material model; a law that keeps a rotation
+// finds it from near where the caller has one (the body's last pass's: see BlockRotations).
 template <class Material>
-void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, Matrix9 (&C)[kLanes]) {
+void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* near, Matrix9 (&C)[kLanes]) {
     typename Material::State state;
-    Material::stress(F, lambda, mu, state);
+    if constexpr (Material::kRotates) {
+        if (near) Material::stress_near(F, lambda, mu, state, *near, kRotationSettled2);
+        else Material::stress(F, lambda, mu, state);
+    } else {
+        Material::stress(F, lambda, mu, state);
+    }
     for (int q = 0; q < 9; ++q) {
         Mat3L dF{};
         dF.m[q / 3][q % 3] = splat(1.0);
@@ -52,6 +58,13 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
     auto process = [&](int model, const int32_t* members, int count) {
         Mat3L F = identity_lanes();
         Lanes lambda = splat(1.0), mu = splat(1.0);
+        const Mat3L* last = rotations_.last(model);
+        Mat3L near = identity_lanes();
+        for (int l = 0; l < count && last; ++l) {
+            const int32_t lane = lane_of_[static_cast<size_t>(members[l])];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) near.m[i][j][l] = last[lane / kLanes].m[i][j][lane % kLanes];
+        }
         for (int l = 0; l < count; ++l) {
             const size_t t = static_cast<size_t>(members[l]);
             const int32_t* tet = &tets_[4 * t];
@@ -69,7 +82,7 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
         bool project = false;
         visit_material(model, [&](auto law) {
             using Law = decltype(law);
-            stress_derivatives<Law>(F, lambda, mu, C);
+            stress_derivatives<Law>(F, lambda, mu, last ? &near : nullptr, C);
             project = Law::kProjectTangent;
         });
         for (int l = 0; l < count; ++l) {

@@ -11,6 +11,10 @@ proxy only and its C cost is small next to the wrapper's (the quantity measured 
 context of 15 mm at 10 kHz (so each world step also extracts its buffer). Each call is timed
 on its own with time.perf_counter().
 
+"python/machine_busy_loop" is a pure-Python loop whose median is calibrated to the block case's:
+its p99.9 is what this machine and the interpreter add to any call that long (the floor under
+the block case's p99.9).
+
 "python/haptic_step_block500_stiff" is softhap_bench's haptic/rate/10000hz/stiff/500 case from
 Python: the 6 x 6 x 3 cm block (12 x 12 x 6 Kuhn-split cells, 5184 tets, corotational, 15 kPa,
 nu 0.45, mass damping 5/s, base fixed), a 1 cm sphere of 2e5 N/m^1.5 pressed 3 mm into its
@@ -77,6 +81,25 @@ def main():
         emit("python/world_step_no_report", steps, median, p999, tets=mesh.tet_count)
     median, p999 = block_press(args.calls)
     emit("python/haptic_step_block500_stiff", args.calls, median, p999, buffer_tets=500, rate_hz=10000)
+    length = busy_length(median)
+    median_busy, p999_busy = timed(lambda: busy(length), args.calls)
+    emit("python/machine_busy_loop", args.calls, median_busy, p999_busy, loop_length=length)
+
+
+def busy(length):
+    """A pure-Python loop of length iterations: no allocation, no call into C."""
+    for _ in range(length):
+        pass
+
+
+def busy_length(target_us):
+    """The busy() length whose median is target_us on this machine: timed like a call, its
+    p99.9 is the tail the machine and the interpreter add to any call that long."""
+    length = 100
+    for _ in range(3):
+        median, _ = timed(lambda: busy(length), 2000)
+        length = max(1, int(length * target_us / median))
+    return length
 
 
 def block_press(calls):

@@ -320,10 +320,15 @@ static void machine_case(double target_us, const haptic_options* options) {
     snprintf(name, sizeof name, "haptic/machine/%gus", target_us);
     if (!name_matches(name, options->filter)) return;
     const int count = options->steps > 0 ? options->steps : kTimedTicks;
-    double* ns = malloc((size_t)count * sizeof(double));
+    enum { kCalibration = 2000 }; /* calls per calibration round */
+    double* ns = malloc((size_t)(count > kCalibration ? count : kCalibration) * sizeof(double));
+    if (!ns) {
+        fprintf(stderr, "%s: out of memory\n", name);
+        return;
+    }
     long length = 10000;
     for (int round = 0; round < 3; ++round)  /* the loop's speed is the machine's: scale to it */
-        length = (long)(length * target_us * 1e3 / median_of_work(length, 2000, ns));
+        length = (long)(length * target_us * 1e3 / median_of_work(length, kCalibration, ns));
     median_of_work(length, count, ns);
     const stats t = summarize(ns, count);
     printf("{\"study\":\"haptic_machine\",\"case\":\"%s\",\"steps\":%d,\"multiply_adds\":%ld,", name, t.count, length);

@@ -22,39 +22,49 @@ double interpolated_energy(const LocalSimplex& s, const double w[3]) {
 // A ball of radius R whose centre lies at distance `height` from a line or plane: along a ray
 // in that line or plane from the centre's foot, at offset r the ball's potential falls with
 // slope phi(r) = psi'(R - rho) r / rho, rho = sqrt(height^2 + r^2); phi rises from 0 and falls
-// back to 0 at the rim.
+// back to 0 at the rim. The depth R - rho is taken as ((R - h)(R + h) - r^2) / (R + rho): where
+// the ball barely reaches (h near R) the plain difference keeps few of its digits, and a noisy
+// phi keeps Newton's steps from settling.
 class BellSlope {
 public:
-    BellSlope(const DepthPotential& psi, double radius, double height) : psi_(psi), radius_(radius), height_(height) {}
+    BellSlope(const DepthPotential& psi, double radius, double height)
+        : psi_(psi), radius_(radius), height2_(height * height),
+          rim2_((radius - std::fabs(height)) * (radius + std::fabs(height))) {}
+    /// R^2 - h^2 (m^2): the squared radius of the ball's disc on the line or plane.
+    double rim2() const { return rim2_; }
     double operator()(double r) const {
-        const double rho = std::sqrt(height_ * height_ + r * r);
-        return rho > 0.0 ? psi_.force(radius_ - rho) * r / rho : 0.0;
+        const double rho = std::sqrt(height2_ + r * r);
+        return rho > 0.0 ? psi_.force(depth(r, rho)) * r / rho : 0.0;
     }
     /// phi(r) and dphi/dr = psi' h^2 / rho^3 - psi'' r^2 / rho^2.
     void with_rate(double r, double& value, double& rate) const {
-        const double rho = std::sqrt(height_ * height_ + r * r);
+        const double rho = std::sqrt(height2_ + r * r);
         value = rate = 0.0;
         if (!(rho > 0.0)) return;
         double force, stiffness;
-        psi_.force_and_stiffness(radius_ - rho, force, stiffness);
+        psi_.force_and_stiffness(depth(r, rho), force, stiffness);
         value = force * r / rho;
-        rate = (force * height_ * height_ / rho - stiffness * r * r) / (rho * rho);
+        rate = (force * height2_ / rho - stiffness * r * r) / (rho * rho);
     }
 
 private:
+    double depth(double r, double rho) const { return (rim2_ - r * r) / (radius_ + rho); }
+
     const DepthPotential& psi_;
-    double radius_, height_;
+    double radius_, height2_, rim2_;
 };
 
 // The root of f(r) = phi(r) - slope in [lo, hi], where f(lo) < 0 <= f(hi), to within tolerance:
-// Newton's method from regula falsi's point (quadratic on a smooth phi: three or four of the
-// law's evaluations where the Illinois rule took ten), kept in the bracket, which every
-// evaluation narrows. A step that would leave the bracket, or a phi that does not rise there,
-// bisects instead. Stops when a step moves r by at most tolerance, and after 100 steps
-// whatever happens.
+// Newton's method (quadratic on a smooth phi, with phi' from the law's own stiffness: a few of
+// the law's evaluations per crossing) from regula falsi's point, kept in the bracket, which
+// every evaluation narrows. It bisects where a Newton step would leave the bracket, where phi
+// does not rise, or where a step is not under half the one before the last (a slow approach,
+// as near phi's maximum), so that it can never do worse than bisection. Stops when a step
+// moves r by at most tolerance, and after 100 steps whatever happens.
 double refine_crossing(const BellSlope& phi, double slope, double lo, double f_lo, double hi, double f_hi,
                        double tolerance) {
     double r = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+    double last = hi - lo, before_last = hi - lo;  // the last two steps' lengths
     for (int it = 0; it < 100; ++it) {
         if (!(r > lo && r < hi)) r = 0.5 * (lo + hi);
         if (!(r > lo && r < hi)) break;  // the bracket is at round-off
@@ -65,8 +75,12 @@ double refine_crossing(const BellSlope& phi, double slope, double lo, double f_l
         if (f > 0.0) hi = r;
         else lo = r;
         if (!(hi - lo > tolerance)) break;
-        const double step = rate > 0.0 ? -f / rate : 0.5 * (lo + hi) - r;
-        if (!(std::fabs(step) > tolerance)) return r + step;
+        double step = rate > 0.0 ? -f / rate : INFINITY;
+        if (std::fabs(step) <= tolerance) return r + step;
+        const bool newton = std::fabs(step) <= 0.5 * before_last && r + step > lo && r + step < hi;
+        if (!newton) step = 0.5 * (lo + hi) - r;
+        before_last = last;
+        last = std::fabs(step);
         r += step;
     }
     return 0.5 * (lo + hi);
@@ -76,11 +90,10 @@ double refine_crossing(const BellSlope& phi, double slope, double lo, double f_l
 // that slope stops rising: the local maximum. Returns -1 if phi stays below slope. The first
 // crossing is bracketed on a scan of the rim radius, then refined to round-off.
 double first_crossing(const DepthPotential& psi, double radius, double height, double slope) {
-    const double rim2 = radius * radius - height * height;
-    if (!(rim2 > 0.0)) return -1.0;
-    if (!(slope > 0.0)) return 0.0;
-    const double rim = std::sqrt(rim2);
     const BellSlope phi(psi, radius, height);
+    if (!(phi.rim2() > 0.0)) return -1.0;
+    if (!(slope > 0.0)) return 0.0;
+    const double rim = std::sqrt(phi.rim2());
     constexpr int kScan = 16;
     double lo = 0.0, hi = -1.0, f_lo = -slope, f_hi = 0.0;  // phi(0) = 0
     for (int k = 1; k <= kScan; ++k) {

@@ -83,8 +83,9 @@ double feature_distance(const double* p, const double* const points[3], int coun
     return flat ? closest_on_triangle(p, points[0], points[1], points[2], w) : 0.0;
 }
 
-bool ball_term(const Collider& collider, const DepthPotential& psi, const FeatureNodes& feature, const int32_t* nodes,
+bool ball_term(const Collider& collider, const DepthPotential& psi, FeatureNodes& feature, const int32_t* nodes,
                int count, double weight, const double centre[3], ContactPoint& out) {
+    feature.measure(collider);
     LocalSimplex s;
     s.count = count;
     double node_push[3][3], node_normal[3][3];

@@ -98,8 +98,8 @@ struct FeatureNodes {
 /// for a sphere: the interpolant takes the nodes' depths in the ball, and the fade (the mesh
 /// resolving the contact) their depths in the collider, so that a capsule's balls leave a
 /// feature whose nodes are all in the capsule to its node terms, as a sphere's does. False
-/// if it has none.
-bool ball_term(const Collider& collider, const DepthPotential& psi, const FeatureNodes& feature, const int32_t* nodes,
+/// if it has none. Measures feature first (FeatureNodes::measure).
+bool ball_term(const Collider& collider, const DepthPotential& psi, FeatureNodes& feature, const int32_t* nodes,
                int count, double weight, const double centre[3], ContactPoint& out);
 
 /// Calls visit(i, term) for each ball i of the collider with an excess term over the edge or
@@ -135,7 +135,6 @@ void for_each_ball_term(const Collider& collider, const StepLaw& law, const doub
         sub3(ball, points[0], offset);
         if (flat && !(std::fabs(dot3(offset, normal)) < radius)) continue;
         if (!(feature_distance(ball, points, count, flat) < radius)) continue;
-        feature.measure(collider);
         ContactPoint term;
         if (ball_term(collider, psi, feature, nodes, count, weight, ball, term)) visit(i, term);
     }

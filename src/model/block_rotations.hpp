@@ -11,6 +11,7 @@
 #include <softhap/softhap.h>
 
 #include <cstddef>
+#include <cstdint>
 
 namespace sh {
 
@@ -23,12 +24,15 @@ public:
     void reserve(const RotatingBlocks& counts) {
         for (int m = 0; m < SH_MATERIAL_COUNT; ++m) reserve_growing(rotations_[m], counts[m]);
     }
-    /// Sizes them for counts (after reserve: allocation-free) and forgets them: the blocks'
-    /// elements changed.
-    void fit(const RotatingBlocks& counts) noexcept {
+    /// Sizes them for counts (after reserve: allocation-free). After blocks were rebuilt
+    /// (keep false) they are forgotten; after blocks were appended (keep true) the old ones
+    /// stay, and the new ones start as zero, from which the first pass finds no rotation and
+    /// falls back to F alone (polar_rotation_near's guard), as it does for a lane a cut
+    /// emptied and refilled with another tet.
+    void fit(const RotatingBlocks& counts, bool keep) noexcept {
         for (int m = 0; m < SH_MATERIAL_COUNT; ++m) {
             rotations_[m].resize(counts[m]);
-            known_[m] = false;
+            known_[m] = known_[m] && keep;
         }
     }
     /// For a pass over model's blocks: warm from the last pass's rotations if there was one
@@ -40,8 +44,19 @@ public:
         known_[model] = true;
         return KeptRotations{warm ? kept.data() : nullptr, kept.data()};
     }
-    /// The rotations of model's blocks from the last pass, or null if there are none.
-    const Mat3L* last(int model) const { return known_[model] ? rotations_[model].data() : nullptr; }
+    /// The last pass's rotations of the count tets of model whose lanes (block * kLanes +
+    /// lane) lane_of gives for members, into near's lanes; false (near untouched) if there was
+    /// no pass.
+    bool gather(int model, const int32_t* members, int count, const int32_t* lane_of, Mat3L& near) const {
+        if (!known_[model]) return false;
+        const Mat3L* last = rotations_[model].data();
+        for (int l = 0; l < count; ++l) {
+            const int32_t lane = lane_of[members[l]];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) near.m[i][j][l] = last[lane / kLanes].m[i][j][lane % kLanes];
+        }
+        return true;
+    }
 
 private:
     vec<Mat3L> rotations_[SH_MATERIAL_COUNT];

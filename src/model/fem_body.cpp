@@ -139,10 +139,13 @@ void FemBody::element_from_source(const GrownNodes& grown, const int32_t* tet, i
     }
 }
 
-void FemBody::keep_rotating(RotatingBlocks& blocks) {
+void FemBody::reserve_rotations(const vec<TetBlock> (&blocks)[SH_MATERIAL_COUNT], const vec<TetBlock>* added,
+                                RotatingBlocks& out) {
     for_each_material([&](auto material, int model) {
-        if (!decltype(material)::kRotates) blocks[model] = 0;
+        const size_t count = blocks[model].size() + (added ? added[model].size() : 0);
+        out[model] = decltype(material)::kRotates ? count : 0;
     });
+    rotations_.reserve(out);
 }
 
 vec<double> FemBody::lumped_mass(const ElementSet& set, size_t node_count) {
@@ -180,9 +183,7 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
         largest = std::max(largest, set.omega2[t]);
     }
     RotatingBlocks rotating;
-    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) rotating[model] = new_blocks[model].size();
-    keep_rotating(rotating);
-    rotations_.reserve(rotating);
+    reserve_rotations(new_blocks, nullptr, rotating);
     // Commit: nothing below allocates.
     if (grown) {
         adopt_nodes(*grown);
@@ -201,7 +202,7 @@ void FemBody::adopt(ElementSet& set, GrownNodes* grown) {
     mass.swap(new_mass);
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) blocks_[model].swap(new_blocks[model]);
     lane_of_.swap(new_lane_of);
-    rotations_.fit(rotating);
+    rotations_.fit(rotating, false);
     vacant_lanes_ = 0;
     ++matrix_version;
     update_inverse_mass();

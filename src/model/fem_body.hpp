@@ -120,8 +120,10 @@ private:
     void change_locally(GrownNodes& grown, const vec<int32_t>& tets, const vec<int32_t>& source, const vec<int32_t>& changed);
     /// Empties the lane of body tet t (zero weights, a live tet's shape).
     void vacate_lane(size_t t);
-    /// Zeroes the block counts of the models whose law keeps no rotation (BlockRotations).
-    static void keep_rotating(RotatingBlocks& blocks);
+    /// Room in rotations_ for the blocks of blocks (plus added's, when given) whose law keeps
+    /// a rotation, their counts in out; throws std::bad_alloc, changing nothing else.
+    void reserve_rotations(const vec<TetBlock> (&blocks)[SH_MATERIAL_COUNT], const vec<TetBlock>* added,
+                           RotatingBlocks& out);
     /// Lumped masses of set over node_count nodes.
     static vec<double> lumped_mass(const ElementSet& set, size_t node_count);
     /// fill_lane for tet t of set.

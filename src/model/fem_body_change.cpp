@@ -84,9 +84,7 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
         reserve_growing(blocks_[model], blocks_[model].size() + added[model].size());
     RotatingBlocks rotating;
-    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) rotating[model] = blocks_[model].size() + added[model].size();
-    keep_rotating(rotating);
-    rotations_.reserve(rotating);
+    reserve_rotations(blocks_, added, rotating);
     surface_index_.reserve(surface_triangles, surface, grown.node_count());
 
     // Commit: nothing below allocates.
@@ -108,7 +106,7 @@ void FemBody::change_locally(GrownNodes& grown, const vec<int32_t>& tets, const 
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
         blocks_[model].insert(blocks_[model].end(), added[model].begin(), added[model].end());
     stable_step_known_ = false;  // new pieces' frequencies are found when the step is asked for
-    rotations_.fit(rotating);    // vacated lanes now repeat other tets
+    rotations_.fit(rotating, true);
     ++matrix_version;
 }
 

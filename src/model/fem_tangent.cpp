@@ -58,13 +58,8 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
     auto process = [&](int model, const int32_t* members, int count) {
         Mat3L F = identity_lanes();
         Lanes lambda = splat(1.0), mu = splat(1.0);
-        const Mat3L* last = rotations_.last(model);
         Mat3L near = identity_lanes();
-        for (int l = 0; l < count && last; ++l) {
-            const int32_t lane = lane_of_[static_cast<size_t>(members[l])];
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) near.m[i][j][l] = last[lane / kLanes].m[i][j][lane % kLanes];
-        }
+        const bool warm = rotations_.gather(model, members, count, lane_of_.data(), near);
         for (int l = 0; l < count; ++l) {
             const size_t t = static_cast<size_t>(members[l]);
             const int32_t* tet = &tets_[4 * t];
@@ -82,7 +77,7 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
         bool project = false;
         visit_material(model, [&](auto law) {
             using Law = decltype(law);
-            stress_derivatives<Law>(F, lambda, mu, last ? &near : nullptr, C);
+            stress_derivatives<Law>(F, lambda, mu, warm ? &near : nullptr, C);
             project = Law::kProjectTangent;
         });
         for (int l = 0; l < count; ++l) {

@@ -107,13 +107,13 @@ bool ball_term(const Collider& collider, const DepthPotential& psi, FeatureNodes
 template <class Visit>
 void for_each_ball_term(const Collider& collider, const StepLaw& law, const double* x, const int32_t* nodes, int count,
                         double weight, Visit&& visit) {
-    if (collider.shape.ball_count() == 0 || !(weight > 0.0)) return;
+    const BallRow& row = collider.balls();
+    if (row.count == 0 || !(weight > 0.0)) return;
     const StepLawPotential psi(collider.params, law);
     FeatureNodes feature(collider, x, nodes, count);
     const double* const* points = feature.points;
     const FeatureBox box(points, count);
     const double radius = collider.shape.ball_radius();
-    const BallRow& row = collider.balls();
     int first = 0, last = row.count - 1;
     if (last > 0) {  // one ball needs no search: the box test below culls it
         double centre[3];

@@ -15,7 +15,7 @@ struct CorotationalMaterial {
     static constexpr sh_material_model kModel = SH_MATERIAL_COROTATIONAL;
     /// With R held fixed, dP/dF is a rotated isotropic tensor: positive semi-definite as it is.
     static constexpr bool kProjectTangent = false;
-    /// Its state keeps the element's rotation R, which stress_near() finds from a nearby one.
+    /// Its state keeps the element's rotation R, which stress_at() and energy_at() take given.
     static constexpr bool kRotates = true;
 
     /// The polar rotation, reused by differential().
@@ -31,15 +31,13 @@ struct CorotationalMaterial {
     }
     /// P(F); keeps R in state.
     static SH_INLINE Mat3L stress(const Mat3L& F, Lanes lambda, Lanes mu, State& state) {
-        state.R = polar_rotation(F);
-        return rotated_stress(state.R, F, lambda, mu, true);
+        return stress_at(F, polar_rotation(F), lambda, mu, state);
     }
-    /// P(F) with R found from a rotation near it (polar_rotation_near, to settled2); keeps R
-    /// in state.
-    static SH_INLINE Mat3L stress_near(const Mat3L& F, Lanes lambda, Lanes mu, State& state, const Mat3L& near,
-                                       double settled2) {
-        state.R = polar_rotation_near(F, near, settled2);
-        return rotated_stress(state.R, F, lambda, mu, true);
+    /// P(F) with R, F's polar rotation, already found (a caller that keeps each element's R
+    /// refines the last one: fem_kernel.hpp's kept_rotation); keeps R in state.
+    static SH_INLINE Mat3L stress_at(const Mat3L& F, const Mat3L& R, Lanes lambda, Lanes mu, State& state) {
+        state.R = R;
+        return rotated_stress(R, F, lambda, mu, true);
     }
     /// dP(F)[dF] with R fixed.
     static SH_INLINE Mat3L differential(const Mat3L&, const State& state, const Mat3L& dF, Lanes lambda, Lanes mu) {

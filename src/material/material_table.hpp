@@ -11,12 +11,11 @@
 //                                           frame: such a law must be isotropic)
 //   kRotates                                true if State holds the element's rotation R
 //                                           (state.R), and the law has
-//                                           stress_near(F, lambda, mu, state, near,
-//                                           settled2), the stress with R found from a
-//                                           rotation near it (polar_rotation_near): a
-//                                           caller that keeps each element's R between force
-//                                           passes warm-starts the next (fem_kernel.hpp),
-//                                           and energy_at(F, R, lambda, mu), psi with R given
+//                                           stress_at(F, R, lambda, mu, state) and
+//                                           energy_at(F, R, lambda, mu), P and psi with R,
+//                                           F's polar rotation, given: a caller that keeps
+//                                           each element's R between passes finds the next
+//                                           from it (fem_kernel.hpp's kept_rotation)
 //   State                                   what stress() computes that differential() reuses
 //   jacobian(F, state)                      det F, for the inverted-element count
 //   stress(F, lambda, mu, state)            the first Piola-Kirchhoff stress P(F)

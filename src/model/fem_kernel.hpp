@@ -135,32 +135,29 @@ struct KeptRotations {
     double settled2 = kRotationSettled2;
 };
 
-/// Block k's -V0 P(F) (the weights carry -V0), warm-started from rotations.near[k] where the
-/// law keeps a rotation and the caller keeps them; the rotation found goes to rotations.kept[k].
+/// Block k's rotations at F: from rotations.near[k] when there is a warm start (to
+/// rotations.settled2), else from F alone; written to rotations.kept[k].
+SH_INLINE Mat3L kept_rotation(const Mat3L& F, size_t k, const KeptRotations& rotations) {
+    const Mat3L R = rotations.near ? polar_rotation_near(F, rotations.near[k], rotations.settled2) : polar_rotation(F);
+    rotations.kept[k] = R;
+    return R;
+}
+
+/// Block k's -V0 P(F) (the weights carry -V0); a law that keeps a rotation takes it from
+/// kept_rotation where the caller keeps them.
 template <class Material>
 SH_INLINE Mat3L block_stress(const Mat3L& F, const TetBlock& b, size_t k, const KeptRotations& rotations,
                              typename Material::State& state) {
-    if constexpr (Material::kRotates) {
-        if (rotations.kept) {
-            const Mat3L P = rotations.near ? Material::stress_near(F, b.lambda_w, b.mu_w, state, rotations.near[k], rotations.settled2)
-                                           : Material::stress(F, b.lambda_w, b.mu_w, state);
-            rotations.kept[k] = state.R;
-            return P;
-        }
-    }
+    if constexpr (Material::kRotates)
+        if (rotations.kept) return Material::stress_at(F, kept_rotation(F, k, rotations), b.lambda_w, b.mu_w, state);
     return Material::stress(F, b.lambda_w, b.mu_w, state);
 }
 
 /// Block k's -V0 psi(F), its rotation kept as block_stress keeps it.
 template <class Material>
 SH_INLINE Lanes block_energy(const Mat3L& F, const TetBlock& b, size_t k, const KeptRotations& rotations) {
-    if constexpr (Material::kRotates) {
-        if (rotations.kept) {
-            const Mat3L R = rotations.near ? polar_rotation_near(F, rotations.near[k], rotations.settled2) : polar_rotation(F);
-            rotations.kept[k] = R;
-            return Material::energy_at(F, R, b.lambda_w, b.mu_w);
-        }
-    }
+    if constexpr (Material::kRotates)
+        if (rotations.kept) return Material::energy_at(F, kept_rotation(F, k, rotations), b.lambda_w, b.mu_w);
     return Material::energy(F, b.lambda_w, b.mu_w);
 }
 

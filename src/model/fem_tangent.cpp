@@ -9,6 +9,7 @@
 #include "material/isotropic_projection.hpp"
 #include "material/material_table.hpp"
 #include "linalg/sparse_system.hpp"
+#include "model/fem_kernel.hpp"
 
 #include <Eigen/Dense>
 
@@ -25,8 +26,8 @@ template <class Material>
 void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* near, Matrix9 (&C)[kLanes]) {
     typename Material::State state;
     if constexpr (Material::kRotates) {
-        if (near) Material::stress_near(F, lambda, mu, state, *near, kRotationSettled2);
-        else Material::stress(F, lambda, mu, state);
+        Mat3L R;  // the batch's own: the body's are the force passes' (BlockRotations)
+        Material::stress_at(F, kept_rotation(F, 0, KeptRotations{near, &R}), lambda, mu, state);
     } else {
         Material::stress(F, lambda, mu, state);
     }

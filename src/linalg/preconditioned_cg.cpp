@@ -3,6 +3,7 @@
 #include "core/clock.hpp"
 #include "core/memory.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace sh {
@@ -16,19 +17,25 @@ double dot(const vec<double>& a, const vec<double>& b) {
 
 }  // namespace
 
+void PreconditionedCgWork::resize(size_t n) {
+    vec<double> fresh[4] = {vec<double>(n), vec<double>(n), vec<double>(n), vec<double>(n)};
+    r.swap(fresh[0]), z.swap(fresh[1]), p.swap(fresh[2]), q.swap(fresh[3]);
+}
+
 PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolver& preconditioner, const double* b,
-                                               double* x, double tolerance, int max_iterations) {
+                                               double* x, double tolerance, int max_iterations,
+                                               PreconditionedCgWork& work) {
     const double t0 = now_seconds();
     PreconditionedCgResult out;
     const size_t n = static_cast<size_t>(a.dof_count());
-    vec<double> r(b, b + n), z(n), p(n), q(n);
-    for (size_t i = 0; i < n; ++i) x[i] = 0.0;
+    vec<double>&r = work.r, &z = work.z, &p = work.p, &q = work.q;
+    for (size_t i = 0; i < n; ++i) x[i] = 0.0, r[i] = b[i];
     const double b_norm = std::sqrt(dot(r, r));
     out.relative_residual = b_norm > 0.0 ? 1.0 : 0.0;
     out.converged = !(b_norm > 0.0);
     if (out.converged) return out;
     preconditioner.solve(a, r.data(), z.data());
-    p = z;
+    std::copy(z.begin(), z.end(), p.begin());
     double rz = dot(r, z);
     while (out.iterations < max_iterations) {
         a.multiply(p.data(), q.data());

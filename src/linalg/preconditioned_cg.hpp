@@ -8,6 +8,14 @@
 
 namespace sh {
 
+/// solve_preconditioned_cg's vectors, kept by its caller beside the matrix so that a solve
+/// allocates nothing (sized for a.dof_count() by resize).
+struct PreconditionedCgWork {
+    vec<double> r, z, p, q;  ///< residual, preconditioned residual, direction, A direction
+    /// Sizes the four vectors for n DOFs; throws std::bad_alloc, changing nothing else.
+    void resize(size_t n);
+};
+
 /// What solve_preconditioned_cg reached.
 struct PreconditionedCgResult {
     int iterations = 0;              ///< matrix products (each with one preconditioner solve)
@@ -23,8 +31,9 @@ struct PreconditionedCgResult {
 /// iterate lowers the quadratic 1/2 x^T A x - b^T x further, so for b = -g (g a gradient) every
 /// iterate is a descent direction. A curvature p^T A p that is not positive (A not positive
 /// definite along p) stops it unconverged at the iterate before. Throws what the
-/// preconditioner's solve throws. Allocates four vectors of a.dof_count().
+/// preconditioner's solve throws. work must be sized for a.dof_count().
 PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolver& preconditioner, const double* b,
-                                               double* x, double tolerance, int max_iterations);
+                                               double* x, double tolerance, int max_iterations,
+                                               PreconditionedCgWork& work);
 
 }  // namespace sh

@@ -368,7 +368,7 @@ bool NewtonStep::solve_by_krylov() {
                                kKrylovMinIterations, kKrylovMaxIterations);
     const PreconditionedCgResult cg = solve_for_update([&](const double* minus_g, double* delta) {
         return solve_preconditioned_cg(matrix_.system, *matrix_.solver, minus_g, delta, kKrylovForcing * s_.factor_reuse,
-                                       cap);
+                                       cap, matrix_.cg);
     });
     result_.linear_iterations += cg.iterations;
     result_.solve_seconds += cg.seconds;

@@ -23,12 +23,15 @@ LinearSolverKind solver_kind(sh_linear_solver kind) {
 void NewtonMatrix::reset(SparseSystem&& pattern, LinearSolverPtr new_solver) {
     const size_t dofs = static_cast<size_t>(pattern.dof_count());
     vec<double> r(dofs), d(dofs, 0.0), p(dofs);
+    PreconditionedCgWork work;
+    work.resize(dofs);
     // Commit only once everything is built.
     system = std::move(pattern);
     solver = std::move(new_solver);
     residual.swap(r);
     delta.swap(d);
     previous_v.swap(p);
+    std::swap(cg, work);
     kept.valid = false;
 }
 

@@ -6,6 +6,7 @@
 
 #include "core/memory.hpp"
 #include "linalg/linear_solver.hpp"
+#include "linalg/preconditioned_cg.hpp"
 #include "linalg/sparse_system.hpp"
 
 #include <softhap/softhap.h>
@@ -45,6 +46,7 @@ struct NewtonMatrix {
     vec<double> delta;       ///< per DOF: the Newton update (CG's warm start)
     vec<double> previous_v;  ///< per DOF: velocities before a trial update (the line search's start)
     KeptFactorisation kept;  ///< the factorisation the solver may be holding
+    PreconditionedCgWork cg; ///< CG's vectors when the kept factorisation preconditions it
 
     /// Takes pattern as the matrix and solver (analysed for it, or null) as its solver, sizes
     /// the scratch vectors for its DOFs (delta zeroed) and forgets any kept factorisation.

@@ -102,6 +102,23 @@ void deepest_contact(const Collider& tool, NearestSurface& near) {
     }
 }
 
+// The proxy's point and outward normal: near's point on its triangle's plane.
+void fill_proxy(const NearestSurface& near, Buffer& out) {
+    const int32_t* tri = near.fem->surface_triangles.data() + 3 * static_cast<size_t>(near.triangle);
+    const double* x = near.fem->x.data();
+    double ab[3], ac[3], n[3];
+    sub3(at(x, tri[1]), at(x, tri[0]), ab);
+    sub3(at(x, tri[2]), at(x, tri[0]), ac);
+    cross3(ab, ac, n);
+    const double length = norm3(n);
+    if (!(length > 0.0)) return;
+    out.has_proxy = true;
+    for (int k = 0; k < 3; ++k) {
+        out.proxy_point[k] = near.point[k];
+        out.proxy_normal[k] = n[k] / length;
+    }
+}
+
 }  // namespace
 
 void HapticContext::ensure_adjacency(const FemBody& body, Id id) {
@@ -120,19 +137,21 @@ void HapticContext::ensure_adjacency(const FemBody& body, Id id) {
     adjacency_version_ = body.topology_version;
 }
 
-void HapticContext::select_tets(const FemBody& body, const double line_a[3], const double line_b[3],
-                               int32_t seed_triangle, Buffer& out) {
+void HapticContext::select_tets(const FemBody& body, const BufferCentre& centre, Buffer& out) {
     const int32_t tet_count = body.element_count();
-    const int32_t* tris = body.surface_triangles.data() + 3 * static_cast<size_t>(seed_triangle);
+    const double* line_a = centre.a;
+    const double* line_b = centre.b;
     ranked_.clear();
-    // The tets at the contact: those with a node of the nearest surface triangle.
-    for (int k = 0; k < 3; ++k)
-        for (int32_t j = node_tet_begin_[static_cast<size_t>(tris[k])]; j < node_tet_begin_[static_cast<size_t>(tris[k]) + 1]; ++j) {
+    // The tets at the contact: those with a seed node.
+    for (size_t k = 0; k < centre.seed_count; ++k) {
+        const size_t node = static_cast<size_t>(centre.seeds[k]);
+        for (int32_t j = node_tet_begin_[node]; j < node_tet_begin_[node + 1]; ++j) {
             const int32_t t = node_tet_[static_cast<size_t>(j)];
             if (in_buffer_[static_cast<size_t>(t)]) continue;
             in_buffer_[static_cast<size_t>(t)] = 1;
             ranked_.push_back({centroid_distance(body, t, line_a, line_b), t});
         }
+    }
     if (def_.rings > 0) {
         size_t frontier = 0;
         for (int32_t ring = 0; ring < def_.rings; ++ring) {
@@ -390,20 +409,7 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
     NearestSurface near = nearest_surface(world, tool.target.p);
     if (!near.fem) return;
     deepest_contact(tool, near);
-    const int32_t* tri = near.fem->surface_triangles.data() + 3 * static_cast<size_t>(near.triangle);
-    const double* x = near.fem->x.data();
-    double ab[3], ac[3], n[3];
-    sub3(at(x, tri[1]), at(x, tri[0]), ab);
-    sub3(at(x, tri[2]), at(x, tri[0]), ac);
-    cross3(ab, ac, n);
-    const double length = norm3(n);
-    if (length > 0.0) {
-        out.has_proxy = true;
-        for (int k = 0; k < 3; ++k) {
-            out.proxy_point[k] = near.point[k];
-            out.proxy_normal[k] = n[k] / length;
-        }
-    }
+    fill_proxy(near, out);
     // A buffer only where the tool may touch before the next extraction.
     double lo[3], hi[3], extent[3];
     tool.shape.bounds(tool.target, 0.0, lo, hi);
@@ -411,19 +417,53 @@ void HapticContext::extract(World& world, double period, Buffer& out) {
     const double max_gap = def_.radius + 0.5 * norm3(extent);
     double offset[3];
     sub3(near.point, tool.target.p, offset);
-    if (norm3(offset) > max_gap) return;
-    out.body = near.body;
-    extracted_body_ = near.body;
-    ensure_adjacency(*near.fem, near.body);
+    const bool touching = norm3(offset) <= max_gap;
+    // Where a blade holds material, the buffer is there, wherever the tool's own shape is (a
+    // scalpel's handle above the tissue, its edge in it): the hold's pull is what the device
+    // feels.
+    Id held_body = kNullId;
+    BufferCentre centre;
+    const bool holding = find_held_centre(world, held_body, centre);
+    if (!touching && !holding) return;
+    const Id body_id = holding ? held_body : near.body;
+    const FemBody& body = static_cast<const FemBody&>(world.body(body_id));
+    if (!holding || (touching && near.body == held_body)) {
+        const int32_t* tri = body.surface_triangles.data() + 3 * static_cast<size_t>(near.triangle);
+        if (!holding) contact_line(tool, near.point, centre.a, centre.b);
+        else std::copy(near.point, near.point + 3, centre.b);  // from the hold to the contact
+        seeds_.insert(seeds_.end(), tri, tri + 3);
+        centre.seeds = seeds_.data();
+        centre.seed_count = seeds_.size();
+    }
+    out.body = body_id;
+    extracted_body_ = body_id;
+    ensure_adjacency(body, body_id);
     // Nodes held by anything else (a table, another tool or body) follow the full model: the
     // buffer models the tool's contact only.
-    other_contact_.assign(static_cast<size_t>(near.fem->node_count()), 0);
-    if (const BodyContacts* contacts = world.contacts_of(near.body))
+    other_contact_.assign(static_cast<size_t>(body.node_count()), 0);
+    if (const BodyContacts* contacts = world.contacts_of(body_id))
         contacts->mark_nodes_of_other_contacts(&tool, other_contact_.data());
-    double line_a[3], line_b[3];
-    contact_line(tool, near.point, line_a, line_b);
-    select_tets(*near.fem, line_a, line_b, near.triangle, out);
-    fill_buffer(world, tool, *near.fem, out);
+    select_tets(body, centre, out);
+    fill_buffer(world, tool, body, out);
+}
+
+// The FEM body whose nodes the tool's blade holds, the held nodes as seeds (in seeds_) and their
+// centroid as the centre's segment (a point, b = a); false, seeds_ empty, if it holds none.
+bool HapticContext::find_held_centre(const World& world, Id& body, BufferCentre& centre) {
+    seeds_.clear();
+    world.for_each_body([&](Id id, const Body& candidate) {
+        BladeHold hold;
+        if (!seeds_.empty() || !candidate.is_fem() || !world.blade_hold(def_.tool.value, id, hold) || hold.count == 0) return;
+        seeds_.assign(hold.nodes, hold.nodes + hold.count);
+        body = id;
+        double sum[3] = {0.0, 0.0, 0.0};
+        for (const int32_t node : seeds_)
+            for (int k = 0; k < 3; ++k) sum[k] += at(candidate.x.data(), node)[k];
+        for (int k = 0; k < 3; ++k) centre.a[k] = centre.b[k] = sum[k] / static_cast<double>(hold.count);
+    });
+    centre.seeds = seeds_.data();
+    centre.seed_count = seeds_.size();
+    return !seeds_.empty();
 }
 
 }  // namespace sh

@@ -79,8 +79,16 @@ private:
 
     // sim side
     void extract(World& world, double period, Buffer& out);
-    void select_tets(const FemBody& body, const double line_a[3], const double line_b[3], int32_t seed_triangle,
-                     Buffer& out);
+    /// Where the tool acts on the body a buffer is cut from: tets rank by their centroid's
+    /// distance to the segment from a to b, and those around the seed nodes come first.
+    struct BufferCentre {
+        double a[3] = {}, b[3] = {};
+        const int32_t* seeds = nullptr;
+        size_t seed_count = 0;
+    };
+    /// The body, point and seeds of tool's blade hold, if it holds nodes of a FEM body.
+    bool find_held_centre(const World& world, Id& body, BufferCentre& centre);
+    void select_tets(const FemBody& body, const BufferCentre& centre, Buffer& out);
     void fill_buffer(const World& world, const Collider& tool, const FemBody& body, Buffer& out);
     void number_nodes(const FemBody& body, Buffer& out);
     void fill_nodes(const FemBody& body, Buffer& out);
@@ -176,6 +184,7 @@ private:
     vec<double> x_before_;                     ///< the buffer body's x before the step
     Id x_before_body_ = kNullId;
     vec<std::pair<double, int32_t>> ranked_;   ///< candidate tets by distance
+    vec<int32_t> seeds_;                       ///< the buffer's seed nodes (BufferCentre)
     vec<int32_t> local_of_;                    ///< body node -> local node, -1 outside
     vec<uint8_t> in_buffer_;                   ///< per body tet
     vec<int32_t> chosen_;                      ///< the buffer's tets (body numbers)

@@ -113,12 +113,14 @@ protected:
         if (factor_) {
             fill_per_node_ = suggested->fill_per_node;
             flops_per_node_ = suggested->flops_per_node;
-            return;
+        } else {
+            factor_ = cholmod_analyze(&matrix, &common_);
+            check(factor_ != nullptr, "symbolic analysis");
+            fill_per_node_ = common_.lnz / nodes;
+            flops_per_node_ = common_.fl / nodes;
         }
-        factor_ = cholmod_analyze(&matrix, &common_);
-        check(factor_ != nullptr, "symbolic analysis");
-        fill_per_node_ = common_.lnz / nodes;
-        flops_per_node_ = common_.fl / nodes;
+        // common_ holds the analysis of the order kept (cholmod_analyze_p sets both).
+        estimated_work_ = factor_work(common_.fl, common_.lnz, kSupernodalSpeed);
     }
 
     bool do_elimination_order(EliminationOrder& out) const override {
@@ -198,6 +200,10 @@ protected:
     }
 
 private:
+    // How many times a solve's operations per second a supernodal factorisation does (BLAS-3
+    // over supernodes, OpenBLAS): 4.3 to 7.4 measured on 17,800 and 11,500 DOF systems.
+    static constexpr double kSupernodalSpeed = 6.0;
+
     // The symbolic analysis of matrix in the suggested node order (each node's DOFs together),
     // or null if that order's fill or flops exceed what kSuggestedOrderTolerance allows: a fresh
     // ordering then pays for itself within a few factorisations.

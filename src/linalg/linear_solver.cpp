@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -53,6 +54,13 @@ void require_finite_solution(const SparseSystem& a, const double* x, const char*
 
 }  // namespace
 
+FactorWork factor_work(double flops, double factor_entries, double speed) {
+    FactorWork work;
+    work.solve = 4.0 * factor_entries;
+    work.factorize = std::max(kMinFactorizeSolves * work.solve, flops / speed);
+    return work;
+}
+
 void LinearSolver::analyze(const SparseSystem& a, const EliminationOrder* suggested) {
     analysed_id_ = 0;
     factorized_ = false;
@@ -60,6 +68,7 @@ void LinearSolver::analyze(const SparseSystem& a, const EliminationOrder* sugges
                "%s: suggested order of %zu nodes for %d DOFs", name(), suggested ? suggested->nodes.size() : 0,
                a.dof_count());
     analysed_dofs_ = 0;
+    estimated_work_ = FactorWork{};
     if (a.dof_count() > 0) do_analyze(a, suggested);
     analysed_id_ = a.pattern_id();
     analysed_dofs_ = a.dof_count();

@@ -15,6 +15,9 @@ struct LinearMaterial {
     static constexpr bool kProjectTangent = false;
     /// Its state keeps no rotation (see the table's kRotates).
     static constexpr bool kRotates = false;
+    /// One element's tangent in a sparse solve's operations (the table's kTangentWork): a
+    /// constant dP/dF.
+    static constexpr double kTangentWork = 700.0;
 
     /// Nothing of stress() is reused by differential().
     struct State {};

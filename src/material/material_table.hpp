@@ -16,6 +16,11 @@
 //                                           F's polar rotation, given: a caller that keeps
 //                                           each element's R between passes finds the next
 //                                           from it (fem_kernel.hpp's kept_rotation)
+//   kTangentWork                            an estimate of one element's tangent (its
+//                                           dP/dF, projection and scatter) in the
+//                                           floating-point operations of a sparse solve
+//                                           (FactorWork): the implicit step weighs it
+//                                           against factorisations and solves
 //   State                                   what stress() computes that differential() reuses
 //   jacobian(F, state)                      det F, for the inverted-element count
 //   stress(F, lambda, mu, state)            the first Piola-Kirchhoff stress P(F)

@@ -72,6 +72,11 @@ public:
     virtual void add_tangent(const double* x, double stiffness_scale, double damping_scale,
                              SparseSystem& system) const = 0;
 
+    /// An estimate of add_tangent's work, in the floating-point operations of a sparse solve
+    /// (FactorWork): what the implicit step weighs against factorisations and solves. A count,
+    /// not a clock, so that identical runs choose alike.
+    virtual double tangent_work() const = 0;
+
     /// Element connectivity: element_count() x nodes_per_element() node indices.
     virtual const int32_t* element_nodes() const = 0;
 

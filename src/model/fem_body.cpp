@@ -299,6 +299,14 @@ double FemBody::frequency_squared_of(size_t t) const {
     return omega2;
 }
 
+double FemBody::tangent_work() const {
+    double work = 0.0;
+    for_each_material([&](auto material, int model) {
+        work += decltype(material)::kTangentWork * static_cast<double>(blocks_[model].size() * kLanes);
+    });
+    return work;
+}
+
 double FemBody::stable_step(const double*) const {
     if (!stable_step_known_) {
         double largest = 0.0;

@@ -59,6 +59,8 @@ public:
     void add_internal_forces(const double* x, const double* v, double* f) const override;
     double elastic_energy(const double* x) const override;
     double stable_step(const double* x) const override;
+    /// Per block lane, its law's kTangentWork (the material table).
+    double tangent_work() const override;
     void add_tangent(const double* x, double stiffness_scale, double damping_scale,
                      SparseSystem& system) const override;
     const int32_t* element_nodes() const override { return tets_.data(); }

@@ -138,6 +138,12 @@ double SpringBody::elastic_energy(const double* xs) const {
     return energy;
 }
 
+// One spring's tangent in a sparse solve's operations (Body::tangent_work): a 3x3 block from
+// its direction and the law's two derivatives, scattered into four blocks.
+constexpr double kSpringTangentWork = 150.0;
+
+double SpringBody::tangent_work() const { return kSpringTangentWork * static_cast<double>(rest_length_.size()); }
+
 double SpringBody::stable_step(const double* xs) const {
     // Block Gershgorin bound of omega_max^2 for M^-1/2 K M^-1/2 at the current state: a
     // spring's 3x3 block k n n^T + (T/l)(I - n n^T) has norm max(k, |T|/l).

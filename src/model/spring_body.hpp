@@ -21,6 +21,8 @@ public:
     bool has_internal_damping() const override { return law_.damping() > 0.0; }
     double elastic_energy(const double* x) const override;
     double stable_step(const double* x) const override;
+    /// kSpringTangentWork per spring.
+    double tangent_work() const override;
     void add_tangent(const double* x, double stiffness_scale, double damping_scale,
                      SparseSystem& system) const override;
     const int32_t* element_nodes() const override { return springs_.data(); }

@@ -1,6 +1,5 @@
 #include "solver/implicit_integrator.hpp"
 
-#include "core/clock.hpp"
 #include "core/error.hpp"
 #include "model/external_field.hpp"
 #include "linalg/preconditioned_cg.hpp"
@@ -28,16 +27,17 @@ constexpr int kMaxStaleSolves = 4;
 // conjugate gradients on the current tangent preconditioned by the kept factorisation, to a
 // relative residual of kKrylovForcing times factor_reuse (an inexact Newton update, more
 // accurate than the kept factorisation's accepted updates), spending at most kKrylovBudget of
-// the kept factorisation's time before it gives up and factorises afresh. A new factorisation
+// the kept factorisation's work before it gives up and factorises afresh. A new factorisation
 // costs its assembly and factorisation once and then serves as many steps as its updates last
 // (kKeepLife weighs their mean over the factorisations before); CG costs an assembly and a few
 // preconditioner solves per step, for at most a factorisation's price on one kept
-// factorisation. Under large rotation the tangent drifts away from a new
-// factorisation within a step or two, and a factorisation costs as much as 15 solves (20 k
-// tets); where the motion is slow one serves many steps without an assembly. Not in contact:
-// contacts switch within a step, where Newton with factorisations at its iterates converges in
-// fewer iterations (a cube on a 1e9 N/m plane did not converge in 20 iterations with CG
-// updates).
+// factorisation. Under large rotation the tangent drifts away from a new factorisation within
+// a step or two, and a factorisation costs as much as 20-26 solves (20 k tets); where the
+// motion is slow one serves many steps without an assembly. Costs are work estimated from
+// counts (KeptFactorisation), not measured times, so that identical runs take identical
+// paths. Not in contact: contacts switch within a step, where Newton with factorisations at
+// its iterates converges in fewer iterations (a cube on a 1e9 N/m plane did not converge in
+// 20 iterations with CG updates).
 constexpr double kKrylovForcing = 0.1;
 constexpr double kKrylovBudget = 0.5;
 constexpr int kKrylovMinIterations = 2, kKrylovMaxIterations = 50;
@@ -135,6 +135,9 @@ private:
     bool krylov_pays();
     /// CG failed this step: no more of it; the next update comes with a new factorisation.
     void give_up_krylov();
+    /// One CG iteration's work: a solve with the kept factorisation and a product with the
+    /// tangent (4 operations per stored entry of its upper triangle).
+    double cg_iteration_work() const;
     /// Returns solve(-g, delta), which solves for the update into matrix_.delta, with -g laid
     /// in matrix_.residual for the call (and g back after it).
     template <class Solve>
@@ -333,11 +336,16 @@ double NewtonStep::assemble_body(Body& body, NewtonBodyState& state) {
 }
 
 void NewtonStep::assemble_tangent() {
-    const double t0 = now_seconds();
     matrix_.kept.roundoff_floor =
         problem_.assemble([&](SteppedBody& m) { return assemble_body(*m.body, *m.newton); }, dt_ * dt_, dt_, false);
-    matrix_.kept.assemble_seconds = now_seconds() - t0;
+    double work = 0.0;
+    problem_.each([&](const SteppedBody& stepped, size_t) { work += stepped.body->tangent_work(); });
+    matrix_.kept.assemble_work = work;
     assembled_ = true;
+}
+
+double NewtonStep::cg_iteration_work() const {
+    return matrix_.kept.solve_work + 4.0 * static_cast<double>(matrix_.system.nonzero_count());
 }
 
 bool NewtonStep::krylov_pays() {
@@ -349,8 +357,8 @@ bool NewtonStep::krylov_pays() {
     }
     // A factorisation's price; CG pays at most that much on one before buying a new one (so
     // that a wrong estimate of the lives costs at most a factorisation per factorisation).
-    const double price = kept.assemble_seconds + kept.factorize_seconds;
-    const double krylov = kept.assemble_seconds + kept.krylov_iterations[kept.steps_served > 0] * kept.solve_seconds;
+    const double price = kept.assemble_work + kept.factorize_work;
+    const double krylov = kept.assemble_work + kept.krylov_iterations[kept.steps_served > 0] * cg_iteration_work();
     return kept.mean_life >= 0.0 && krylov < price / std::max(kept.mean_life, 1.0) && kept.krylov_spent < price;
 }
 
@@ -363,8 +371,8 @@ void NewtonStep::give_up_krylov() {
 bool NewtonStep::solve_by_krylov() {
     assemble_tangent();
     KeptFactorisation& kept = matrix_.kept;
-    const double per_solve = std::max(kept.solve_seconds, 1e-9);
-    const int cap = std::clamp(static_cast<int>(kKrylovBudget * kept.factorize_seconds / per_solve),
+    const double per_iteration = cg_iteration_work();
+    const int cap = std::clamp(static_cast<int>(kKrylovBudget * kept.factorize_work / per_iteration),
                                kKrylovMinIterations, kKrylovMaxIterations);
     const PreconditionedCgResult cg = solve_for_update([&](const double* minus_g, double* delta) {
         return solve_preconditioned_cg(matrix_.system, *matrix_.solver, minus_g, delta, kKrylovForcing * s_.factor_reuse,
@@ -382,7 +390,7 @@ bool NewtonStep::solve_by_krylov() {
     const double iterations = outpaced ? 4.0 * cap : cg.iterations;
     double& mean = kept.krylov_iterations[kept.steps_served > 0];
     mean = kKeepLife * mean + (1.0 - kKeepLife) * iterations;
-    kept.krylov_spent += kept.assemble_seconds + cg.seconds;
+    kept.krylov_spent += kept.assemble_work + cg.iterations * per_iteration;
     used_stale = true;  // the kept factorisation steered it: a failed step retries without it
     return cg.converged;
 }
@@ -406,7 +414,8 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
             matrix_.kept.valid = false;
             if (!assembled_) assemble_tangent();
             matrix_.solver->factorize(matrix_.system);
-            matrix_.kept.factorize_seconds = matrix_.solver->factorize_seconds;
+            matrix_.kept.factorize_work = matrix_.solver->work().factorize;
+            matrix_.kept.solve_work = matrix_.solver->work().solve;
             matrix_.kept.steps_served = 0;
             matrix_.kept.failed = false;
             matrix_.kept.krylov_spent = 0.0;
@@ -422,7 +431,6 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
         result_.linear_iterations += solve_for_update(
             [&](const double* minus_g, double* delta) { return matrix_.solver->solve(matrix_.system, minus_g, delta); });
         result_.solve_seconds += matrix_.solver->solve_seconds;
-        matrix_.kept.solve_seconds = matrix_.solver->solve_seconds;
     } catch (const Error& e) {
         if (e.status() != SH_ERR_NOT_CONVERGED && e.status() != SH_ERR_SOLVER) throw;
         result_.status = e.status();

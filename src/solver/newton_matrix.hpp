@@ -23,9 +23,11 @@ struct KeptFactorisation {
     double dt = 0.0;              ///< the step size it was made for (s)
     uint64_t matrix_version = 0;  ///< the bodies' matrix version it was made for
     double roundoff_floor = 0.0;  ///< the residual's round-off level at the factorised iterate
-    double factorize_seconds = 0.0;  ///< what making it took (s): the price of a new one
-    double solve_seconds = 0.0;      ///< what its last solve took (s)
-    double assemble_seconds = 0.0;   ///< what the last assembly of the tangent took (s)
+    // Work in a sparse solve's floating-point operations (FactorWork), estimated from counts:
+    // the step's choices depend on no clock.
+    double factorize_work = 0.0;  ///< a factorisation's: the price of a new one
+    double solve_work = 0.0;      ///< one solve's with it
+    double assemble_work = 0.0;   ///< one assembly of the tangent's (Body::tangent_work)
     int steps_served = 0;            ///< steps begun with it since it was made
     bool failed = false;             ///< an update solved with it failed
     /// Steps the factorisations' updates served before their first failure, a running mean
@@ -35,7 +37,7 @@ struct KeptFactorisation {
     /// CG iterations per solve preconditioned with a factorisation made in the same step [0]
     /// or an earlier one [1] (running means).
     double krylov_iterations[2] = {4.0, 4.0};
-    double krylov_spent = 0.0;       ///< assembly and CG time spent with it as preconditioner (s)
+    double krylov_spent = 0.0;    ///< assembly and CG work spent with it as preconditioner
 };
 
 /// The sparse linear system of a Newton solve and what solving it needs.

@@ -22,23 +22,23 @@ void PreconditionedCgWork::resize(size_t n) {
     r.swap(fresh[0]), z.swap(fresh[1]), p.swap(fresh[2]), q.swap(fresh[3]);
 }
 
-PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolver& preconditioner, const double* b,
-                                               double* x, double tolerance, int max_iterations,
-                                               PreconditionedCgWork& work) {
+PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::function<void(const double*, double*)>& multiply,
+                                               Preconditioner& preconditioner, const double* b, double* x,
+                                               double tolerance, int max_iterations, PreconditionedCgWork& work) {
     const double t0 = now_seconds();
     PreconditionedCgResult out;
-    const size_t n = static_cast<size_t>(a.dof_count());
+    const size_t n = static_cast<size_t>(dof_count);
     vec<double>&r = work.r, &z = work.z, &p = work.p, &q = work.q;
     for (size_t i = 0; i < n; ++i) x[i] = 0.0, r[i] = b[i];
     const double b_norm = std::sqrt(dot(r, r));
     out.relative_residual = b_norm > 0.0 ? 1.0 : 0.0;
     out.converged = !(b_norm > 0.0);
     if (out.converged) return out;
-    preconditioner.solve(a, r.data(), z.data());
+    preconditioner.apply(r.data(), z.data());
     std::copy(z.begin(), z.end(), p.begin());
     double rz = dot(r, z);
     while (out.iterations < max_iterations) {
-        a.multiply(p.data(), q.data());
+        multiply(p.data(), q.data());
         ++out.iterations;
         const double curvature = dot(p, q);
         if (!(curvature > 0.0) || !(rz > 0.0)) break;
@@ -52,7 +52,7 @@ PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolv
             out.converged = true;
             break;
         }
-        preconditioner.solve(a, r.data(), z.data());
+        preconditioner.apply(r.data(), z.data());
         const double rz_next = dot(r, z);
         const double beta = rz_next / rz;
         rz = rz_next;
@@ -60,6 +60,20 @@ PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolv
     }
     out.seconds = now_seconds() - t0;
     return out;
+}
+
+PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolver& preconditioner, const double* b,
+                                               double* x, double tolerance, int max_iterations,
+                                               PreconditionedCgWork& work) {
+    struct Factorisation final : Preconditioner {
+        const SparseSystem& a;
+        LinearSolver& solver;
+        Factorisation(const SparseSystem& a_, LinearSolver& solver_) : a(a_), solver(solver_) {}
+        void apply(const double* r, double* z) override { solver.solve(a, r, z); }
+    } factorisation(a, preconditioner);
+    return solve_preconditioned_cg(
+        a.dof_count(), [&](const double* in, double* out) { a.multiply(in, out); }, factorisation, b, x, tolerance,
+        max_iterations, work);
 }
 
 }  // namespace sh

@@ -1,12 +1,22 @@
-// Conjugate gradients preconditioned by a direct solver's factorisation of a nearby matrix: a
-// factorisation kept from an earlier Newton iterate or step serves the current tangent with a
-// few iterations instead of a new factorisation.
+// Conjugate gradients with a preconditioner: a direct solver's factorisation of a nearby matrix
+// (one kept from an earlier Newton iterate or step serves the current tangent with a few
+// iterations instead of a new factorisation) or a multigrid cycle.
 #pragma once
 
 #include "linalg/linear_solver.hpp"
 #include "linalg/sparse_system.hpp"
 
+#include <functional>
+
 namespace sh {
+
+/// z = M^-1 r for a symmetric positive definite M near the system's matrix.
+class Preconditioner {
+public:
+    virtual ~Preconditioner() = default;
+    /// z = M^-1 r (dof_count values each; they must not overlap).
+    virtual void apply(const double* r, double* z) = 0;
+};
 
 /// solve_preconditioned_cg's vectors, kept by its caller beside the matrix so that a solve
 /// allocates nothing (sized for a.dof_count() by resize).
@@ -35,5 +45,10 @@ struct PreconditionedCgResult {
 PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolver& preconditioner, const double* b,
                                                double* x, double tolerance, int max_iterations,
                                                PreconditionedCgWork& work);
+
+/// The same with any preconditioner; multiply(x, y) computes y = A x.
+PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::function<void(const double*, double*)>& multiply,
+                                               Preconditioner& preconditioner, const double* b, double* x,
+                                               double tolerance, int max_iterations, PreconditionedCgWork& work);
 
 }  // namespace sh

@@ -38,6 +38,14 @@ constexpr int kMaxStaleSolves = 4;
 // paths. Not in contact: contacts switch within a step, where Newton with factorisations at
 // its iterates converges in fewer iterations (a cube on a 1e9 N/m plane did not converge in
 // 20 iterations with CG updates).
+// For a body solved alone with at least this many free DOFs and no contact candidates, CG's
+// preconditioner is the warped multigrid (linalg/warped_multigrid.hpp) rather than the kept
+// factorisation wherever krylov_pays finds it cheaper per step than new factorisations: under
+// large rotation a factorisation (20-26 solves at 20 k tets) goes stale within a step or two,
+// where 5-7 multigrid iterations cost about three solves and never go stale. Once chosen, steps
+// start with it until it fails to converge. Smaller bodies factorise in a few ms and keep the
+// direct path.
+constexpr int32_t kMultigridMinDofs = 9000;
 constexpr double kKrylovForcing = 0.1;
 constexpr double kKrylovBudget = 0.5;
 constexpr int kKrylovMinIterations = 2, kKrylovMaxIterations = 50;
@@ -135,6 +143,14 @@ private:
     bool krylov_pays();
     /// CG failed this step: no more of it; the next update comes with a new factorisation.
     void give_up_krylov();
+    /// True if the warped multigrid serves this step (kMultigridMinDofs), built first if the
+    /// step size or the matrix version changed.
+    bool use_multigrid();
+    /// Builds matrix_.multigrid from the step's matrix at the rest shape; false if it failed.
+    bool build_multigrid();
+    /// The update by CG preconditioned by the multigrid on the assembled tangent; false if it
+    /// did not converge within kKrylovMaxIterations.
+    bool solve_by_multigrid();
     /// One CG iteration's work: a solve with the kept factorisation and a product with the
     /// tangent (4 operations per stored entry of its upper triangle).
     double cg_iteration_work() const;
@@ -190,6 +206,7 @@ private:
     bool krylov_ = false;          // the kept factorisation preconditions CG on the tangent
     bool krylov_update_ = false;   // the last update came from such CG (it counts as fresh_)
     bool krylov_failed_ = false;   // CG failed this step: no more of it
+    bool multigrid_ = false;       // CG is preconditioned by the multigrid, not the kept factorisation
     bool assembled_ = false;       // matrix_.system holds the tangent at the current iterate
     bool in_contact_ = false;      // a body has contact candidates (a field) this step
     uint64_t matrix_version_ = 0;  // the bodies' matrix version at the step's start
@@ -271,6 +288,44 @@ void NewtonStep::begin() {
     factor_current_ = reuse_ && allow_stale_ && matrix_.kept.valid && matrix_.kept.dt == dt_ &&
                       matrix_.kept.matrix_version == matrix_version_;
     if (factor_current_) ++matrix_.kept.steps_served;
+    multigrid_ = krylov_ = matrix_.multigrid_mode && use_multigrid();
+}
+
+bool NewtonStep::use_multigrid() {
+    if (!allow_stale_ || !reuse_ || in_contact_ || problem_.body_count() != 1 ||
+        matrix_.system.dof_count() < kMultigridMinDofs)
+        return false;
+    const bool current = matrix_.multigrid_dt == dt_ && matrix_.multigrid_version == matrix_version_;
+    if (current && matrix_.multigrid.built_for(matrix_.system)) return true;
+    if (current && matrix_.multigrid_failed) return false;
+    return build_multigrid();
+}
+
+bool NewtonStep::build_multigrid() {
+    SteppedBody& stepped = problem_.body(0);
+    Body& body = *stepped.body;
+    matrix_.multigrid.clear();
+    matrix_.multigrid_dt = dt_;
+    matrix_.multigrid_version = matrix_version_;
+    matrix_.multigrid_failed = true;
+    const vec<int32_t>& global = matrix_.system.dof_to_global();
+    vec<double> rest(global.size()), current(body.x);
+    for (size_t d = 0; d < global.size(); ++d) rest[d] = body.rest[static_cast<size_t>(global[d])];
+    // The step's matrix at the rest shape, where every law is linear elasticity.
+    std::copy(body.rest.begin(), body.rest.end(), body.x.begin());
+    try {
+        assemble_body(body, *stepped.newton);
+        std::copy(current.begin(), current.end(), body.x.begin());
+        assembled_ = false;
+        matrix_.multigrid.build(matrix_.system, rest.data());
+        matrix_.rotations.reset(body, global);
+    } catch (const Error& e) {
+        std::copy(current.begin(), current.end(), body.x.begin());
+        if (e.status() != SH_ERR_SOLVER) throw;
+        return false;
+    }
+    matrix_.multigrid_failed = false;
+    return true;
 }
 
 // Moves every body to x = x0 + h v, then fills matrix_.residual with g(v), r_, r_max_ and phi_.
@@ -358,18 +413,54 @@ bool NewtonStep::krylov_pays() {
     // A factorisation's price; CG pays at most that much on one before buying a new one (so
     // that a wrong estimate of the lives costs at most a factorisation per factorisation).
     const double price = kept.assemble_work + kept.factorize_work;
+    const double direct = price / std::max(kept.mean_life, 1.0);
+    if (use_multigrid()) {
+        const double multigrid = kept.assemble_work + matrix_.multigrid_iterations * matrix_.multigrid.iteration_work();
+        multigrid_ = matrix_.multigrid_mode = multigrid < direct + kept.solve_work;
+        if (multigrid_) return true;
+    }
     const double krylov = kept.assemble_work + kept.krylov_iterations[kept.steps_served > 0] * cg_iteration_work();
-    return kept.mean_life >= 0.0 && krylov < price / std::max(kept.mean_life, 1.0) && kept.krylov_spent < price;
+    return kept.mean_life >= 0.0 && krylov < direct && kept.krylov_spent < price;
 }
 
 void NewtonStep::give_up_krylov() {
-    krylov_ = false;
+    krylov_ = multigrid_ = false;
     krylov_failed_ = true;
     factor_current_ = false;
 }
 
+bool NewtonStep::solve_by_multigrid() {
+    WarpedMultigrid& multigrid = matrix_.multigrid;
+    try {
+        multigrid.prepare(matrix_.system, matrix_.rotations.update(*problem_.body(0).body));
+    } catch (const Error& e) {
+        if (e.status() != SH_ERR_SOLVER) throw;
+        matrix_.multigrid_mode = false;
+        return false;  // a diagonal block not positive definite: the factorisation will say where
+    }
+    // At most as many iterations as a factorisation costs (the fallback), once that is known.
+    const double factorisation = matrix_.kept.factorize_work;
+    const int cap = factorisation > 0.0 ? std::clamp(static_cast<int>(factorisation / multigrid.iteration_work()),
+                                                     kKrylovMinIterations, kKrylovMaxIterations)
+                                        : kKrylovMaxIterations;
+    const PreconditionedCgResult cg = solve_for_update([&](const double* minus_g, double* delta) {
+        return solve_preconditioned_cg(
+            matrix_.system.dof_count(), [&](const double* x, double* y) { multigrid.multiply(x, y); }, multigrid,
+            minus_g, delta, kKrylovForcing * s_.factor_reuse, cap, matrix_.cg);
+    });
+    result_.linear_iterations += cg.iterations;
+    result_.solve_seconds += cg.seconds;
+    used_stale = true;  // an inexact update: a failed step retries with factorisations
+    // A failure counts twice the cap, so that a body it fails on goes back to factorisations.
+    double& mean = matrix_.multigrid_iterations;
+    mean = kKeepLife * mean + (1.0 - kKeepLife) * (cg.converged ? cg.iterations : 2.0 * cap);
+    if (!cg.converged) matrix_.multigrid_mode = false;
+    return cg.converged;
+}
+
 bool NewtonStep::solve_by_krylov() {
     assemble_tangent();
+    if (multigrid_) return solve_by_multigrid();
     KeptFactorisation& kept = matrix_.kept;
     const double per_iteration = cg_iteration_work();
     const int cap = std::clamp(static_cast<int>(kKrylovBudget * kept.factorize_work / per_iteration),
@@ -403,7 +494,7 @@ bool NewtonStep::factorize_and_solve(bool& failed) {
     failed = false;
     krylov_update_ = false;
     try {
-        if (krylov_ && factor_current_) {
+        if (krylov_ && (multigrid_ || factor_current_)) {
             if (solve_by_krylov()) {
                 fresh_ = krylov_update_ = true;
                 return true;

@@ -33,6 +33,8 @@ void NewtonMatrix::reset(SparseSystem&& pattern, LinearSolverPtr new_solver) {
     previous_v.swap(p);
     std::swap(cg, work);
     kept.valid = false;
+    multigrid.clear();
+    multigrid_failed = multigrid_mode = false;
 }
 
 LinearSolverPtr make_analysed_solver(const SparseSystem& system, const sh_implicit_settings& s,

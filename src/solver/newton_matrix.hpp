@@ -8,6 +8,8 @@
 #include "linalg/linear_solver.hpp"
 #include "linalg/preconditioned_cg.hpp"
 #include "linalg/sparse_system.hpp"
+#include "linalg/warped_multigrid.hpp"
+#include "solver/node_rotations.hpp"
 
 #include <softhap/softhap.h>
 
@@ -48,7 +50,16 @@ struct NewtonMatrix {
     vec<double> delta;       ///< per DOF: the Newton update (CG's warm start)
     vec<double> previous_v;  ///< per DOF: velocities before a trial update (the line search's start)
     KeptFactorisation kept;  ///< the factorisation the solver may be holding
-    PreconditionedCgWork cg; ///< CG's vectors when the kept factorisation preconditions it
+    PreconditionedCgWork cg; ///< CG's vectors when the kept factorisation or multigrid preconditions it
+    /// A large body's CG preconditioner under large rotation, built at the rest shape on first
+    /// use for one step size and matrix version (the members below), and its nodes' rotations.
+    WarpedMultigrid multigrid;
+    NodeRotations rotations;
+    double multigrid_dt = 0.0;         ///< the step size multigrid was built (or failed) for (s)
+    uint64_t multigrid_version = 0;    ///< and the bodies' matrix version
+    bool multigrid_failed = false;     ///< its build failed for them: not tried again
+    bool multigrid_mode = false;       ///< steps start with it (it paid when a factorisation failed)
+    double multigrid_iterations = 6.0; ///< CG iterations per solve with it (running mean)
 
     /// Takes pattern as the matrix and solver (analysed for it, or null) as its solver, sizes
     /// the scratch vectors for its DOFs (delta zeroed) and forgets any kept factorisation.

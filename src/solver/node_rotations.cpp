@@ -1,0 +1,69 @@
+#include "solver/node_rotations.hpp"
+
+#include "core/vec3.hpp"
+#include "material/lanes.hpp"
+#include "material/polar_decomposition.hpp"
+
+#include <algorithm>
+
+namespace sh {
+namespace {
+
+// A preconditioner needs the rotations to a few 1e-4 rad, not the element laws' 1e-6.
+constexpr double kNodeRotationSettled2 = 1e-8;
+
+}  // namespace
+
+void NodeRotations::reset(const Body& body, const vec<int32_t>& dof_to_global) {
+    const size_t free_nodes = dof_to_global.size() / 3;
+    vec<int32_t> free_of(body.x.size() / 3, -1);
+    for (size_t k = 0; k < free_nodes; ++k) free_of[static_cast<size_t>(dof_to_global[3 * k]) / 3] = static_cast<int32_t>(k);
+    vec<double> shape(9 * free_nodes, 0.0), rotation(9 * free_nodes, 0.0);
+    for (size_t k = 0; k < free_nodes; ++k) rotation[9 * k] = rotation[9 * k + 4] = rotation[9 * k + 8] = 1.0;
+    free_of_.swap(free_of), shape_.swap(shape), rotation_.swap(rotation);
+}
+
+const double* NodeRotations::update(const Body& body) {
+    std::fill(shape_.begin(), shape_.end(), 0.0);
+    const int32_t* elements = body.element_nodes();
+    const int per = body.nodes_per_element();
+    const double* x = body.x.data();
+    const double* rest = body.rest.data();
+    for (int32_t e = 0; e < body.element_count(); ++e) {
+        const int32_t* nodes = elements + static_cast<size_t>(e) * static_cast<size_t>(per);
+        for (int a = 0; a < per; ++a) {
+            const int32_t k = free_of_[static_cast<size_t>(nodes[a])];
+            if (k < 0) continue;
+            double* s = &shape_[9 * static_cast<size_t>(k)];
+            for (int b = 0; b < per; ++b) {
+                if (b == a) continue;
+                double dx[3], dr[3];
+                sub3(at(x, nodes[b]), at(x, nodes[a]), dx);
+                sub3(at(rest, nodes[b]), at(rest, nodes[a]), dr);
+                for (int r = 0; r < 3; ++r)
+                    for (int c = 0; c < 3; ++c) s[3 * r + c] += dx[r] * dr[c];
+            }
+        }
+    }
+    // kLanes nodes at a time; the last group's spare lanes repeat its first node.
+    const size_t n = size();
+    for (size_t first = 0; first < n; first += kLanes) {
+        Mat3L f, near;
+        for (int l = 0; l < kLanes; ++l) {
+            const size_t k = first + static_cast<size_t>(l) < n ? first + static_cast<size_t>(l) : first;
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) {
+                    f.m[r][c][l] = shape_[9 * k + 3 * static_cast<size_t>(r) + static_cast<size_t>(c)];
+                    near.m[r][c][l] = rotation_[9 * k + 3 * static_cast<size_t>(r) + static_cast<size_t>(c)];
+                }
+        }
+        const Mat3L found = polar_rotation_near(f, near, kNodeRotationSettled2);
+        for (int l = 0; l < kLanes && first + static_cast<size_t>(l) < n; ++l)
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c)
+                    rotation_[9 * (first + static_cast<size_t>(l)) + 3 * static_cast<size_t>(r) + static_cast<size_t>(c)] = found.m[r][c][l];
+    }
+    return rotation_.data();
+}
+
+}  // namespace sh

@@ -1,0 +1,33 @@
+// Each free node's rotation from the rest shape to the current one, for the warped multigrid
+// preconditioner of implicit steps (linalg/warped_multigrid.hpp): the rotation of the polar
+// decomposition of the node's shape-matching matrix S_i = sum (x_j - x_i)(X_j - X_i)^T over the
+// element edges from i (X rest, x current). Each call starts from the last call's rotations,
+// which one or two Newton updates carry to the new ones.
+#pragma once
+
+#include "core/memory.hpp"
+#include "model/body.hpp"
+
+#include <cstdint>
+
+namespace sh {
+
+/// Free nodes' rotations of one body (see the file comment).
+class NodeRotations {
+public:
+    /// Starts over for a body whose free DOF d stands for body DOF dof_to_global[d] (3 per free
+    /// node, x y z in order): identity rotations. Allocates.
+    void reset(const Body& body, const vec<int32_t>& dof_to_global);
+    /// The rotations at body's current positions (9 per free node, row-major, rest frame to
+    /// current), from the last ones.
+    const double* update(const Body& body);
+    /// Free nodes it holds.
+    size_t size() const { return rotation_.size() / 9; }
+
+private:
+    vec<int32_t> free_of_;   // per body node: its free node, -1 if not free
+    vec<double> shape_;      // 9 per free node: S_i
+    vec<double> rotation_;   // 9 per free node
+};
+
+}  // namespace sh

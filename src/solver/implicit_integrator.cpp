@@ -42,9 +42,10 @@ constexpr int kMaxStaleSolves = 4;
 // preconditioner is the warped multigrid (linalg/warped_multigrid.hpp) rather than the kept
 // factorisation wherever krylov_pays finds it cheaper per step than new factorisations: under
 // large rotation a factorisation (20-26 solves at 20 k tets) goes stale within a step or two,
-// where 5-7 multigrid iterations cost about three solves and never go stale. Once chosen, steps
-// start with it until it fails to converge. Smaller bodies factorise in a few ms and keep the
-// direct path.
+// where 5-7 multigrid iterations cost about one solve and never go stale. Once chosen, steps
+// start with it; once it fails to converge within a factorisation's work, the body keeps
+// factorisations until its matrix version or the step size changes. Smaller bodies factorise
+// in a few ms and keep the direct path.
 constexpr int32_t kMultigridMinDofs = 9000;
 constexpr double kKrylovForcing = 0.1;
 constexpr double kKrylovBudget = 0.5;
@@ -436,6 +437,8 @@ bool NewtonStep::solve_by_multigrid() {
     } catch (const Error& e) {
         if (e.status() != SH_ERR_SOLVER) throw;
         matrix_.multigrid_mode = false;
+        matrix_.multigrid_failed = true;
+        matrix_.multigrid.clear();
         return false;  // a diagonal block not positive definite: the factorisation will say where
     }
     // At most as many iterations as a factorisation costs (the fallback), once that is known.
@@ -451,11 +454,17 @@ bool NewtonStep::solve_by_multigrid() {
     result_.linear_iterations += cg.iterations;
     result_.solve_seconds += cg.seconds;
     used_stale = true;  // an inexact update: a failed step retries with factorisations
-    // A failure counts twice the cap, so that a body it fails on goes back to factorisations.
+    // A body it fails on (a coarse grid that couples parts the mesh does not, such as the
+    // raptor's legs: 20-44 iterations) keeps factorisations until its matrix changes.
+    if (!cg.converged) {
+        matrix_.multigrid_mode = false;
+        matrix_.multigrid_failed = true;
+        matrix_.multigrid.clear();
+        return false;
+    }
     double& mean = matrix_.multigrid_iterations;
-    mean = kKeepLife * mean + (1.0 - kKeepLife) * (cg.converged ? cg.iterations : 2.0 * cap);
-    if (!cg.converged) matrix_.multigrid_mode = false;
-    return cg.converged;
+    mean = kKeepLife * mean + (1.0 - kKeepLife) * cg.iterations;
+    return true;
 }
 
 bool NewtonStep::solve_by_krylov() {

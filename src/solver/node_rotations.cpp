@@ -4,13 +4,40 @@
 #include "material/lanes.hpp"
 #include "material/polar_decomposition.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
+#include <cmath>
 
 namespace sh {
 namespace {
 
-// A preconditioner needs the rotations to a few 1e-4 rad, not the element laws' 1e-6.
-constexpr double kNodeRotationSettled2 = 1e-8;
+// A preconditioner needs the rotations to about 1e-3 rad, not the element laws' 1e-6.
+constexpr double kNodeRotationSettled2 = 1e-6;
+
+// Adds the products (x_b - x_a)(r_b - r_a)^T over the element edges from each free node a into
+// out (9 per free node), x and r positions of the body's nodes.
+void add_edge_products(const Body& body, const vec<int32_t>& free_of, const double* x, const double* r,
+                       vec<double>& out) {
+    const int32_t* elements = body.element_nodes();
+    const int per = body.nodes_per_element();
+    for (int32_t e = 0; e < body.element_count(); ++e) {
+        const int32_t* nodes = elements + static_cast<size_t>(e) * static_cast<size_t>(per);
+        for (int a = 0; a < per; ++a) {
+            const int32_t k = free_of[static_cast<size_t>(nodes[a])];
+            if (k < 0) continue;
+            double* s = &out[9 * static_cast<size_t>(k)];
+            for (int b = 0; b < per; ++b) {
+                if (b == a) continue;
+                double dx[3], dr[3];
+                sub3(at(x, nodes[b]), at(x, nodes[a]), dx);
+                sub3(at(r, nodes[b]), at(r, nodes[a]), dr);
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 3; ++j) s[3 * i + j] += dx[i] * dr[j];
+            }
+        }
+    }
+}
 
 }  // namespace
 
@@ -18,32 +45,25 @@ void NodeRotations::reset(const Body& body, const vec<int32_t>& dof_to_global) {
     const size_t free_nodes = dof_to_global.size() / 3;
     vec<int32_t> free_of(body.x.size() / 3, -1);
     for (size_t k = 0; k < free_nodes; ++k) free_of[static_cast<size_t>(dof_to_global[3 * k]) / 3] = static_cast<int32_t>(k);
-    vec<double> shape(9 * free_nodes, 0.0), rotation(9 * free_nodes, 0.0);
-    for (size_t k = 0; k < free_nodes; ++k) rotation[9 * k] = rotation[9 * k + 4] = rotation[9 * k + 8] = 1.0;
-    free_of_.swap(free_of), shape_.swap(shape), rotation_.swap(rotation);
+    vec<double> shape(9 * free_nodes, 0.0), inverse_rest(9 * free_nodes, 0.0), rotation(9 * free_nodes, 0.0);
+    add_edge_products(body, free_of, body.rest.data(), body.rest.data(), inverse_rest);
+    for (size_t k = 0; k < free_nodes; ++k) {
+        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> q(&inverse_rest[9 * k]);
+        const double det = q.determinant(), size = q.squaredNorm();
+        // A node whose edges lie in a plane or on a line (springs): S alone, scaled.
+        if (det > 1e-9 * size * std::sqrt(size)) q = q.inverse().eval();
+        else q /= std::max(size, 1e-300);
+        rotation[9 * k] = rotation[9 * k + 4] = rotation[9 * k + 8] = 1.0;
+    }
+    free_of_.swap(free_of), shape_.swap(shape), inverse_rest_.swap(inverse_rest), rotation_.swap(rotation);
 }
 
 const double* NodeRotations::update(const Body& body) {
     std::fill(shape_.begin(), shape_.end(), 0.0);
-    const int32_t* elements = body.element_nodes();
-    const int per = body.nodes_per_element();
-    const double* x = body.x.data();
-    const double* rest = body.rest.data();
-    for (int32_t e = 0; e < body.element_count(); ++e) {
-        const int32_t* nodes = elements + static_cast<size_t>(e) * static_cast<size_t>(per);
-        for (int a = 0; a < per; ++a) {
-            const int32_t k = free_of_[static_cast<size_t>(nodes[a])];
-            if (k < 0) continue;
-            double* s = &shape_[9 * static_cast<size_t>(k)];
-            for (int b = 0; b < per; ++b) {
-                if (b == a) continue;
-                double dx[3], dr[3];
-                sub3(at(x, nodes[b]), at(x, nodes[a]), dx);
-                sub3(at(rest, nodes[b]), at(rest, nodes[a]), dr);
-                for (int r = 0; r < 3; ++r)
-                    for (int c = 0; c < 3; ++c) s[3 * r + c] += dx[r] * dr[c];
-            }
-        }
+    add_edge_products(body, free_of_, body.x.data(), body.rest.data(), shape_);
+    for (size_t k = 0; k < size(); ++k) {
+        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s(&shape_[9 * k]);
+        s = (s * Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&inverse_rest_[9 * k])).eval();
     }
     // kLanes nodes at a time; the last group's spare lanes repeat its first node.
     const size_t n = size();

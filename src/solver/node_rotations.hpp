@@ -1,8 +1,9 @@
 // Each free node's rotation from the rest shape to the current one, for the warped multigrid
 // preconditioner of implicit steps (linalg/warped_multigrid.hpp): the rotation of the polar
-// decomposition of the node's shape-matching matrix S_i = sum (x_j - x_i)(X_j - X_i)^T over the
-// element edges from i (X rest, x current). Each call starts from the last call's rotations,
-// which one or two Newton updates carry to the new ones.
+// decomposition of the node's least-squares deformation gradient F_i = S_i Q_i^-1, with
+// S_i = sum (x_j - x_i)(X_j - X_i)^T and Q_i = sum (X_j - X_i)(X_j - X_i)^T over the element
+// edges from i (X rest, x current). Each call starts from the last call's rotations, which one
+// or two Newton updates carry to the new ones.
 #pragma once
 
 #include "core/memory.hpp"
@@ -27,6 +28,7 @@ public:
 private:
     vec<int32_t> free_of_;   // per body node: its free node, -1 if not free
     vec<double> shape_;      // 9 per free node: S_i
+    vec<double> inverse_rest_;  // 9 per free node: Q_i^-1 (Q_i / tr Q_i^2 where Q_i is singular)
     vec<double> rotation_;   // 9 per free node
 };
 

@@ -10,7 +10,8 @@ with the converged backward Euler step (Newton to 1e-9, a factorisation at every
 relative to that run's largest displacement:
 
   - the default settings (one linearised update per step; a kept factorisation, or CG on the
-    tangent preconditioned by it where the tangent drifts too fast for new ones to pay off);
+    tangent where the tangent drifts too fast for new ones to pay off, preconditioned by the
+    kept factorisation or, from 9,000 free DOF, by the warped multigrid);
   - exact linearised steps (factor_reuse 0: a factorisation every step);
   - backward Euler itself at dt / 4, which shows the size of its own time error at 60 Hz.
 

@@ -413,14 +413,17 @@ typedef struct sh_implicit_settings {
                                          instead by conjugate gradients on the current tangent
                                          preconditioned by the kept factorisation, to a relative
                                          residual of 0.1 factor_reuse, and factorises afresh once
-                                         that has cost as much as a factorisation; a body solved
-                                         alone with 9,000 free DOF or more uses a multigrid
-                                         cycle (a grid over its rest shape, warped by its
-                                         nodes' rotations) as that preconditioner, and keeps
-                                         it across steps, until it fails to converge within a
-                                         factorisation's work. These choices weigh work
-                                         estimated from counts, never measured time, so that
-                                         identical runs repeat bit for bit. Changing dt,
+                                         that has cost as much as a factorisation. A body solved
+                                         alone with 9,000 free DOF or more and no contact
+                                         candidates uses a multigrid cycle instead (a grid over
+                                         its rest shape, warped by its nodes' rotations) where
+                                         that costs less per step than new factorisations, and
+                                         keeps it across steps until its nodes settle or it
+                                         fails to converge within a factorisation's work;
+                                         changing dt by more than 25 % or the matrix rebuilds
+                                         it. These choices weigh work estimated from counts,
+                                         never measured time, so that identical runs repeat bit
+                                         for bit. Changing dt,
                                          the fixed nodes, a material or node
                                          damping refactorises. 0 = a new factorisation at every
                                          Newton iteration (exact Newton); must be in [0, 1);

@@ -15,6 +15,10 @@ namespace {
 constexpr double kCoarsening = 25.0;
 // The most coarse nodes: the coarse matrix is dense (1,200 DOF: 11.5 MB, a 0.2 ms solve).
 constexpr int32_t kMaxCoarseNodes = 400;
+// The grid search's bounds: cells along the longest side, and nodes of a grid (its index is
+// one int32 per grid node).
+constexpr int32_t kMaxCells = 256;
+constexpr int64_t kMaxGridNodes = int64_t{1} << 21;
 // Trilinear weights below this are left out of P, so that no coarse node hangs on weights of
 // zero (a node on a grid plane) and makes the coarse matrix singular.
 constexpr double kWeightFloor = 1e-9;
@@ -88,15 +92,23 @@ void WarpedMultigrid::build_prolongation(const double* rest, int32_t nodes) {
             lo[a] = std::min(lo[a], rest[3 * static_cast<size_t>(i) + a]);
             hi[a] = std::max(hi[a], rest[3 * static_cast<size_t>(i) + a]);
         }
-    // The finest grid (cells along the longest side) within the coarse node budget.
+    // The finest grid (cells along the longest side) within the coarse node budget, by
+    // bisection (the count grows with the cells), and no grid of more than kMaxGridNodes nodes
+    // (a body whose nodes fill little of their box: two organs far apart).
     const int32_t wanted = std::min(kMaxCoarseNodes, std::max(8, static_cast<int32_t>(nodes / kCoarsening)));
     vec<int32_t> index;
-    int32_t cells = 1;
-    while (cells < 256) {
-        if (number_corners(grid_over(lo, hi, cells + 1), rest, nodes, index) > wanted) break;
-        ++cells;
+    int32_t fits = 1, too_many = 1;
+    while (too_many < kMaxCells && grid_over(lo, hi, 2 * too_many).node_count() <= kMaxGridNodes &&
+           number_corners(grid_over(lo, hi, 2 * too_many), rest, nodes, index) <= wanted)
+        fits = too_many *= 2;
+    too_many = 2 * fits;
+    while (too_many - fits > 1) {
+        const int32_t middle = (fits + too_many) / 2;
+        const Grid g = grid_over(lo, hi, middle);
+        const bool ok = g.node_count() <= kMaxGridNodes && number_corners(g, rest, nodes, index) <= wanted;
+        (ok ? fits : too_many) = middle;
     }
-    const Grid g = grid_over(lo, hi, cells);
+    const Grid g = grid_over(lo, hi, fits);
     coarse_count_ = number_corners(g, rest, nodes, index);
     corner_.assign(8 * static_cast<size_t>(nodes), -1);
     weight_.assign(8 * static_cast<size_t>(nodes), 0.0);
@@ -158,8 +170,9 @@ void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
     std::copy(rotations, rotations + rotation_.size(), rotation_.begin());
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
         const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> d(blocks_.block(blocks_.diagonal(i)));
-        const Eigen::Matrix3d inverse = d.inverse();
-        SH_REQUIRE(d(0, 0) > 0.0 && d.determinant() > 0.0 && inverse.allFinite(), SH_ERR_SOLVER,
+        const Eigen::LLT<Eigen::Matrix3d> cholesky(d);
+        const Eigen::Matrix3d inverse = cholesky.solve(Eigen::Matrix3d::Identity());
+        SH_REQUIRE(cholesky.info() == Eigen::Success && inverse.allFinite(), SH_ERR_SOLVER,
                    "multigrid: the diagonal block of free node %d is not positive definite", i);
         Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> out(&inverse_diagonal_[9 * static_cast<size_t>(i)]);
         out = inverse;

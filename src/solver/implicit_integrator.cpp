@@ -47,6 +47,16 @@ constexpr int kMaxStaleSolves = 4;
 // factorisations until its matrix version or the step size changes. Smaller bodies factorise
 // in a few ms and keep the direct path.
 constexpr int32_t kMultigridMinDofs = 9000;
+// The multigrid built for one step size serves steps within this fraction of it (it only
+// preconditions; a host alternating 1/60 and 1/61 s would rebuild it every step).
+constexpr double kMultigridStepTolerance = 0.25;
+// Nodes that turn by less than this (rad) per update for NewtonMatrix::multigrid_calm_needed
+// multigrid updates in a row (10 at first) have settled: the body goes back to factorisations,
+// which then last many steps with one solve each, where the multigrid keeps costing an assembly
+// and 5-6 iterations. Where the new factorisation goes stale sooner than that count anyway (a
+// slow swing), the count doubles, up to kMaxCalmSteps: such probes cost a factorisation each.
+constexpr double kCalmTurn = 0.005;
+constexpr int kMaxCalmSteps = 640;
 constexpr double kKrylovForcing = 0.1;
 constexpr double kKrylovBudget = 0.5;
 constexpr int kKrylovMinIterations = 2, kKrylovMaxIterations = 50;
@@ -130,8 +140,9 @@ private:
     double extent() const;
     /// Moves the bodies to the current velocities' positions; residual, its norms and Phi there.
     void evaluate();
-    /// One body's m (1 + dt c) + dt D + dt^2 K into its own matrix; its force round-off.
-    double assemble_body(Body& body, NewtonBodyState& state);
+    /// One body's m (1 + dt c) + dt D + dt^2 K at positions x into its own matrix; its force
+    /// round-off.
+    double assemble_body(Body& body, NewtonBodyState& state, const double* x);
     /// Solves for the Newton update, factorising first unless a kept factorisation serves.
     bool factorize_and_solve(bool& failed);
     /// Assembles the bodies' tangent at the current iterate into matrix_.system.
@@ -149,9 +160,15 @@ private:
     bool use_multigrid();
     /// Builds matrix_.multigrid from the step's matrix at the rest shape; false if it failed.
     bool build_multigrid();
-    /// The update by CG preconditioned by the multigrid on the assembled tangent; false if it
-    /// did not converge within kKrylovMaxIterations.
+    /// The multigrid does not serve this body until its matrix version or step size changes.
+    void drop_multigrid();
+    /// The update by CG preconditioned by the multigrid on the assembled tangent; false (the
+    /// multigrid dropped) if it did not converge within a factorisation's work.
     bool solve_by_multigrid();
+    /// After a multigrid update: leaves multigrid mode once the nodes have turned by less than
+    /// kCalmTurn per update for multigrid_calm_needed updates (a new factorisation would then
+    /// last).
+    void note_multigrid_motion(double turn);
     /// One CG iteration's work: a solve with the kept factorisation and a product with the
     /// tangent (4 operations per stored entry of its upper triangle).
     double cg_iteration_work() const;
@@ -289,41 +306,48 @@ void NewtonStep::begin() {
     factor_current_ = reuse_ && allow_stale_ && matrix_.kept.valid && matrix_.kept.dt == dt_ &&
                       matrix_.kept.matrix_version == matrix_version_;
     if (factor_current_) ++matrix_.kept.steps_served;
-    multigrid_ = krylov_ = matrix_.multigrid_mode && use_multigrid();
 }
 
 bool NewtonStep::use_multigrid() {
     if (!allow_stale_ || !reuse_ || in_contact_ || problem_.body_count() != 1 ||
         matrix_.system.dof_count() < kMultigridMinDofs)
         return false;
-    const bool current = matrix_.multigrid_dt == dt_ && matrix_.multigrid_version == matrix_version_;
-    if (current && matrix_.multigrid.built_for(matrix_.system)) return true;
+    const bool current = std::fabs(matrix_.multigrid_dt / dt_ - 1.0) <= kMultigridStepTolerance &&
+                         matrix_.multigrid_version == matrix_version_;
     if (current && matrix_.multigrid_failed) return false;
+    if (current && matrix_.multigrid.built_for(matrix_.system)) return true;
     return build_multigrid();
+}
+
+void NewtonStep::drop_multigrid() {
+    matrix_.multigrid.clear();
+    matrix_.multigrid_failed = true;
+    matrix_.multigrid_mode = multigrid_ = false;
 }
 
 bool NewtonStep::build_multigrid() {
     SteppedBody& stepped = problem_.body(0);
     Body& body = *stepped.body;
-    matrix_.multigrid.clear();
+    drop_multigrid();  // until the build succeeds: not tried again for this dt and version
     matrix_.multigrid_dt = dt_;
     matrix_.multigrid_version = matrix_version_;
-    matrix_.multigrid_failed = true;
+    matrix_.multigrid_calm_steps = 0;
     const vec<int32_t>& global = matrix_.system.dof_to_global();
-    vec<double> rest(global.size()), current(body.x);
+    vec<double> rest(global.size());
     for (size_t d = 0; d < global.size(); ++d) rest[d] = body.rest[static_cast<size_t>(global[d])];
-    // The step's matrix at the rest shape, where every law is linear elasticity.
-    std::copy(body.rest.begin(), body.rest.end(), body.x.begin());
+    assembled_ = false;  // the matrix holds the rest shape's from here
     try {
-        assemble_body(body, *stepped.newton);
-        std::copy(current.begin(), current.end(), body.x.begin());
-        assembled_ = false;
-        matrix_.multigrid.build(matrix_.system, rest.data());
         matrix_.rotations.reset(body, global);
+        // The step's matrix at the rest shape, where every law is linear elasticity.
+        assemble_body(body, *stepped.newton, body.rest.data());
+        matrix_.multigrid.build(matrix_.system, rest.data());
     } catch (const Error& e) {
-        std::copy(current.begin(), current.end(), body.x.begin());
+        matrix_.multigrid.clear();
         if (e.status() != SH_ERR_SOLVER) throw;
         return false;
+    } catch (...) {
+        matrix_.multigrid.clear();
+        throw;
     }
     matrix_.multigrid_failed = false;
     return true;
@@ -386,14 +410,15 @@ void NewtonStep::evaluate() {
 }
 
 // m (1 + dt c) + dt D + dt^2 K of one body into its own matrix; its force round-off.
-double NewtonStep::assemble_body(Body& body, NewtonBodyState& state) {
+double NewtonStep::assemble_body(Body& body, NewtonBodyState& state, const double* x) {
     fill_mass_diagonal(body, state, dt_);
-    return state.assemble_tangent(body, dt_ * dt_, dt_, body.v.data(), state.diagonal.data(), 1.0 / dt_);
+    return state.assemble_tangent(body, x, dt_ * dt_, dt_, body.v.data(), state.diagonal.data(), 1.0 / dt_);
 }
 
 void NewtonStep::assemble_tangent() {
     matrix_.kept.roundoff_floor =
-        problem_.assemble([&](SteppedBody& m) { return assemble_body(*m.body, *m.newton); }, dt_ * dt_, dt_, false);
+        problem_.assemble([&](SteppedBody& m) { return assemble_body(*m.body, *m.newton, m.body->x.data()); }, dt_ * dt_,
+                          dt_, false);
     double work = 0.0;
     problem_.each([&](const SteppedBody& stepped, size_t) { work += stepped.body->tangent_work(); });
     matrix_.kept.assemble_work = work;
@@ -418,7 +443,12 @@ bool NewtonStep::krylov_pays() {
     if (use_multigrid()) {
         const double multigrid = kept.assemble_work + matrix_.multigrid_iterations * matrix_.multigrid.iteration_work();
         multigrid_ = matrix_.multigrid_mode = multigrid < direct + kept.solve_work;
-        if (multigrid_) return true;
+        if (multigrid_) {
+            int& needed = matrix_.multigrid_calm_needed;
+            if (matrix_.multigrid_left_calm && kept.mean_life < needed) needed = std::min(2 * needed, kMaxCalmSteps);
+            matrix_.multigrid_left_calm = false;
+            return true;
+        }
     }
     const double krylov = kept.assemble_work + kept.krylov_iterations[kept.steps_served > 0] * cg_iteration_work();
     return kept.mean_life >= 0.0 && krylov < direct && kept.krylov_spent < price;
@@ -432,13 +462,14 @@ void NewtonStep::give_up_krylov() {
 
 bool NewtonStep::solve_by_multigrid() {
     WarpedMultigrid& multigrid = matrix_.multigrid;
+    SH_REQUIRE(matrix_.rotations.size() == static_cast<size_t>(matrix_.system.dof_count() / 3), SH_ERR_INTERNAL,
+               "multigrid: rotations for %zu nodes, system of %d DOFs", matrix_.rotations.size(),
+               matrix_.system.dof_count());
     try {
         multigrid.prepare(matrix_.system, matrix_.rotations.update(*problem_.body(0).body));
     } catch (const Error& e) {
         if (e.status() != SH_ERR_SOLVER) throw;
-        matrix_.multigrid_mode = false;
-        matrix_.multigrid_failed = true;
-        matrix_.multigrid.clear();
+        drop_multigrid();
         return false;  // a diagonal block not positive definite: the factorisation will say where
     }
     // At most as many iterations as a factorisation costs (the fallback), once that is known.
@@ -457,14 +488,25 @@ bool NewtonStep::solve_by_multigrid() {
     // A body it fails on (a coarse grid that couples parts the mesh does not, such as the
     // raptor's legs: 20-44 iterations) keeps factorisations until its matrix changes.
     if (!cg.converged) {
-        matrix_.multigrid_mode = false;
-        matrix_.multigrid_failed = true;
-        matrix_.multigrid.clear();
+        drop_multigrid();
         return false;
     }
     double& mean = matrix_.multigrid_iterations;
     mean = kKeepLife * mean + (1.0 - kKeepLife) * cg.iterations;
+    note_multigrid_motion(matrix_.rotations.last_turn());
     return true;
+}
+
+void NewtonStep::note_multigrid_motion(double turn) {
+    int& calm = matrix_.multigrid_calm_steps;
+    calm = turn < kCalmTurn ? calm + 1 : 0;
+    if (calm < matrix_.multigrid_calm_needed) return;
+    // The next update factorises afresh, and how long that one lasts is measured anew.
+    matrix_.multigrid_mode = false;
+    matrix_.multigrid_left_calm = true;
+    matrix_.kept.valid = false;
+    matrix_.kept.mean_life = -1.0;
+    calm = 0;
 }
 
 bool NewtonStep::solve_by_krylov() {
@@ -619,6 +661,10 @@ BodyStepResult NewtonStep::run(bool keep_best) {
     begin();
     bool converged = false, solver_failed = false;
     try {
+        // Built at the first step (beside the first factorisation and symbolic analysis), so
+        // that the step that switches to it pays no more than its solve.
+        const bool multigrid = use_multigrid();
+        multigrid_ = krylov_ = matrix_.multigrid_mode && multigrid;
         evaluate();
         converged = iterate(solver_failed);
     } catch (...) {

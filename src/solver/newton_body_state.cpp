@@ -88,13 +88,12 @@ int32_t NewtonBodyState::prepare(const Body& body, const sh_implicit_settings& s
     return 3 * count;
 }
 
-double NewtonBodyState::assemble_tangent(const Body& body, double stiffness_scale, double damping_scale, const double* v,
-                                         const double* add_diagonal, double roundoff_scale) {
+double NewtonBodyState::assemble_tangent(const Body& body, const double* x, double stiffness_scale, double damping_scale,
+                                         const double* v, const double* add_diagonal, double roundoff_scale) {
     SparseSystem& system = matrix.system;
     system.clear_values();
-    body.add_tangent(body.x.data(), stiffness_scale, damping_scale, system);
-    if (body.field)
-        body.field->add_tangent(body.x.data(), v, stiffness_scale, damping_scale, free_index.data(), system);
+    body.add_tangent(x, stiffness_scale, damping_scale, system);
+    if (body.field) body.field->add_tangent(x, v, stiffness_scale, damping_scale, free_index.data(), system);
     const double roundoff = force_roundoff(system, body.x, roundoff_scale);
     if (add_diagonal) system.add_diagonal(add_diagonal, 1.0);
     return roundoff;

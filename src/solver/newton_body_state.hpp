@@ -41,12 +41,13 @@ struct NewtonBodyState {
         matrix.kept.valid = false;
     }
 
-    /// Clears the matrix and adds stiffness_scale K + damping_scale D of body at (body.x, v)
-    /// (v null: at rest) from its elements and its field, then add_diagonal (per free DOF) if
-    /// not null. Returns the round-off of the body's forces: force_roundoff of the matrix
-    /// before the diagonal, with roundoff_scale.
-    double assemble_tangent(const Body& body, double stiffness_scale, double damping_scale, const double* v,
-                            const double* add_diagonal, double roundoff_scale);
+    /// Clears the matrix and adds stiffness_scale K + damping_scale D of body at positions x
+    /// (3 per node; body.x, or e.g. its rest shape) and velocities v (null: at rest) from its
+    /// elements and its field, then add_diagonal (per free DOF) if not null. Returns the
+    /// round-off of the body's forces at body.x: force_roundoff of the matrix before the
+    /// diagonal, with roundoff_scale.
+    double assemble_tangent(const Body& body, const double* x, double stiffness_scale, double damping_scale,
+                            const double* v, const double* add_diagonal, double roundoff_scale);
 };
 
 }  // namespace sh

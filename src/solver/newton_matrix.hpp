@@ -60,6 +60,9 @@ struct NewtonMatrix {
     bool multigrid_failed = false;     ///< its build failed for them: not tried again
     bool multigrid_mode = false;       ///< steps start with it (it paid when a factorisation failed)
     double multigrid_iterations = 6.0; ///< CG iterations per solve with it (running mean)
+    int multigrid_calm_steps = 0;      ///< its updates in a row whose nodes barely turned
+    int multigrid_calm_needed = 10;    ///< how many of them leave it (doubles when leaving did not pay)
+    bool multigrid_left_calm = false;  ///< it was left for being calm, and not chosen again since
 
     /// Takes pattern as the matrix and solver (analysed for it, or null) as its solver, sizes
     /// the scratch vectors for its DOFs (delta zeroed) and forgets any kept factorisation.

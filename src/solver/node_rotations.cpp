@@ -67,6 +67,7 @@ const double* NodeRotations::update(const Body& body) {
     }
     // kLanes nodes at a time; the last group's spare lanes repeat its first node.
     const size_t n = size();
+    double turn = 0.0;
     for (size_t first = 0; first < n; first += kLanes) {
         Mat3L f, near;
         for (int l = 0; l < kLanes; ++l) {
@@ -78,11 +79,19 @@ const double* NodeRotations::update(const Body& body) {
                 }
         }
         const Mat3L found = polar_rotation_near(f, near, kNodeRotationSettled2);
-        for (int l = 0; l < kLanes && first + static_cast<size_t>(l) < n; ++l)
-            for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c)
-                    rotation_[9 * (first + static_cast<size_t>(l)) + 3 * static_cast<size_t>(r) + static_cast<size_t>(c)] = found.m[r][c][l];
+        for (int l = 0; l < kLanes && first + static_cast<size_t>(l) < n; ++l) {
+            double change2 = 0.0;
+            double* r = &rotation_[9 * (first + static_cast<size_t>(l))];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) {
+                    const double value = found.m[i][j][l], d = value - r[3 * i + j];
+                    change2 += d * d;
+                    r[3 * i + j] = value;
+                }
+            turn = std::max(turn, std::sqrt(0.5 * change2));  // |R' - R|_F = sqrt(2) angle
+        }
     }
+    last_turn_ = turn;
     return rotation_.data();
 }
 

@@ -24,12 +24,15 @@ public:
     const double* update(const Body& body);
     /// Free nodes it holds.
     size_t size() const { return rotation_.size() / 9; }
+    /// The largest angle (rad, to second order) any node turned by in the last update.
+    double last_turn() const { return last_turn_; }
 
 private:
     vec<int32_t> free_of_;   // per body node: its free node, -1 if not free
     vec<double> shape_;      // 9 per free node: S_i
     vec<double> inverse_rest_;  // 9 per free node: Q_i^-1 (Q_i / tr Q_i^2 where Q_i is singular)
     vec<double> rotation_;   // 9 per free node
+    double last_turn_ = 0.0;
 };
 
 }  // namespace sh

@@ -41,7 +41,7 @@ double assemble_static_tangent(Body& body, NewtonBodyState& state, double shift)
         for (int32_t d = 0; d < k.dof_count(); ++d)
             state.diagonal[static_cast<size_t>(d)] = shift * k.values()[static_cast<size_t>(k.diagonal_slot(d))];
     }
-    return state.assemble_tangent(body, 1.0, 0.0, nullptr, floating ? state.diagonal.data() : nullptr, 1.0);
+    return state.assemble_tangent(body, body.x.data(), 1.0, 0.0, nullptr, floating ? state.diagonal.data() : nullptr, 1.0);
 }
 
 // Out-of-balance force f(x) + load_factor * (f_ext + m g) on the free DOFs into out, and its

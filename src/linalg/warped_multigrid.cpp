@@ -96,20 +96,25 @@ void WarpedMultigrid::build_prolongation(const double* rest, int32_t nodes) {
     // bisection (the count grows with the cells), and no grid of more than kMaxGridNodes nodes
     // (a body whose nodes fill little of their box: two organs far apart).
     const int32_t wanted = std::min(kMaxCoarseNodes, std::max(8, static_cast<int32_t>(nodes / kCoarsening)));
-    vec<int32_t> index;
+    const auto fits_budget = [&](int32_t cells) {
+        const Grid g = grid_over(lo, hi, cells);
+        return g.node_count() <= kMaxGridNodes && fill_prolongation(lo, hi, cells, rest, nodes) <= wanted;
+    };
     int32_t fits = 1, too_many = 1;
-    while (too_many < kMaxCells && grid_over(lo, hi, 2 * too_many).node_count() <= kMaxGridNodes &&
-           number_corners(grid_over(lo, hi, 2 * too_many), rest, nodes, index) <= wanted)
-        fits = too_many *= 2;
+    while (too_many < kMaxCells && fits_budget(2 * too_many)) fits = too_many *= 2;
     too_many = 2 * fits;
     while (too_many - fits > 1) {
         const int32_t middle = (fits + too_many) / 2;
-        const Grid g = grid_over(lo, hi, middle);
-        const bool ok = g.node_count() <= kMaxGridNodes && number_corners(g, rest, nodes, index) <= wanted;
-        (ok ? fits : too_many) = middle;
+        (fits_budget(middle) ? fits : too_many) = middle;
     }
-    const Grid g = grid_over(lo, hi, fits);
-    coarse_count_ = number_corners(g, rest, nodes, index);
+    coarse_count_ = fill_prolongation(lo, hi, fits, rest, nodes);
+}
+
+int32_t WarpedMultigrid::fill_prolongation(const double lo[3], const double hi[3], int32_t cells, const double* rest,
+                                           int32_t nodes) {
+    const Grid g = grid_over(lo, hi, cells);
+    vec<int32_t>& index = scratch_;
+    number_corners(g, rest, nodes, index);
     corner_.assign(8 * static_cast<size_t>(nodes), -1);
     weight_.assign(8 * static_cast<size_t>(nodes), 0.0);
     for (int32_t i = 0; i < nodes; ++i) {
@@ -124,6 +129,41 @@ void WarpedMultigrid::build_prolongation(const double* rest, int32_t nodes) {
             weight_[8 * static_cast<size_t>(i) + c] = w;
         }
     }
+    return split_by_connection(nodes);
+}
+
+int32_t WarpedMultigrid::split_by_connection(int32_t nodes) {
+    // Union-find over the attachments (node i, corner c) = 8 i + c: two attachments to the same
+    // grid node are one coarse node if their fine nodes share an element (a block).
+    vec<int32_t>& parent = scratch_;
+    parent.resize(8 * static_cast<size_t>(nodes));
+    for (size_t a = 0; a < parent.size(); ++a) parent[a] = static_cast<int32_t>(a);
+    const auto find = [&](int32_t a) {
+        while (parent[static_cast<size_t>(a)] != a) a = parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
+        return a;
+    };
+    for (int32_t i = 0; i < nodes; ++i)
+        for (int32_t k = blocks_.row_start()[i]; k < blocks_.row_start()[i + 1]; ++k) {
+            const int32_t j = blocks_.column()[k];
+            if (j <= i) continue;
+            for (int p = 0; p < 8; ++p) {
+                const int32_t grid_node = corner_[8 * static_cast<size_t>(i) + p];
+                if (grid_node < 0) continue;
+                for (int q = 0; q < 8; ++q)
+                    if (corner_[8 * static_cast<size_t>(j) + q] == grid_node)
+                        parent[static_cast<size_t>(find(8 * i + p))] = find(8 * j + q);
+            }
+        }
+    // Each root is a coarse node; number them in order of their first attachment.
+    vec<int32_t> number(parent.size(), -1);
+    int32_t count = 0;
+    for (int32_t a = 0; a < 8 * nodes; ++a) {
+        if (corner_[static_cast<size_t>(a)] < 0) continue;
+        int32_t& n = number[static_cast<size_t>(find(a))];
+        if (n < 0) n = count++;
+        corner_[static_cast<size_t>(a)] = n;
+    }
+    return count;
 }
 
 void WarpedMultigrid::build_coarse() {

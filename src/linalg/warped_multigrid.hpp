@@ -47,6 +47,13 @@ public:
 private:
     /// Picks the grid and fills corner_ and weight_ from the rest positions.
     void build_prolongation(const double* rest, int32_t nodes);
+    /// corner_ and weight_ for the grid of `cells` cells along the longest side of the box
+    /// [lo, hi]; returns the coarse nodes' count (split_by_connection).
+    int32_t fill_prolongation(const double lo[3], const double hi[3], int32_t cells, const double* rest, int32_t nodes);
+    /// Splits each grid node into one coarse node per connected part of the fine nodes it
+    /// holds (parts joined by elements: blocks_'s pattern), so that a cut, or legs that share
+    /// grid cells but no element, are not tied together; renumbers corner_, returns the count.
+    int32_t split_by_connection(int32_t nodes);
     /// coarse_ := P^T A0 P (A0 in blocks_) and its Cholesky factor.
     void build_coarse();
     /// One block Gauss-Seidel sweep over the nodes, forward or backward, on z towards r.
@@ -64,6 +71,7 @@ private:
     Eigen::LLT<Eigen::MatrixXd> coarse_;  // factor of P^T A0 P (3 per coarse node)
     Eigen::VectorXd coarse_rhs_;          // restricted residual, then the coarse solution
     vec<double> residual_;                // 3 per node
+    vec<int32_t> scratch_;                // the grid's node numbers, then the union-find's parents
 };
 
 }  // namespace sh

@@ -50,6 +50,11 @@ constexpr int32_t kMultigridMinDofs = 9000;
 // The multigrid built for one step size serves steps within this fraction of it (it only
 // preconditions; a host alternating 1/60 and 1/61 s would rebuild it every step).
 constexpr double kMultigridStepTolerance = 0.25;
+// A multigrid solve may cost up to this many factorisations before the body gives it up: where
+// new factorisations go stale within a step (the raptor's corotational swing refactorises 23-30
+// times in 30 steps, a few steps many times), one step's factorisation and the solves after it
+// cost about that much (the raptor's solves need 27-30 iterations).
+constexpr double kMultigridBudget = 2.0;
 // Nodes that turn by less than this (rad) per update for NewtonMatrix::multigrid_calm_needed
 // multigrid updates in a row (10 at first) have settled: the body goes back to factorisations,
 // which then last many steps with one solve each, where the multigrid keeps costing an assembly
@@ -472,11 +477,12 @@ bool NewtonStep::solve_by_multigrid() {
         drop_multigrid();
         return false;  // a diagonal block not positive definite: the factorisation will say where
     }
-    // At most as many iterations as a factorisation costs (the fallback), once that is known.
+    // At most as many iterations as kMultigridBudget factorisations cost, once that is known.
     const double factorisation = matrix_.kept.factorize_work;
-    const int cap = factorisation > 0.0 ? std::clamp(static_cast<int>(factorisation / multigrid.iteration_work()),
-                                                     kKrylovMinIterations, kKrylovMaxIterations)
-                                        : kKrylovMaxIterations;
+    const int cap = factorisation > 0.0
+                        ? std::clamp(static_cast<int>(kMultigridBudget * factorisation / multigrid.iteration_work()),
+                                     kKrylovMinIterations, kKrylovMaxIterations)
+                        : kKrylovMaxIterations;
     const PreconditionedCgResult cg = solve_for_update([&](const double* minus_g, double* delta) {
         return solve_preconditioned_cg(
             matrix_.system.dof_count(), [&](const double* x, double* y) { multigrid.multiply(x, y); }, multigrid,

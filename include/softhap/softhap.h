@@ -419,7 +419,7 @@ typedef struct sh_implicit_settings {
                                          its rest shape, warped by its nodes' rotations) where
                                          that costs less per step than new factorisations, and
                                          keeps it across steps until its nodes settle or it
-                                         fails to converge within a factorisation's work;
+                                         fails to converge within two factorisations' work;
                                          changing dt by more than 25 % or the matrix rebuilds
                                          it. These choices weigh work estimated from counts,
                                          never measured time, so that identical runs repeat bit

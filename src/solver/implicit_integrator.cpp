@@ -43,9 +43,9 @@ constexpr int kMaxStaleSolves = 4;
 // factorisation wherever krylov_pays finds it cheaper per step than new factorisations: under
 // large rotation a factorisation (20-26 solves at 20 k tets) goes stale within a step or two,
 // where 5-7 multigrid iterations cost about one solve and never go stale. Once chosen, steps
-// start with it; once it fails to converge within a factorisation's work, the body keeps
-// factorisations until its matrix version or the step size changes. Smaller bodies factorise
-// in a few ms and keep the direct path.
+// start with it; once it fails to converge within kMultigridBudget factorisations' work, the
+// body keeps factorisations until its matrix version or the step size changes. Smaller bodies
+// factorise in a few ms and keep the direct path.
 constexpr int32_t kMultigridMinDofs = 9000;
 // The multigrid built for one step size serves steps within this fraction of it (it only
 // preconditions; a host alternating 1/60 and 1/61 s would rebuild it every step).
@@ -491,8 +491,8 @@ bool NewtonStep::solve_by_multigrid() {
     result_.linear_iterations += cg.iterations;
     result_.solve_seconds += cg.seconds;
     used_stale = true;  // an inexact update: a failed step retries with factorisations
-    // A body it fails on (a coarse grid that couples parts the mesh does not, such as the
-    // raptor's legs: 20-44 iterations) keeps factorisations until its matrix changes.
+    // A body it fails on (a thin body turning fast, such as the raptor's corotational swing:
+    // 10-44 iterations, then over 50) keeps factorisations until its matrix changes.
     if (!cg.converged) {
         drop_multigrid();
         return false;

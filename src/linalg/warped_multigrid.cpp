@@ -139,7 +139,11 @@ int32_t WarpedMultigrid::split_by_connection(int32_t nodes) {
     parent.resize(8 * static_cast<size_t>(nodes));
     for (size_t a = 0; a < parent.size(); ++a) parent[a] = static_cast<int32_t>(a);
     const auto find = [&](int32_t a) {
-        while (parent[static_cast<size_t>(a)] != a) a = parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
+        while (parent[static_cast<size_t>(a)] != a) {
+            int32_t& up = parent[static_cast<size_t>(a)];
+            up = parent[static_cast<size_t>(up)];  // path halving
+            a = up;
+        }
         return a;
     };
     for (int32_t i = 0; i < nodes; ++i)

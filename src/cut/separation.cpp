@@ -1,5 +1,6 @@
 #include "cut/separation.hpp"
 
+#include "core/union_find.hpp"
 #include "cut/tet_cut.hpp"
 #include "mesh/tet_mesh.hpp"
 
@@ -43,12 +44,6 @@ uint64_t edge_key(int32_t a, int32_t b) {
     return static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32 | static_cast<uint32_t>(b);
 }
 int32_t edge_end(uint64_t edge, int i) { return static_cast<int32_t>(static_cast<uint32_t>(edge >> (32 * (1 - i)))); }
-
-// Union-find over a star's tets.
-int32_t root(vec<int32_t>& parent, int32_t i) {
-    while (parent[static_cast<size_t>(i)] != i) i = parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
-    return i;
-}
 
 // The separation's working state over the tets at the cut.
 struct Separation {
@@ -113,8 +108,7 @@ struct Separation {
             if (face != faces[i + 1].first || std::binary_search(cut_faces.begin(), cut_faces.end(), face)) continue;
             for (int c = 0; c < 3; ++c)
                 if (const int32_t node = face[c]; is_cut_node(node))
-                    star_parent[static_cast<size_t>(root(star_parent, star_entry(node, faces[i].second)))] =
-                        root(star_parent, star_entry(node, faces[i + 1].second));
+                    union_join(star_parent, star_entry(node, faces[i].second), star_entry(node, faces[i + 1].second));
         }
     }
 
@@ -122,15 +116,15 @@ struct Separation {
     // largest piece keeps the node.
     void number_star_pieces(size_t begin, size_t end) {
         const int32_t node = star[begin].first;
-        for (size_t i = begin; i < end; ++i) star_members[static_cast<size_t>(root(star_parent, static_cast<int32_t>(i)))] = 0;
-        for (size_t i = begin; i < end; ++i) ++star_members[static_cast<size_t>(root(star_parent, static_cast<int32_t>(i)))];
+        for (size_t i = begin; i < end; ++i) star_members[static_cast<size_t>(union_root(star_parent, static_cast<int32_t>(i)))] = 0;
+        for (size_t i = begin; i < end; ++i) ++star_members[static_cast<size_t>(union_root(star_parent, static_cast<int32_t>(i)))];
         size_t keeper = begin;
         for (size_t i = begin; i < end; ++i)
             if (star_members[i] > star_members[keeper]) keeper = i;
         for (size_t i = begin; i < end; ++i) star_number[i] = -1;
         star_number[keeper] = node;
         for (size_t i = begin; i < end; ++i) {
-            int32_t& n = star_number[static_cast<size_t>(root(star_parent, static_cast<int32_t>(i)))];
+            int32_t& n = star_number[static_cast<size_t>(union_root(star_parent, static_cast<int32_t>(i)))];
             if (n < 0) {
                 n = node_count + static_cast<int32_t>(cut.origins.size() + copies.size());
                 copies.push_back(NodeOrigin{node, node, 0.0});
@@ -216,9 +210,9 @@ struct Separation {
             std::iota(parent.begin(), parent.end(), 0);
             const auto slot = [&](int32_t n) { return static_cast<int32_t>(std::lower_bound(ends.begin(), ends.end(), n) - ends.begin()); };
             for (size_t i = begin; i < end; ++i)
-                parent[static_cast<size_t>(root(parent, slot(links[i].second[0])))] = root(parent, slot(links[i].second[1]));
+                union_join(parent, slot(links[i].second[0]), slot(links[i].second[1]));
             int32_t fans = 0;
-            for (size_t i = 0; i < ends.size(); ++i) fans += root(parent, static_cast<int32_t>(i)) == static_cast<int32_t>(i) ? 1 : 0;
+            for (size_t i = 0; i < ends.size(); ++i) fans += union_root(parent, static_cast<int32_t>(i)) == static_cast<int32_t>(i) ? 1 : 0;
             if (fans > 1 && is_cut_node(original(links[begin].first))) pinched.push_back(original(links[begin].first));
             begin = end;
         }

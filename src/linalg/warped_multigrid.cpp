@@ -1,6 +1,7 @@
 #include "linalg/warped_multigrid.hpp"
 
 #include "core/error.hpp"
+#include "core/union_find.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -138,14 +139,6 @@ int32_t WarpedMultigrid::split_by_connection(int32_t nodes) {
     vec<int32_t>& parent = scratch_;
     parent.resize(8 * static_cast<size_t>(nodes));
     for (size_t a = 0; a < parent.size(); ++a) parent[a] = static_cast<int32_t>(a);
-    const auto find = [&](int32_t a) {
-        while (parent[static_cast<size_t>(a)] != a) {
-            int32_t& up = parent[static_cast<size_t>(a)];
-            up = parent[static_cast<size_t>(up)];  // path halving
-            a = up;
-        }
-        return a;
-    };
     for (int32_t i = 0; i < nodes; ++i)
         for (int32_t k = blocks_.row_start()[i]; k < blocks_.row_start()[i + 1]; ++k) {
             const int32_t j = blocks_.column()[k];
@@ -155,7 +148,7 @@ int32_t WarpedMultigrid::split_by_connection(int32_t nodes) {
                 if (grid_node < 0) continue;
                 for (int q = 0; q < 8; ++q)
                     if (corner_[8 * static_cast<size_t>(j) + q] == grid_node)
-                        parent[static_cast<size_t>(find(8 * i + p))] = find(8 * j + q);
+                        union_join(parent, 8 * i + p, 8 * j + q);
             }
         }
     // Each root is a coarse node; number them in order of their first attachment.
@@ -163,7 +156,7 @@ int32_t WarpedMultigrid::split_by_connection(int32_t nodes) {
     int32_t count = 0;
     for (int32_t a = 0; a < 8 * nodes; ++a) {
         if (corner_[static_cast<size_t>(a)] < 0) continue;
-        int32_t& n = number[static_cast<size_t>(find(a))];
+        int32_t& n = number[static_cast<size_t>(union_root(parent, a))];
         if (n < 0) n = count++;
         corner_[static_cast<size_t>(a)] = n;
     }

@@ -1,6 +1,7 @@
 #include "world/contact_islands.hpp"
 
 #include "core/clock.hpp"
+#include "core/union_find.hpp"
 #include "solver/implicit_integrator.hpp"
 #include "solver/newton_problem.hpp"
 #include "solver/static_solver.hpp"
@@ -16,13 +17,7 @@ ContactIslands::~ContactIslands() {
     for (Kept& k : kept_) sh::destroy(k.problem);
 }
 
-uint32_t ContactIslands::root(uint32_t slot) {
-    while (parent_[slot] != slot) {
-        parent_[slot] = parent_[parent_[slot]];
-        slot = parent_[slot];
-    }
-    return slot;
-}
+uint32_t ContactIslands::root(uint32_t slot) { return union_root(parent_, slot); }
 
 int32_t ContactIslands::group(size_t slot_count) {
     parent_.resize(slot_count);

@@ -1,6 +1,7 @@
 // A block of cubes split into six tets each (Kuhn), for the linear-algebra unit tests.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -23,6 +24,20 @@ inline std::vector<int32_t> block_tets(int cells) {
                     for (const int corner : tet)
                         tets.push_back(grid_node(cells, i + (corner & 1), j + ((corner >> 1) & 1), k + ((corner >> 2) & 1)));
     return tets;
+}
+
+/// A tet's graph Laplacian per component, 4 I - ones (row-major 12x12 over its 4 nodes' x y z),
+/// with an x-y coupling `shear` in each block (symmetric positive semi-definite for |shear| < 1;
+/// anisotropic, so that a rotation changes it).
+inline std::array<double, 144> laplacian_element(double shear) {
+    std::array<double, 144> ke{};
+    for (int r = 0; r < 12; ++r)
+        for (int c = 0; c < 12; ++c) {
+            const double weight = r / 3 == c / 3 ? 3.0 : -1.0;
+            const int rc = r % 3, cc = c % 3;
+            ke[static_cast<size_t>(12 * r + c)] = rc == cc ? weight : (rc + cc == 1 ? weight * shear : 0.0);
+        }
+    return ke;
 }
 
 }  // namespace kuhn

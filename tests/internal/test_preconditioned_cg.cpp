@@ -37,13 +37,7 @@ void assemble(sh::SparseSystem& a, double stiffness, double shear) {
     for (int32_t i = 0; i < kNodes; ++i) identity[static_cast<size_t>(i)] = i;
     if (a.dof_count() == 0) a.build_pattern(tets.data(), tets.size() / 4, 4, identity.data(), kNodes, kNodes);
     a.clear_values();
-    std::array<double, 144> ke{};
-    for (int r = 0; r < 12; ++r)
-        for (int c = 0; c < 12; ++c) {
-            const double weight = r / 3 == c / 3 ? 3.0 : -1.0;
-            const int rc = r % 3, cc = c % 3;
-            ke[static_cast<size_t>(12 * r + c)] = rc == cc ? weight : (rc + cc == 1 ? weight * shear : 0.0);
-        }
+    const std::array<double, 144> ke = kuhn::laplacian_element(shear);
     for (size_t e = 0; e < tets.size() / 4; ++e) a.add_element(e, ke.data(), stiffness);
     std::vector<double> diagonal(3 * static_cast<size_t>(kNodes));
     for (size_t d = 0; d < diagonal.size(); ++d) diagonal[d] = 1.0 + static_cast<double>(d % 5) / 4.0;

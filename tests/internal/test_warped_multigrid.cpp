@@ -48,13 +48,8 @@ void build_block(int cells, double angle, Block& out, int copies = 1, double gap
     for (int32_t i = 0; i < nodes; ++i) identity[static_cast<size_t>(i)] = i;
     out.a.build_pattern(tets.data(), tets.size() / 4, 4, identity.data(), nodes, nodes);
     const Eigen::Matrix3d q = Eigen::AngleAxisd(angle, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
-    Eigen::Matrix<double, 12, 12, Eigen::RowMajor> ke, rotation = Eigen::Matrix<double, 12, 12, Eigen::RowMajor>::Zero();
-    for (int r = 0; r < 12; ++r)
-        for (int c = 0; c < 12; ++c) {
-            const double weight = r / 3 == c / 3 ? 3.0 : -1.0;
-            const int rc = r % 3, cc = c % 3;
-            ke(r, c) = rc == cc ? weight : (rc + cc == 1 ? weight * kShear : 0.0);
-        }
+    Eigen::Matrix<double, 12, 12, Eigen::RowMajor> ke(kuhn::laplacian_element(kShear).data());
+    Eigen::Matrix<double, 12, 12, Eigen::RowMajor> rotation = Eigen::Matrix<double, 12, 12, Eigen::RowMajor>::Zero();
     for (int b = 0; b < 4; ++b) rotation.block<3, 3>(3 * b, 3 * b) = q;
     ke = rotation * ke * rotation.transpose();
     for (size_t e = 0; e < tets.size() / 4; ++e) out.a.add_element(e, ke.data(), kStiffness);

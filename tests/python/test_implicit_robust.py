@@ -191,9 +191,11 @@ def collapse_run(meshes, steps=30):
 def test_identical_runs_end_identically(meshes):
     # The step chooses between a kept factorisation, a new one and CG from work it estimates
     # from counts, not from a clock: choices made from measured times made two identical runs
-    # of this collapse end up to 12 mm apart (of a 21 cm liver), with 55 to 80 factorisations.
+    # of this collapse end up to 12 mm apart (of a 21 cm liver), with 39 to 89 factorisations.
     first = collapse_run(meshes)
     second = collapse_run(meshes)
-    assert first[2] > first[1] > 0  # both paths taken: CG iterations beside factorisations
+    # Kept factorisations fail and the step chooses again many times (128 factorisations in 30
+    # steps, measured), so the runs pass through the choices this is about.
+    assert first[1] > 2 * 30
     assert first[1:] == second[1:]
     assert np.array_equal(first[0], second[0])

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "material/isotropic_law.hpp"
+#include "material/isotropic_projection.hpp"
 
 #include <softhap/softhap.h>
 
@@ -15,10 +16,27 @@ struct StvkMaterial {
     static constexpr bool kProjectTangent = true;
     /// Its state keeps no rotation (see the table's kRotates).
     static constexpr bool kRotates = false;
-    /// One element's tangent in a sparse solve's operations (the table's kTangentWork): with the
-    /// 9x9 projection of the elements found indefinite, about 1.1 us per tet in a step under
-    /// large rotation, 3.6 times the corotational tangent.
-    static constexpr double kTangentWork = 3600.0;
+    /// One element's tangent in a sparse solve's operations (the table's kTangentWork): its
+    /// singular frame, analytic eigensystem and projection, about 0.4 us per tet in a step
+    /// under large rotation, 1.5 times the corotational tangent.
+    static constexpr double kTangentWork = 1500.0;
+
+    /// dP/dF's eigensystem at F's signed singular values s (see PrincipalStiffness). In s,
+    /// E_i = (s_i^2 - 1)/2 and psi_i = (2 mu E_i + lambda tr E) s_i.
+    static PrincipalStiffness principal_stiffness(const Eigen::Vector3d& s, double lambda, double mu) {
+        const double tr = 0.5 * (s.squaredNorm() - 3.0);
+        PrincipalStiffness k;
+        for (int a = 0; a < 3; ++a) {
+            const int b = (a + 1) % 3, c = (a + 2) % 3;
+            k.stretch(a, a) = (2.0 * mu + lambda) * s(a) * s(a) + mu * (s(a) * s(a) - 1.0) + lambda * tr;
+            k.stretch(b, c) = k.stretch(c, b) = lambda * s(b) * s(c);
+            // psi_b -+ psi_c = (s_b -+ s_c) (mu (s_b^2 +- s_b s_c + s_c^2 - 1) + lambda tr E).
+            const double squares = s(b) * s(b) + s(c) * s(c) - 1.0;
+            k.shear(a) = mu * (squares + s(b) * s(c)) + lambda * tr;
+            k.turn(a) = mu * (squares - s(b) * s(c)) + lambda * tr;
+        }
+        return k;
+    }
 
     /// The second Piola stress, reused by differential().
     struct State {

@@ -1,13 +1,15 @@
 // Tangent stiffness of FEM bodies for the implicit and static solvers:
-// K_e = V0 G^T C G with C = dP/dF (9x9, from each material's differential on the unit basis of F)
-// and G the map from nodal displacements to F (dF_kj / dx_ak = g_a[j], g_a the shape-function
-// gradients). For the laws whose C can be indefinite (kProjectTangent in the material table;
-// all isotropic), C is projected to positive semi-definite per element in F's singular frame.
+// K_e = V0 G^T C G with C = dP/dF (9x9) and G the map from nodal displacements to F
+// (dF_kj / dx_ak = g_a[j], g_a the shape-function gradients). For the laws whose C can be
+// indefinite (kProjectTangent in the material table; all isotropic), C is formed already
+// projected to positive semi-definite, from the law's analytic eigensystem in F's singular
+// frame; for the others, from the law's differential on the unit basis of F.
 #include "model/fem_body.hpp"
 
 #include "material/material_params.hpp"
 #include "material/isotropic_projection.hpp"
 #include "material/material_table.hpp"
+#include "material/polar_decomposition.hpp"
 #include "linalg/sparse_system.hpp"
 #include "model/fem_kernel.hpp"
 
@@ -40,13 +42,19 @@ void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* nea
     }
 }
 
-// C projected to positive semi-definite for an element at F (the laws that need it are
-// isotropic: project_isotropic_tangent works in F's singular frame).
-void project_positive(Matrix9& c, const Eigen::Matrix3d& f) {
-    // Most elements' C is already positive definite (all but the strongly compressed or
-    // inverted ones): a Cholesky factorisation proves it at a fraction of the projection's cost.
-    if (Eigen::LLT<Matrix9>(c).info() == Eigen::Success) return;
-    project_isotropic_tangent(c, f);
+// dP/dF of a law that projects (all isotropic: see the material table's kProjectTangent) for
+// each lane, projected to positive semi-definite: from the law's analytic eigensystem in F's
+// singular frame, which the batch's polar rotations give.
+template <class Material>
+void projected_stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, int count, Matrix9 (&C)[kLanes]) {
+    const Mat3L R = polar_rotation(F);
+    for (int l = 0; l < count; ++l) {
+        Eigen::Matrix3d f, r;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) f(i, j) = F.m[i][j][l], r(i, j) = R.m[i][j][l];
+        const SingularFrame frame = singular_frame(f, r);
+        C[l] = projected_stress_derivative(Material::principal_stiffness(frame.s, lambda[l], mu[l]), frame);
+    }
 }
 
 }  // namespace
@@ -75,21 +83,18 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
             mu[l] = lame_mu(materials_[t]);
         }
         Matrix9 C[kLanes];
-        bool project = false;
         visit_material(model, [&](auto law) {
             using Law = decltype(law);
-            stress_derivatives<Law>(F, lambda, mu, warm ? &near : nullptr, C);
-            project = Law::kProjectTangent;
+            if constexpr (Law::kProjectTangent) {
+                projected_stress_derivatives<Law>(F, lambda, mu, count, C);
+            } else {
+                stress_derivatives<Law>(F, lambda, mu, warm ? &near : nullptr, C);
+                for (int l = 0; l < count; ++l) C[l] = 0.5 * (C[l] + C[l].transpose());
+            }
         });
         for (int l = 0; l < count; ++l) {
             const size_t t = static_cast<size_t>(members[l]);
-            Matrix9 c = 0.5 * (C[l] + C[l].transpose());
-            if (project) {
-                Eigen::Matrix3d f;
-                for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j) f(i, j) = F.m[i][j][l];
-                project_positive(c, f);
-            }
+            const Matrix9& c = C[l];
             const double* bm = &inverse_rest_[9 * t];
             double g[4][3];
             for (int j = 0; j < 3; ++j) {

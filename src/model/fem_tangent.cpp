@@ -20,12 +20,21 @@
 namespace sh {
 namespace {
 
-using Matrix9 = StressDerivative;
+// dP/dF of a batch's lanes: c[p][q] is dP_p / dF_q (p, q = 3 i + j), one lane per element.
+struct StressDerivativeLanes {
+    Lanes c[9][9];
+};
 
-// dP/dF per lane of a batch of elements of one material model; a law that keeps a rotation
-// finds it from near where the caller has one (the body's last pass's: see BlockRotations).
+// One element's stiffness per lane, by 3x3 node blocks: block[a][b][k][l] = K((a, k), (b, l)).
+struct StiffnessLanes {
+    Lanes block[4][4][3][3];
+};
+
+// dP/dF per lane of a batch of elements of one material model, symmetrised; a law that keeps
+// a rotation finds it from near where the caller has one (the body's last pass's: see
+// BlockRotations).
 template <class Material>
-void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* near, Matrix9 (&C)[kLanes]) {
+void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* near, StressDerivativeLanes& C) {
     typename Material::State state;
     if constexpr (Material::kRotates) {
         Mat3L R;  // the batch's own: the body's are the force passes' (BlockRotations)
@@ -37,24 +46,67 @@ void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* nea
         Mat3L dF{};
         dF.m[q / 3][q % 3] = splat(1.0);
         const Mat3L dP = Material::differential(F, state, dF, lambda, mu);
-        for (int l = 0; l < kLanes; ++l)
-            for (int p = 0; p < 9; ++p) C[l](p, q) = dP.m[p / 3][p % 3][l];
+        for (int p = 0; p < 9; ++p) C.c[p][q] = dP.m[p / 3][p % 3];
     }
+    for (int p = 0; p < 9; ++p)
+        for (int q = p + 1; q < 9; ++q) C.c[p][q] = C.c[q][p] = 0.5 * (C.c[p][q] + C.c[q][p]);
 }
 
 // dP/dF of a law that projects (all isotropic: see the material table's kProjectTangent) for
 // each lane, projected to positive semi-definite: from the law's analytic eigensystem in F's
 // singular frame, which the batch's polar rotations give.
 template <class Material>
-void projected_stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, int count, Matrix9 (&C)[kLanes]) {
+void projected_stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, int count, StressDerivativeLanes& C) {
     const Mat3L R = polar_rotation(F);
+    for (int l = count; l < kLanes; ++l)  // padding: inert
+        for (int p = 0; p < 9; ++p)
+            for (int q = 0; q < 9; ++q) C.c[p][q][l] = 0.0;
     for (int l = 0; l < count; ++l) {
         Eigen::Matrix3d f, r;
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) f(i, j) = F.m[i][j][l], r(i, j) = R.m[i][j][l];
         const SingularFrame frame = singular_frame(f, r);
-        C[l] = projected_stress_derivative(Material::principal_stiffness(frame.s, lambda[l], mu[l]), frame);
+        const StressDerivative c =
+            projected_stress_derivative(Material::principal_stiffness(frame.s, lambda[l], mu[l]), frame);
+        for (int p = 0; p < 9; ++p)
+            for (int q = 0; q < 9; ++q) C.c[p][q][l] = c(p, q);
     }
+}
+
+// K = V0 G^T C G per lane, for symmetric C and the shape-function gradients g[a - 1] of nodes
+// a = 1..3 (rows of the inverse rest edge matrix): the blocks (a, b), 1 <= a <= b, from
+// K((a, k), (b, l)) = V0 sum_jm g_a[j] C((k, j), (l, m)) g_b[m]; their mirror images below the
+// diagonal; and node 0's, whose gradient is -(g_1 + g_2 + g_3), as minus the sums of the others.
+void element_stiffness(const StressDerivativeLanes& C, const Lanes (&g)[3][3], Lanes volume, StiffnessLanes& K) {
+    for (int b = 1; b < 4; ++b) {
+        Lanes cg[9][3];  // cg[q][l] = sum_m C(q, (l, m)) g_b[m]
+        for (int q = 0; q < 9; ++q)
+            for (int l = 0; l < 3; ++l)
+                cg[q][l] = C.c[q][3 * l] * g[b - 1][0] + C.c[q][3 * l + 1] * g[b - 1][1] + C.c[q][3 * l + 2] * g[b - 1][2];
+        for (int a = 1; a <= b; ++a)
+            for (int k = 0; k < 3; ++k)
+                for (int l = 0; l < 3; ++l) {
+                    const Lanes v = volume * (g[a - 1][0] * cg[3 * k][l] + g[a - 1][1] * cg[3 * k + 1][l] +
+                                              g[a - 1][2] * cg[3 * k + 2][l]);
+                    K.block[a][b][k][l] = K.block[b][a][l][k] = v;
+                }
+    }
+    for (int b = 1; b < 4; ++b)
+        for (int k = 0; k < 3; ++k)
+            for (int l = 0; l < 3; ++l)
+                K.block[0][b][k][l] = K.block[b][0][l][k] =
+                    -(K.block[1][b][k][l] + K.block[2][b][k][l] + K.block[3][b][k][l]);
+    for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l)
+            K.block[0][0][k][l] = -(K.block[0][1][k][l] + K.block[0][2][k][l] + K.block[0][3][k][l]);
+}
+
+// Lane l's stiffness as the row-major 12x12 matrix SparseSystem::add_element takes.
+void lane_stiffness(const StiffnessLanes& K, int l, double (&ke)[144]) {
+    for (int a = 0; a < 4; ++a)
+        for (int k = 0; k < 3; ++k)
+            for (int b = 0; b < 4; ++b)
+                for (int c = 0; c < 3; ++c) ke[12 * (3 * a + k) + 3 * b + c] = K.block[a][b][k][c][l];
 }
 
 }  // namespace
@@ -66,7 +118,8 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
 
     auto process = [&](int model, const int32_t* members, int count) {
         Mat3L F = identity_lanes();
-        Lanes lambda = splat(1.0), mu = splat(1.0);
+        Lanes lambda = splat(1.0), mu = splat(1.0), volume = Lanes{};
+        Lanes g[3][3] = {};
         Mat3L near = identity_lanes();
         const bool warm = rotations_.gather(model, members, count, lane_of_.data(), near);
         for (int l = 0; l < count; ++l) {
@@ -78,45 +131,26 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
                     double f = 0.0;
                     for (int a = 0; a < 3; ++a) f += (xs[3 * tet[a + 1] + i] - xs[3 * tet[0] + i]) * bm[3 * a + j];
                     F.m[i][j][l] = f;
+                    g[i][j][l] = bm[3 * i + j];
                 }
             lambda[l] = lame_lambda(materials_[t]);
             mu[l] = lame_mu(materials_[t]);
+            volume[l] = volume_[t];
         }
-        Matrix9 C[kLanes];
+        StressDerivativeLanes C;
         visit_material(model, [&](auto law) {
             using Law = decltype(law);
-            if constexpr (Law::kProjectTangent) {
+            if constexpr (Law::kProjectTangent)
                 projected_stress_derivatives<Law>(F, lambda, mu, count, C);
-            } else {
+            else
                 stress_derivatives<Law>(F, lambda, mu, warm ? &near : nullptr, C);
-                for (int l = 0; l < count; ++l) C[l] = 0.5 * (C[l] + C[l].transpose());
-            }
         });
+        StiffnessLanes K;
+        element_stiffness(C, g, volume, K);
         for (int l = 0; l < count; ++l) {
-            const size_t t = static_cast<size_t>(members[l]);
-            const Matrix9& c = C[l];
-            const double* bm = &inverse_rest_[9 * t];
-            double g[4][3];
-            for (int j = 0; j < 3; ++j) {
-                g[0][j] = 0.0;
-                for (int a = 1; a < 4; ++a) {
-                    g[a][j] = bm[3 * (a - 1) + j];
-                    g[0][j] -= g[a][j];
-                }
-            }
-            // CG(q, (b, l)) = sum_m C(q, (l, m)) g_b[m]; K((a, k), (b, l)) = V0 sum_j g_a[j] CG((k, j), (b, l)).
-            double cg[9][12];
-            for (int q = 0; q < 9; ++q)
-                for (int b = 0; b < 4; ++b)
-                    for (int lc = 0; lc < 3; ++lc)
-                        cg[q][3 * b + lc] = c(q, 3 * lc) * g[b][0] + c(q, 3 * lc + 1) * g[b][1] + c(q, 3 * lc + 2) * g[b][2];
             double ke[144];
-            for (int a = 0; a < 4; ++a)
-                for (int k = 0; k < 3; ++k)
-                    for (int col = 0; col < 12; ++col)
-                        ke[12 * (3 * a + k) + col] = volume_[t] * (g[a][0] * cg[3 * k][col] + g[a][1] * cg[3 * k + 1][col] +
-                                                                   g[a][2] * cg[3 * k + 2][col]);
-            system.add_element(t, ke, scale);
+            lane_stiffness(K, l, ke);
+            system.add_element(static_cast<size_t>(members[l]), ke, scale);
         }
     };
 

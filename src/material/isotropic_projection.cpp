@@ -1,102 +1,140 @@
 #include "material/isotropic_projection.hpp"
 
-#include <Eigen/Dense>
-
-#include <cmath>
+#include "material/polar_decomposition.hpp"
 
 namespace sh {
 namespace {
 
-using Vector9 = Eigen::Matrix<double, 9, 1>;
+// Cyclic Jacobi sweeps stop once every lane's off-diagonal part is below this fraction of its
+// matrix (squared): round-off, reached in two to four sweeps (convergence is quadratic).
+constexpr double kOffDiagonal2 = 1e-30;
+constexpr int kMaxSweeps = 8;
 
-// The basis vector u_k v_l^T, as dP/dF's rows and columns are indexed (3 i + j).
-Vector9 frame_direction(const SingularFrame& frame, int k, int l) {
-    Vector9 q;
+SH_INLINE bool any_lane(LaneMask mask) {
+    for (int l = 0; l < kLanes; ++l)
+        if (mask[l]) return true;
+    return false;
+}
+
+SH_INLINE Lanes positive_part(Lanes x) { return select(x > 0.0, x, Lanes{}); }
+
+// One Jacobi rotation per lane in plane (p, q) of the symmetric a, zeroing a[p][q]
+// (Golub and Van Loan's symmetric Schur step, written without dividing by a[p][q]);
+// v <- v J gathers the rotations.
+SH_INLINE void jacobi_turn(Lanes (&a)[3][3], Mat3L& v, int p, int q) {
+    const Lanes apq = a[p][q], d = a[q][q] - a[p][p];
+    const Lanes magnitude = select(d < 0.0, -d, d) + lanes_sqrt(d * d + 4.0 * apq * apq);
+    const Lanes sign = select(d < 0.0, splat(-1.0), splat(1.0));
+    const Lanes t = select(magnitude > 0.0, 2.0 * apq * sign / select(magnitude > 0.0, magnitude, splat(1.0)), Lanes{});
+    const Lanes c = 1.0 / lanes_sqrt(1.0 + t * t), s = t * c;
+    for (int k = 0; k < 3; ++k) {
+        const Lanes kp = a[k][p], kq = a[k][q];
+        a[k][p] = c * kp - s * kq;
+        a[k][q] = s * kp + c * kq;
+    }
+    for (int k = 0; k < 3; ++k) {
+        const Lanes pk = a[p][k], qk = a[q][k];
+        a[p][k] = c * pk - s * qk;
+        a[q][k] = s * pk + c * qk;
+    }
+    for (int k = 0; k < 3; ++k) {
+        const Lanes kp = v.m[k][p], kq = v.m[k][q];
+        v.m[k][p] = c * kp - s * kq;
+        v.m[k][q] = s * kp + c * kq;
+    }
+}
+
+// a = v diag v^T per lane: a is turned diagonal in place (its eigenvalues on the diagonal)
+// and v gets the orthonormal eigenvectors as columns.
+void symmetric_eigen(Lanes (&a)[3][3], Mat3L& v) {
+    v = identity_lanes();
+    for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+        const Lanes off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        const Lanes size = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2] + 2.0 * off;
+        if (!any_lane(off > kOffDiagonal2 * size)) return;  // NaN lanes do not hold the others up
+        jacobi_turn(a, v, 0, 1);
+        jacobi_turn(a, v, 0, 2);
+        jacobi_turn(a, v, 1, 2);
+    }
+}
+
+// The stretches' block with its negative eigenvalues set to zero, in the lanes where it is not
+// positive definite (strongly compressed elements; the others keep theirs unchanged).
+void project_stretch_block(Lanes (&k)[3][3]) {
+    const Lanes minor2 = k[0][0] * k[1][1] - k[0][1] * k[0][1];
+    const Lanes minor3 = k[0][0] * (k[1][1] * k[2][2] - k[1][2] * k[1][2]) -
+                         k[0][1] * (k[0][1] * k[2][2] - k[1][2] * k[0][2]) +
+                         k[0][2] * (k[0][1] * k[1][2] - k[1][1] * k[0][2]);
+    const LaneMask indefinite = !(k[0][0] > 0.0 && minor2 > 0.0 && minor3 > 0.0);
+    if (!any_lane(indefinite)) return;
+    Lanes a[3][3];
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) q(3 * i + j) = frame.u(i, k) * frame.v(j, l);
-    return q;
-}
-
-// c += max(lambda, 0) q q^T.
-void add_mode(StressDerivative& c, double lambda, const Vector9& q) {
-    if (lambda > 0.0) c.noalias() += lambda * q * q.transpose();
-}
-
-// s = v diag(d) v^T with v orthonormal, to round-off. The direct 3x3 solve's eigenvectors of
-// nearly equal eigenvalues are only good to about 1e-10 (enough to leave negative eigenvalues
-// of that size after a projection) and orthonormal only as well: they are made orthonormal
-// (Gram-Schmidt), and one cyclic Jacobi sweep on the nearly diagonal v^T s v, which converges
-// quadratically from there, makes them accurate.
-void symmetric_eigen(const Eigen::Matrix3d& s, Eigen::Matrix3d& v, Eigen::Vector3d& d) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
-    eigen.computeDirect(s);
-    v = eigen.eigenvectors();
-    v.col(0).normalize();
-    v.col(1) = (v.col(1) - v.col(0).dot(v.col(1)) * v.col(0)).normalized();
-    v.col(2) = v.col(0).cross(v.col(1));
-    Eigen::Matrix3d a = v.transpose() * s * v;
-    for (int p = 0; p < 2; ++p)
-        for (int q = p + 1; q < 3; ++q) {
-            // Separated eigenvalues come out of the direct solve accurate: nothing to turn.
-            if (std::abs(a(p, q)) <= 1e-15 * (std::abs(a(p, p)) + std::abs(a(q, q)))) continue;
-            // The rotation by t = tan(theta) in plane (p, q) that zeroes a(p, q).
-            const double tau = (a(q, q) - a(p, p)) / (2.0 * a(p, q));
-            const double t = (tau >= 0.0 ? 1.0 : -1.0) / (std::abs(tau) + std::sqrt(1.0 + tau * tau));
-            const double c = 1.0 / std::sqrt(1.0 + t * t), sn = t * c;
-            for (int k = 0; k < 3; ++k) {  // a <- a J (columns p, q)
-                const double ap = a(k, p), aq = a(k, q);
-                a(k, p) = c * ap - sn * aq, a(k, q) = sn * ap + c * aq;
-            }
-            for (int k = 0; k < 3; ++k) {  // a <- J^T a (rows p, q)
-                const double ap = a(p, k), aq = a(q, k);
-                a(p, k) = c * ap - sn * aq, a(q, k) = sn * ap + c * aq;
-            }
-            for (int k = 0; k < 3; ++k) {  // v <- v J
-                const double vp = v(k, p), vq = v(k, q);
-                v(k, p) = c * vp - sn * vq, v(k, q) = sn * vp + c * vq;
-            }
+        for (int j = 0; j < 3; ++j) a[i][j] = k[i][j];
+    Mat3L w;
+    symmetric_eigen(a, w);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            Lanes sum = Lanes{};
+            for (int m = 0; m < 3; ++m) sum += w.m[i][m] * positive_part(a[m][m]) * w.m[j][m];
+            k[i][j] = select(indefinite, sum, k[i][j]);
         }
-    d = a.diagonal();
 }
 
-// Whether symmetric k is positive definite (its leading minors are positive).
-bool positive_definite(const Eigen::Matrix3d& k) {
-    const double minor2 = k(0, 0) * k(1, 1) - k(0, 1) * k(0, 1);
-    return k(0, 0) > 0.0 && minor2 > 0.0 && k.determinant() > 0.0;
+// out = E K E^T on and above the diagonal: E's columns are the stretch modes u_a v_a^T.
+void add_stretch_modes(const Lanes (&k)[3][3], const SingularFrameLanes& frame, StressDerivativeLanes& out) {
+    Lanes e[9][3], ek[9][3];
+    for (int p = 0; p < 9; ++p)
+        for (int a = 0; a < 3; ++a) e[p][a] = frame.u.m[p / 3][a] * frame.v.m[p % 3][a];
+    for (int p = 0; p < 9; ++p)
+        for (int b = 0; b < 3; ++b) ek[p][b] = e[p][0] * k[0][b] + e[p][1] * k[1][b] + e[p][2] * k[2][b];
+    for (int p = 0; p < 9; ++p)
+        for (int q = p; q < 9; ++q) out.c[p][q] = ek[p][0] * e[q][0] + ek[p][1] * e[q][1] + ek[p][2] * e[q][2];
+}
+
+// out += each pair's shear and turn modes, on and above the diagonal, with their eigenvalues'
+// positive parts. With x = u_i v_j^T and y = u_j v_i^T the modes are (x +- y) / sqrt 2.
+void add_pair_modes(const PrincipalStiffnessLanes& k, const SingularFrameLanes& frame, StressDerivativeLanes& out) {
+    for (int m = 0; m < 3; ++m) {
+        const int i = m == 0 ? 1 : 0, j = m == 2 ? 1 : 2;
+        const Lanes shear = 0.5 * positive_part(k.shear[m]), turn = 0.5 * positive_part(k.turn[m]);
+        Lanes plus[9], minus[9];
+        for (int p = 0; p < 9; ++p) {
+            const Lanes x = frame.u.m[p / 3][i] * frame.v.m[p % 3][j], y = frame.u.m[p / 3][j] * frame.v.m[p % 3][i];
+            plus[p] = x + y;
+            minus[p] = x - y;
+        }
+        for (int p = 0; p < 9; ++p) {
+            const Lanes sp = shear * plus[p], tm = turn * minus[p];
+            for (int q = p; q < 9; ++q) out.c[p][q] += sp * plus[q] + tm * minus[q];
+        }
+    }
 }
 
 }  // namespace
 
-SingularFrame singular_frame(const Eigen::Matrix3d& f, const Eigen::Matrix3d& r) {
-    const Eigen::Matrix3d m = r.transpose() * f;
-    SingularFrame frame;
-    symmetric_eigen(0.5 * (m + m.transpose()), frame.v, frame.s);
-    frame.u = r * frame.v;
+SingularFrameLanes singular_frames(const Mat3L& F) {
+    const Mat3L r = polar_rotation(F);
+    const Mat3L m = mul_tn(r, F);
+    Lanes a[3][3];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) a[i][j] = 0.5 * (m.m[i][j] + m.m[j][i]);
+    SingularFrameLanes frame;
+    symmetric_eigen(a, frame.v);
+    for (int i = 0; i < 3; ++i) frame.s[i] = a[i][i];
+    frame.u = mul(r, frame.v);
     return frame;
 }
 
-StressDerivative projected_stress_derivative(const PrincipalStiffness& stiffness, const SingularFrame& frame) {
-    // The stretches: c = E K E^T with E's columns the modes u_a v_a^T and K the block,
-    // projected first unless it is positive definite (as it is for all but strongly compressed
-    // elements, where its eigendecomposition is then saved).
-    Eigen::Matrix<double, 9, 3> e;
-    for (int a = 0; a < 3; ++a) e.col(a) = frame_direction(frame, a, a);
-    Eigen::Matrix3d k = stiffness.stretch;
-    if (!positive_definite(k)) {
-        Eigen::Matrix3d w;
-        Eigen::Vector3d lambda;
-        symmetric_eigen(k, w, lambda);
-        k = w * lambda.cwiseMax(0.0).asDiagonal() * w.transpose();
-    }
-    StressDerivative c;
-    c.noalias() = (e * k).lazyProduct(e.transpose());  // coefficient-wise: no blocked GEMM for 9x9
-    for (int m = 0; m < 3; ++m) {
-        const int i = m == 0 ? 1 : 0, j = m == 2 ? 1 : 2;
-        const Vector9 ij = frame_direction(frame, i, j), ji = frame_direction(frame, j, i);
-        add_mode(c, stiffness.shear(m), std::sqrt(0.5) * (ij + ji));
-        add_mode(c, stiffness.turn(m), std::sqrt(0.5) * (ij - ji));
-    }
-    return c;
+void projected_stress_derivatives(const PrincipalStiffnessLanes& stiffness, const SingularFrameLanes& frame,
+                                  StressDerivativeLanes& out) {
+    Lanes k[3][3];
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) k[a][b] = stiffness.stretch[a][b];
+    project_stretch_block(k);
+    add_stretch_modes(k, frame, out);
+    add_pair_modes(stiffness, frame, out);
+    for (int p = 0; p < 9; ++p)
+        for (int q = 0; q < p; ++q) out.c[p][q] = out.c[q][p];
 }
 
 }  // namespace sh

@@ -3,45 +3,49 @@
 // distortion energies"; Teran et al. 2005, "Robust quasistatic finite elements and flesh
 // simulation"). In F's singular frame (F = U diag(s) V^T) dP/dF falls apart into the
 // stretches' 3x3 block and, for each pair of axes, a shear and a turn whose eigenvalues the law
-// writes in closed form: no 9x9 matrix is formed, differentiated or decomposed numerically.
+// writes in closed form: no 9x9 matrix is differentiated or decomposed numerically. Everything
+// runs on kLanes elements at once, as the element loops do.
 #pragma once
 
-#include <Eigen/Core>
+#include "material/lanes.hpp"
 
 namespace sh {
 
-/// dP/dF as a 9x9 matrix: row 3 i + j is dP_ij, column 3 k + l the direction dF_kl.
-using StressDerivative = Eigen::Matrix<double, 9, 9>;
-
-/// F's singular frame: orthonormal u, v and the signed singular values s with F = u diag(s)
-/// v^T. With det F < 0 one of s is negative (u = r v keeps u's orientation v's, r a rotation).
-struct SingularFrame {
-    Eigen::Matrix3d u, v;
-    Eigen::Vector3d s;
+/// dP/dF per lane: c[p][q] = dP_p / dF_q with p, q = 3 i + j.
+struct StressDerivativeLanes {
+    Lanes c[9][9];
 };
 
-/// F's singular frame from its polar rotation r (F = r S, S symmetric, det r = +1): v and s
-/// are S's eigenvectors and eigenvalues and u = r v. S is symmetric and about as large as F, so
-/// its direct 3x3 eigensolve is accurate where one of F^T F (whose entries square F's) would
-/// lose the small singular values, and it costs a fraction of an SVD's Jacobi sweeps.
-SingularFrame singular_frame(const Eigen::Matrix3d& f, const Eigen::Matrix3d& r);
+/// F's singular frame per lane: orthonormal u, v and the signed singular values s with
+/// F = u diag(s) v^T. Where det F < 0 one of s is negative (u = r v with r a rotation).
+struct SingularFrameLanes {
+    Mat3L u, v;
+    Lanes s[3];
+};
 
-/// An isotropic law's dP/dF in its singular frame, from its energy psi(s) as a function of the
-/// signed singular values s (psi_i = d psi / d s_i):
+/// F's singular frames, from its polar rotations r (F = r S, S symmetric, det r = +1): v and s
+/// are S's eigenvectors and eigenvalues (cyclic Jacobi, to round-off) and u = r v. S is
+/// symmetric and about as large as F, so its eigenvalues are as accurate as F's entries, where
+/// those of F^T F (which square F's) would lose the small singular values.
+SingularFrameLanes singular_frames(const Mat3L& F);
+
+/// An isotropic law's dP/dF in its singular frame per lane, from its energy psi(s) as a
+/// function of the signed singular values s (psi_i = d psi / d s_i):
 /// - stretch: the block d2 psi / ds_a ds_b of the modes u_a v_a^T;
 /// - for pair k, the axes i < j other than k, the eigenvalues of its two modes:
 ///   shear[k], of (u_i v_j^T + u_j v_i^T) / sqrt 2, equals (psi_i - psi_j) / (s_i - s_j);
 ///   turn[k], of (u_i v_j^T - u_j v_i^T) / sqrt 2, equals (psi_i + psi_j) / (s_i + s_j).
 /// Each law writes the quotients with the division carried out, so that they stay exact where
 /// singular values meet (the rest shape, uniform compression).
-struct PrincipalStiffness {
-    Eigen::Matrix3d stretch;
-    Eigen::Vector3d shear, turn;
+struct PrincipalStiffnessLanes {
+    Lanes stretch[3][3];
+    Lanes shear[3], turn[3];
 };
 
-/// dP/dF with its negative eigenvalues set to zero: the sum over the nine modes q of
+/// dP/dF with its negative eigenvalues set to zero, per lane: the sum over the nine modes q of
 /// max(eigenvalue, 0) q q^T, in the frame's basis. Exactly dP/dF where it is positive
 /// semi-definite; the nearest positive semi-definite matrix elsewhere.
-StressDerivative projected_stress_derivative(const PrincipalStiffness& stiffness, const SingularFrame& frame);
+void projected_stress_derivatives(const PrincipalStiffnessLanes& stiffness, const SingularFrameLanes& frame,
+                                  StressDerivativeLanes& out);
 
 }  // namespace sh

@@ -9,21 +9,13 @@
 #include "material/material_params.hpp"
 #include "material/isotropic_projection.hpp"
 #include "material/material_table.hpp"
-#include "material/polar_decomposition.hpp"
 #include "linalg/sparse_system.hpp"
 #include "model/fem_kernel.hpp"
-
-#include <Eigen/Dense>
 
 #include <algorithm>
 
 namespace sh {
 namespace {
-
-// dP/dF of a batch's lanes: c[p][q] is dP_p / dF_q (p, q = 3 i + j), one lane per element.
-struct StressDerivativeLanes {
-    Lanes c[9][9];
-};
 
 // One element's stiffness per lane, by 3x3 node blocks: block[a][b][k][l] = K((a, k), (b, l)).
 struct StiffnessLanes {
@@ -52,25 +44,13 @@ void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* nea
         for (int q = p + 1; q < 9; ++q) C.c[p][q] = C.c[q][p] = 0.5 * (C.c[p][q] + C.c[q][p]);
 }
 
-// dP/dF of a law that projects (all isotropic: see the material table's kProjectTangent) for
-// each lane, projected to positive semi-definite: from the law's analytic eigensystem in F's
-// singular frame, which the batch's polar rotations give.
+// dP/dF of a law that projects (all isotropic: see the material table's kProjectTangent) per
+// lane, projected to positive semi-definite: from the law's analytic eigensystem in F's
+// singular frame.
 template <class Material>
-void projected_stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, int count, StressDerivativeLanes& C) {
-    const Mat3L R = polar_rotation(F);
-    for (int l = count; l < kLanes; ++l)  // padding: inert
-        for (int p = 0; p < 9; ++p)
-            for (int q = 0; q < 9; ++q) C.c[p][q][l] = 0.0;
-    for (int l = 0; l < count; ++l) {
-        Eigen::Matrix3d f, r;
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) f(i, j) = F.m[i][j][l], r(i, j) = R.m[i][j][l];
-        const SingularFrame frame = singular_frame(f, r);
-        const StressDerivative c =
-            projected_stress_derivative(Material::principal_stiffness(frame.s, lambda[l], mu[l]), frame);
-        for (int p = 0; p < 9; ++p)
-            for (int q = 0; q < 9; ++q) C.c[p][q][l] = c(p, q);
-    }
+void projected_stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, StressDerivativeLanes& C) {
+    const SingularFrameLanes frame = singular_frames(F);
+    projected_stress_derivatives(Material::principal_stiffness(frame.s, lambda, mu), frame, C);
 }
 
 // K = V0 G^T C G per lane, for symmetric C and the shape-function gradients g[a - 1] of nodes
@@ -141,7 +121,7 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
         visit_material(model, [&](auto law) {
             using Law = decltype(law);
             if constexpr (Law::kProjectTangent)
-                projected_stress_derivatives<Law>(F, lambda, mu, count, C);
+                projected_stress_derivatives<Law>(F, lambda, mu, C);
             else
                 stress_derivatives<Law>(F, lambda, mu, warm ? &near : nullptr, C);
         });

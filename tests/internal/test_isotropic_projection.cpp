@@ -6,13 +6,14 @@
 // degenerate deformations.
 #include "material/isotropic_projection.hpp"
 #include "material/neohookean_material.hpp"
-#include "material/polar_decomposition.hpp"
 #include "material/stvk_material.hpp"
 
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <algorithm>
 #include <random>
+#include <vector>
 
 extern "C" {
 #include <setjmp.h>
@@ -23,7 +24,8 @@ extern "C" {
 
 namespace {
 
-using sh::StressDerivative;
+using StressDerivative = Eigen::Matrix<double, 9, 9>;
+using Deformations = std::vector<Eigen::Matrix3d>;
 
 Eigen::Matrix3d rotation(std::mt19937_64& rng) {
     std::normal_distribution<double> normal;
@@ -49,94 +51,121 @@ StressDerivative derivative(const Eigen::Matrix3d& f, double lambda, double mu) 
     return 0.5 * (c + c.transpose());
 }
 
-/// f's singular frame the way the tangent assembly finds it: from f's polar rotation.
-sh::SingularFrame frame_of(const Eigen::Matrix3d& f) {
-    sh::Mat3L F;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) F.m[i][j] = sh::splat(f(i, j));
-    const sh::Mat3L R = sh::polar_rotation(F);
-    Eigen::Matrix3d r;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) r(i, j) = R.m[i][j][0];
-    return sh::singular_frame(f, r);
-}
-
 /// The reference: c's eigendecomposition with the negative eigenvalues set to zero.
 StressDerivative clamped(const StressDerivative& c) {
     const Eigen::SelfAdjointEigenSolver<StressDerivative> eigen(c);
     return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * eigen.eigenvectors().transpose();
 }
 
-/// Projects Law's derivative at r1 diag(s) r2 and compares with the reference; returns the
-/// reference's negative eigenvalues (those the projection removed).
-template <class Law>
-int check(const Eigen::Matrix3d& r1, const Eigen::Vector3d& s, const Eigen::Matrix3d& r2) {
-    const Eigen::Matrix3d f = r1 * s.asDiagonal() * r2;
-    const StressDerivative c = derivative<Law>(f, 2.0, 1.0);
-    const sh::SingularFrame frame = frame_of(f);
-    // The frame is orthonormal and diagonalises f, to round-off ...
-    const Eigen::Matrix3d d = frame.u.transpose() * f * frame.v;
-    assert_true((d - Eigen::Matrix3d(d.diagonal().asDiagonal())).cwiseAbs().maxCoeff() <= 1e-14 * f.norm());
-    assert_true((d.diagonal() - frame.s).cwiseAbs().maxCoeff() <= 1e-14 * f.norm());
-    assert_true((frame.u.transpose() * frame.u - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-14);
-    assert_true((frame.v.transpose() * frame.v - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-14);
-    const StressDerivative projected =
-        sh::projected_stress_derivative(Law::principal_stiffness(frame.s, 2.0, 1.0), frame);
-    const StressDerivative expected = clamped(c);
-    const double scale = c.cwiseAbs().maxCoeff();
-    assert_true((projected - expected).cwiseAbs().maxCoeff() <= 1e-10 * scale);
-    // ... and gives the reference's projection, which is positive semi-definite.
-    const Eigen::SelfAdjointEigenSolver<StressDerivative> after(projected);
-    assert_true(after.eigenvalues()(0) >= -1e-10 * scale);
-    const Eigen::SelfAdjointEigenSolver<StressDerivative> before(c);
-    return static_cast<int>((before.eigenvalues().array() < -1e-10 * scale).count());
+Eigen::Matrix3d lane(const sh::Mat3L& a, int l) {
+    Eigen::Matrix3d r;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) r(i, j) = a.m[i][j][l];
+    return r;
 }
 
-/// Random deformations with principal stretches in [low, high], det F > 0.
+/// Checks lane l's frame of f: orthonormal, and it diagonalises f into its signed singular
+/// values, to round-off.
+void check_frame(const sh::SingularFrameLanes& frame, int l, const Eigen::Matrix3d& f) {
+    const Eigen::Matrix3d u = lane(frame.u, l), v = lane(frame.v, l);
+    const Eigen::Matrix3d d = u.transpose() * f * v;
+    const Eigen::Vector3d s(frame.s[0][l], frame.s[1][l], frame.s[2][l]);
+    assert_true((d - Eigen::Matrix3d(s.asDiagonal())).cwiseAbs().maxCoeff() <= 1e-14 * f.norm());
+    assert_true((u.transpose() * u - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-14);
+    assert_true((v.transpose() * v - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-14);
+}
+
+/// Projects Law's derivative at up to kLanes deformations at once (one per lane, the last
+/// repeated into the rest) and compares each lane with the reference; returns the reference's
+/// negative eigenvalues (those the projection removed).
 template <class Law>
-int random_cases(double low, double high, unsigned seed) {
+int check_lanes(const Eigen::Matrix3d* fs, int count) {
+    sh::Mat3L F;
+    for (int l = 0; l < sh::kLanes; ++l)
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) F.m[i][j][l] = fs[std::min(l, count - 1)](i, j);
+    const sh::SingularFrameLanes frame = sh::singular_frames(F);
+    sh::StressDerivativeLanes projected;
+    sh::projected_stress_derivatives(Law::principal_stiffness(frame.s, sh::splat(2.0), sh::splat(1.0)), frame,
+                                     projected);
+    int removed = 0;
+    for (int l = 0; l < count; ++l) {
+        check_frame(frame, l, fs[l]);
+        const StressDerivative c = derivative<Law>(fs[l], 2.0, 1.0);
+        StressDerivative mine;
+        for (int p = 0; p < 9; ++p)
+            for (int q = 0; q < 9; ++q) mine(p, q) = projected.c[p][q][l];
+        // The reference's projection, which is positive semi-definite.
+        const double scale = c.cwiseAbs().maxCoeff();
+        assert_true((mine - clamped(c)).cwiseAbs().maxCoeff() <= 1e-10 * scale);
+        const Eigen::SelfAdjointEigenSolver<StressDerivative> after(mine), before(c);
+        assert_true(after.eigenvalues()(0) >= -1e-10 * scale);
+        removed += static_cast<int>((before.eigenvalues().array() < -1e-10 * scale).count());
+    }
+    return removed;
+}
+
+/// check_lanes over all of fs, kLanes at a time.
+template <class Law>
+int check(const Deformations& fs) {
+    int removed = 0;
+    for (size_t first = 0; first < fs.size(); first += sh::kLanes)
+        removed += check_lanes<Law>(&fs[first], static_cast<int>(std::min<size_t>(sh::kLanes, fs.size() - first)));
+    return removed;
+}
+
+/// Random deformations r1 diag(s) r2 with principal stretches in [low, high], det F > 0.
+Deformations random_deformations(double low, double high, unsigned seed) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> stretch(low, high);
-    int removed = 0;
-    for (int n = 0; n < 300; ++n)
-        removed += check<Law>(rotation(rng), Eigen::Vector3d(stretch(rng), stretch(rng), stretch(rng)), rotation(rng));
-    return removed;
+    Deformations fs;
+    for (int n = 0; n < 300; ++n) {
+        const Eigen::Matrix3d r1 = rotation(rng);
+        const Eigen::Vector3d s(stretch(rng), stretch(rng), stretch(rng));
+        fs.push_back(r1 * s.asDiagonal() * rotation(rng));
+    }
+    return fs;
 }
 
 /// Strong compression makes both laws indefinite: eigenvalues must be removed, and the result
 /// is the full eigendecomposition's.
 void compressed_elements(void**) {
-    assert_true(random_cases<sh::StvkMaterial>(0.2, 0.9, 1) > 0);
-    assert_true(random_cases<sh::NeoHookeanMaterial>(0.1, 0.6, 2) > 0);
+    assert_true(check<sh::StvkMaterial>(random_deformations(0.2, 0.9, 1)) > 0);
+    assert_true(check<sh::NeoHookeanMaterial>(random_deformations(0.1, 0.6, 2)) > 0);
 }
 
 /// Stretched and mixed deformations, definite or not.
 void mixed_elements(void**) {
-    random_cases<sh::StvkMaterial>(0.3, 2.0, 3);
-    random_cases<sh::NeoHookeanMaterial>(0.3, 2.0, 4);
+    check<sh::StvkMaterial>(random_deformations(0.3, 2.0, 3));
+    check<sh::NeoHookeanMaterial>(random_deformations(0.3, 2.0, 4));
 }
 
-/// Inverted elements (one negative principal stretch, as the SVD of det F < 0 returns).
+/// Inverted elements (one negative principal stretch).
 void inverted_elements(void**) {
     std::mt19937_64 rng(5);
-    int removed = 0;
+    Deformations fs;
     for (int n = 0; n < 100; ++n) {
-        const Eigen::Vector3d s(0.9, 0.7, -0.2 - 0.001 * n);
-        removed += check<sh::StvkMaterial>(rotation(rng), s, rotation(rng));
-        removed += check<sh::NeoHookeanMaterial>(rotation(rng), s, rotation(rng));
+        const Eigen::Matrix3d r1 = rotation(rng);
+        fs.push_back(r1 * Eigen::Vector3d(0.9, 0.7, -0.2 - 0.001 * n).asDiagonal() * rotation(rng));
     }
-    assert_true(removed > 0);
+    assert_true(check<sh::StvkMaterial>(fs) > 0);
+    assert_true(check<sh::NeoHookeanMaterial>(fs) > 0);
 }
 
-/// Repeated singular values (the frame is not unique there) and the rest shape.
+/// Repeated singular values (the frame is not unique there) and the rest shape, in the same
+/// batches as distinct ones (each lane converges on its own).
 void degenerate_stretches(void**) {
     std::mt19937_64 rng(6);
+    Deformations fs;
     for (int n = 0; n < 100; ++n) {
         const Eigen::Matrix3d r1 = rotation(rng), r2 = rotation(rng);
-        check<sh::StvkMaterial>(r1, Eigen::Vector3d(0.5, 0.5, 1.2), r2);
-        check<sh::NeoHookeanMaterial>(r1, Eigen::Vector3d(0.4, 0.4, 0.4), r2);
-        check<sh::StvkMaterial>(r1, Eigen::Vector3d(1.0, 1.0, 1.0), r1.transpose());
+        fs.push_back(r1 * Eigen::Vector3d(0.5, 0.5, 1.2).asDiagonal() * r2);
+        fs.push_back(r1 * Eigen::Vector3d(0.4, 0.4, 0.4).asDiagonal() * r2);
+        fs.push_back(r1 * r1.transpose());
+        fs.push_back(r1 * Eigen::Vector3d(0.3, 0.8, 1.6).asDiagonal() * r2);
     }
+    check<sh::StvkMaterial>(fs);
+    check<sh::NeoHookeanMaterial>(fs);
 }
 
 }  // namespace

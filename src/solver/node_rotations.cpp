@@ -16,26 +16,29 @@ namespace {
 constexpr double kNodeRotationSettled2 = 1e-6;
 
 // Adds the products (x_b - x_a)(r_b - r_a)^T over the element edges from each free node a into
-// out (9 per free node), x and r positions of the body's nodes.
+// out (9 per free node), x and r positions of the body's nodes. An edge's product is the same
+// from either end: each is formed once and added to both.
 void add_edge_products(const Body& body, const vec<int32_t>& free_of, const double* x, const double* r,
                        vec<double>& out) {
     const int32_t* elements = body.element_nodes();
     const int per = body.nodes_per_element();
     for (int32_t e = 0; e < body.element_count(); ++e) {
         const int32_t* nodes = elements + static_cast<size_t>(e) * static_cast<size_t>(per);
-        for (int a = 0; a < per; ++a) {
-            const int32_t k = free_of[static_cast<size_t>(nodes[a])];
-            if (k < 0) continue;
-            double* s = &out[9 * static_cast<size_t>(k)];
-            for (int b = 0; b < per; ++b) {
-                if (b == a) continue;
-                double dx[3], dr[3];
+        for (int a = 0; a < per; ++a)
+            for (int b = a + 1; b < per; ++b) {
+                const int32_t ka = free_of[static_cast<size_t>(nodes[a])], kb = free_of[static_cast<size_t>(nodes[b])];
+                if (ka < 0 && kb < 0) continue;
+                double dx[3], dr[3], product[9];
                 sub3(at(x, nodes[b]), at(x, nodes[a]), dx);
                 sub3(at(r, nodes[b]), at(r, nodes[a]), dr);
                 for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j) s[3 * i + j] += dx[i] * dr[j];
+                    for (int j = 0; j < 3; ++j) product[3 * i + j] = dx[i] * dr[j];
+                for (const int32_t k : {ka, kb}) {
+                    if (k < 0) continue;
+                    double* s = &out[9 * static_cast<size_t>(k)];
+                    for (int q = 0; q < 9; ++q) s[q] += product[q];
+                }
             }
-        }
     }
 }
 

@@ -63,6 +63,14 @@ public:
     /// Elastic energy at positions x (J).
     virtual double elastic_energy(const double* x) const = 0;
 
+    /// Adds the elastic forces at x into f (add_internal_forces without damping) and returns
+    /// the elastic energy at x, as the two calls would; a body that can share their work in one
+    /// pass over its elements overrides it.
+    virtual double add_elastic_forces_and_energy(const double* x, double* f) const {
+        add_internal_forces(x, nullptr, f);
+        return elastic_energy(x);
+    }
+
     /// Largest stable step of an undamped leapfrog step, 2 / omega_max, at state x (s).
     virtual double stable_step(const double* x) const = 0;
 

@@ -282,6 +282,18 @@ void FemBody::add_internal_forces(const double* xs, const double* vs, double* f)
     inverted_elements_ = std::max(inverted_elements_, inverted);
 }
 
+double FemBody::add_elastic_forces_and_energy(const double* xs, double* f) const {
+    double energy = 0.0;
+    int32_t inverted = 0;
+    for_each_material([&](auto material, int model) {
+        using Material = decltype(material);
+        const vec<TetBlock>& blocks = blocks_[model];
+        inverted += add_fem_forces_and_energy<Material>(blocks.data(), blocks.size(), xs, f, rotations_.pass(model), &energy);
+    });
+    inverted_elements_ = std::max(inverted_elements_, inverted);
+    return energy;
+}
+
 double FemBody::elastic_energy(const double* xs) const {
     double energy = 0.0;
     for_each_material([&](auto material, int model) {

@@ -161,17 +161,28 @@ SH_INLINE Lanes block_energy(const Mat3L& F, const TetBlock& b, size_t k, const 
     return Material::energy(F, b.lambda_w, b.mu_w);
 }
 
-/// The force loop; Damped adds -beta K(x) v through the material's differential.
-template <class Material, bool Damped>
+/// -V0 psi(F) of a block whose stress state is known (a law that keeps a rotation takes it
+/// from the state, where block_stress put it).
+template <class Material>
+SH_INLINE Lanes state_energy(const Mat3L& F, const TetBlock& b, const typename Material::State& state) {
+    if constexpr (Material::kRotates) return Material::energy_at(F, state.R, b.lambda_w, b.mu_w);
+    else return Material::energy(F, b.lambda_w, b.mu_w);
+}
+
+/// The force loop; Damped adds -beta K(x) v through the material's differential; Energy adds
+/// the elastic energy into *energy from the same F and stress state.
+template <class Material, bool Damped, bool Energy>
 int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const double* x, const double* v,
-                            double beta, double* f, const KeptRotations& rotations) {
+                            double beta, double* f, const KeptRotations& rotations, double* energy) {
     int32_t inverted = 0;  // elements with det F <= 0 (unused lanes weigh 0)
+    Lanes energy_sum = Lanes{};
     for (size_t k = 0; k < block_count; ++k) {
         const TetBlock& b = blocks[k];
         const Mat3L F = mul(gather_edges(b, x), b.Bm);
         typename Material::State state;
         Mat3L P = block_stress<Material>(F, b, k, rotations, state);  // -V0 P
         inverted += count_non_positive(Material::jacobian(F, state), b.mu_w);
+        if constexpr (Energy) energy_sum -= state_energy<Material>(F, b, state);  // the weights carry -V0
         if (Damped) {
             const Mat3L dF = mul(gather_edges(b, v), b.Bm);
             const Mat3L dP = Material::differential(F, state, dF, b.lambda_w, b.mu_w);
@@ -184,6 +195,7 @@ int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const do
         scatter_add_xyz<true>(f, b.node[0], H.m[0][0] + H.m[0][1] + H.m[0][2], H.m[1][0] + H.m[1][1] + H.m[1][2],
                               H.m[2][0] + H.m[2][1] + H.m[2][2]);
     }
+    if constexpr (Energy) *energy += lane_sum(energy_sum);
     return inverted;
 }
 
@@ -193,8 +205,16 @@ int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const do
 template <class Material>
 int32_t add_fem_forces(const TetBlock* blocks, size_t block_count, const double* x, const double* v, double beta,
                        double* f, const KeptRotations& rotations = KeptRotations{}) {
-    if (v) return add_fem_forces_loop<Material, true>(blocks, block_count, x, v, beta, f, rotations);
-    return add_fem_forces_loop<Material, false>(blocks, block_count, x, nullptr, 0.0, f, rotations);
+    if (v) return add_fem_forces_loop<Material, true, false>(blocks, block_count, x, v, beta, f, rotations, nullptr);
+    return add_fem_forces_loop<Material, false, false>(blocks, block_count, x, nullptr, 0.0, f, rotations, nullptr);
+}
+
+/// add_fem_forces without damping, adding the blocks' elastic energy (J) into *energy from the
+/// same pass: one gather, F and stress per element where fem_energy would repeat them.
+template <class Material>
+int32_t add_fem_forces_and_energy(const TetBlock* blocks, size_t block_count, const double* x, double* f,
+                                  const KeptRotations& rotations, double* energy) {
+    return add_fem_forces_loop<Material, false, true>(blocks, block_count, x, nullptr, 0.0, f, rotations, energy);
 }
 
 /// The rotations of blocks' elements at positions x into out[k], found from F alone, for a

@@ -378,7 +378,7 @@ void NewtonStep::evaluate() {
         if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
         if (first_evaluation_)
             for (const int32_t j : state.matrix.system.dof_to_global()) push2 += f[static_cast<size_t>(j)] * f[static_cast<size_t>(j)];
-        body.add_internal_forces(body.x.data(), nullptr, f);
+        const double elastic = body.add_elastic_forces_and_energy(body.x.data(), f);
         double* damping = nullptr;  // -D0 v, the lagged internal damping force
         if (body.has_internal_damping()) {
             damping = stepped.workspace.stage_a[2].data();
@@ -387,7 +387,6 @@ void NewtonStep::evaluate() {
             const double* base = stepped.workspace.stage_a[1].data();
             for (size_t j = 0; j < body.x.size(); ++j) damping[j] -= base[j];
         }
-        const double elastic = body.elastic_energy(body.x.data());
         const double field = body.field ? body.field->energy(body.x.data()) + h * body.field->dissipation(body.v.data()) : 0.0;
         phi.value += elastic + field;
         phi.scale += std::fabs(elastic) + std::fabs(field);

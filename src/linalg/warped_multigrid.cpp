@@ -9,6 +9,15 @@
 namespace sh {
 namespace {
 
+// s -= A_k z_j for stored block k = (i, j) of a.
+inline void subtract_block_product(const BlockMatrix& a, int32_t k, const double* z, double (&s)[3]) {
+    const double* b = a.block(k);
+    const double* zj = z + 3 * static_cast<size_t>(a.column()[k]);
+    s[0] -= b[0] * zj[0] + b[1] * zj[1] + b[2] * zj[2];
+    s[1] -= b[3] * zj[0] + b[4] * zj[1] + b[5] * zj[2];
+    s[2] -= b[6] * zj[0] + b[7] * zj[1] + b[8] * zj[2];
+}
+
 // Free nodes per coarse node the grid aims at: about 4 fine cells per coarse cell along each
 // axis on a structured mesh (4x4x4 coarse cells for a 15^3-cell cube: 5-7 CG iterations to a
 // relative residual of 0.025 through large rotations). Finer grids cost more per cycle than
@@ -221,15 +230,8 @@ void WarpedMultigrid::sweep(const double* r, double* z, bool forward) const {
     for (int32_t step = 0; step < n; ++step) {
         const int32_t i = forward ? step : n - 1 - step;
         double s[3] = {r[3 * static_cast<size_t>(i)], r[3 * static_cast<size_t>(i) + 1], r[3 * static_cast<size_t>(i) + 2]};
-        for (int32_t k = blocks_.row_start()[i]; k < blocks_.row_start()[i + 1]; ++k) {
-            const int32_t j = blocks_.column()[k];
-            if (j == i) continue;
-            const double* b = blocks_.block(k);
-            const double* zj = z + 3 * static_cast<size_t>(j);
-            s[0] -= b[0] * zj[0] + b[1] * zj[1] + b[2] * zj[2];
-            s[1] -= b[3] * zj[0] + b[4] * zj[1] + b[5] * zj[2];
-            s[2] -= b[6] * zj[0] + b[7] * zj[1] + b[8] * zj[2];
-        }
+        for (int32_t k = blocks_.row_start()[i]; k < blocks_.row_start()[i + 1]; ++k)
+            if (k != blocks_.diagonal(i)) subtract_block_product(blocks_, k, z, s);
         const double* d = &inverse_diagonal_[9 * static_cast<size_t>(i)];
         double* zi = z + 3 * static_cast<size_t>(i);
         zi[0] = d[0] * s[0] + d[1] * s[1] + d[2] * s[2];
@@ -238,14 +240,31 @@ void WarpedMultigrid::sweep(const double* r, double* z, bool forward) const {
     }
 }
 
-void WarpedMultigrid::coarse_correction(const double* r, double* z) {
+void WarpedMultigrid::first_sweep(const double* r, double* z) {
     const int32_t n = blocks_.node_count();
-    blocks_.multiply(z, residual_.data());
+    const int32_t* start = blocks_.row_start();
+    std::fill(z, z + 3 * static_cast<size_t>(n), 0.0);
+    for (int32_t i = 0; i < n; ++i) {
+        double s[3] = {r[3 * static_cast<size_t>(i)], r[3 * static_cast<size_t>(i) + 1], r[3 * static_cast<size_t>(i) + 2]};
+        for (int32_t k = start[i]; k < blocks_.diagonal(i); ++k) subtract_block_product(blocks_, k, z, s);
+        const double* d = &inverse_diagonal_[9 * static_cast<size_t>(i)];
+        double* zi = z + 3 * static_cast<size_t>(i);
+        for (int c = 0; c < 3; ++c) zi[c] = d[3 * c] * s[0] + d[3 * c + 1] * s[1] + d[3 * c + 2] * s[2];
+    }
+    for (int32_t i = 0; i < n; ++i) {
+        double s[3] = {0.0, 0.0, 0.0};
+        for (int32_t k = blocks_.diagonal(i) + 1; k < start[i + 1]; ++k) subtract_block_product(blocks_, k, z, s);
+        std::copy(s, s + 3, &residual_[3 * static_cast<size_t>(i)]);
+    }
+}
+
+void WarpedMultigrid::coarse_correction(double* z) {
+    const int32_t n = blocks_.node_count();
     coarse_rhs_.setZero();
     for (int32_t i = 0; i < n; ++i) {
         const double* R = &rotation_[9 * static_cast<size_t>(i)];
-        double e[3], local[3];
-        for (int c = 0; c < 3; ++c) e[c] = r[3 * static_cast<size_t>(i) + c] - residual_[3 * static_cast<size_t>(i) + c];
+        const double* e = &residual_[3 * static_cast<size_t>(i)];
+        double local[3];
         for (int c = 0; c < 3; ++c) local[c] = R[c] * e[0] + R[3 + c] * e[1] + R[6 + c] * e[2];  // R^T e
         for (int p = 0; p < 8; ++p) {
             const int32_t I = corner_[8 * static_cast<size_t>(i) + p];
@@ -270,18 +289,18 @@ void WarpedMultigrid::coarse_correction(const double* r, double* z) {
 }
 
 void WarpedMultigrid::apply(const double* r, double* z) {
-    std::fill(z, z + 3 * static_cast<size_t>(blocks_.node_count()), 0.0);
-    sweep(r, z, true);
-    coarse_correction(r, z);
+    first_sweep(r, z);
+    coarse_correction(z);
     sweep(r, z, false);
 }
 
 double WarpedMultigrid::iteration_work() const {
-    // 18 operations per stored block for each of the forward sweep, the residual, the backward
-    // sweep and CG's product; the transfers; the dense coarse solve. They count half a sparse
-    // solve's operation each: the blocks (4-5 MB at 20 k tets) stay in cache across the
-    // cycle where a factor (29 MB) streams from memory (measured: 0.65 ms per iteration,
-    // rotations included, against 4.2 ms per solve on the 20,250-tet cube).
+    // 18 operations per stored block for four passes' worth: the first sweep with its residual
+    // (one pass, measured no cheaper than 1.7 of the others), the backward sweep and CG's
+    // product; the transfers; the dense coarse solve. They count half a sparse solve's
+    // operation each: the blocks (4-5 MB at 20 k tets) stay in cache across the cycle where a
+    // factor (29 MB) streams from memory (measured: 0.6 ms per iteration, rotations included,
+    // against 4.2 ms per solve on the 20,250-tet cube).
     const double blocks = static_cast<double>(blocks_.block_count());
     const double coarse = 3.0 * coarse_count_;
     return 0.5 * (4.0 * 18.0 * blocks + 120.0 * blocks_.node_count() + 2.0 * coarse * coarse);

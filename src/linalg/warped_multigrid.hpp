@@ -58,8 +58,13 @@ private:
     void build_coarse();
     /// One block Gauss-Seidel sweep over the nodes, forward or backward, on z towards r.
     void sweep(const double* r, double* z, bool forward) const;
-    /// z += R P (coarse solve of P^T R^T (r - A z)).
-    void coarse_correction(const double* r, double* z);
+    /// The forward sweep from z = 0, then residual_ = r - A z. From zero only the blocks left
+    /// of the diagonal meet a nonzero z, and the sweep zeroes each row's residual up to its
+    /// diagonal, so that r - A z = -U z (U the blocks right of it): one pass over the blocks
+    /// where a full sweep and a product make two.
+    void first_sweep(const double* r, double* z);
+    /// z += R P (coarse solve of P^T R^T residual_).
+    void coarse_correction(double* z);
 
     bool built_ = false;
     BlockMatrix blocks_;           // the current matrix (A0 while building)

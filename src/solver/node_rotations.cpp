@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 
 namespace sh {
@@ -15,30 +16,52 @@ namespace {
 // A preconditioner needs the rotations to about 1e-3 rad, not the element laws' 1e-6.
 constexpr double kNodeRotationSettled2 = 1e-6;
 
-// Adds the products (x_b - x_a)(r_b - r_a)^T over the element edges from each free node a into
-// out (9 per free node), x and r positions of the body's nodes. An edge's product is the same
-// from either end: each is formed once and added to both.
-void add_edge_products(const Body& body, const vec<int32_t>& free_of, const double* x, const double* r,
-                       vec<double>& out) {
+// The edges of body's elements with a free end, each once (a < b), and how many elements share
+// it: in a tet mesh about five, so that the sums over element edges take a fifth of the work.
+vec<NodeRotations::Edge> unique_edges(const Body& body, const vec<int32_t>& free_of) {
     const int32_t* elements = body.element_nodes();
     const int per = body.nodes_per_element();
+    vec<std::pair<int32_t, int32_t>> pairs;
+    pairs.reserve(static_cast<size_t>(body.element_count()) * static_cast<size_t>(per * (per - 1) / 2));
     for (int32_t e = 0; e < body.element_count(); ++e) {
         const int32_t* nodes = elements + static_cast<size_t>(e) * static_cast<size_t>(per);
-        for (int a = 0; a < per; ++a)
-            for (int b = a + 1; b < per; ++b) {
-                const int32_t ka = free_of[static_cast<size_t>(nodes[a])], kb = free_of[static_cast<size_t>(nodes[b])];
-                if (ka < 0 && kb < 0) continue;
-                double dx[3], dr[3], product[9];
-                sub3(at(x, nodes[b]), at(x, nodes[a]), dx);
-                sub3(at(r, nodes[b]), at(r, nodes[a]), dr);
-                for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j) product[3 * i + j] = dx[i] * dr[j];
-                for (const int32_t k : {ka, kb}) {
-                    if (k < 0) continue;
-                    double* s = &out[9 * static_cast<size_t>(k)];
-                    for (int q = 0; q < 9; ++q) s[q] += product[q];
-                }
+        for (int i = 0; i < per; ++i)
+            for (int j = i + 1; j < per; ++j) {
+                const int32_t a = std::min(nodes[i], nodes[j]), b = std::max(nodes[i], nodes[j]);
+                if (free_of[static_cast<size_t>(a)] >= 0 || free_of[static_cast<size_t>(b)] >= 0) pairs.emplace_back(a, b);
             }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    vec<NodeRotations::Edge> edges;
+    for (size_t k = 0; k < pairs.size(); ++k) {
+        if (k > 0 && pairs[k] == pairs[k - 1]) {
+            edges.back().weight += 1.0;
+            continue;
+        }
+        NodeRotations::Edge edge;
+        edge.free_a = free_of[static_cast<size_t>(pairs[k].first)], edge.free_b = free_of[static_cast<size_t>(pairs[k].second)];
+        edge.a = pairs[k].first, edge.b = pairs[k].second;
+        edge.weight = 1.0;
+        edges.push_back(edge);
+    }
+    return edges;
+}
+
+// Adds weight (x_b - x_a)(r_b - r_a)^T over the edges into out at each free end (9 per free
+// node): the sum over the element edges from each free node, x and r node positions. An
+// edge's product is the same from either end.
+void add_edge_products(const vec<NodeRotations::Edge>& edges, const double* x, const double* r, vec<double>& out) {
+    for (const NodeRotations::Edge& edge : edges) {
+        double dx[3], dr[3], product[9];
+        sub3(at(x, edge.b), at(x, edge.a), dx);
+        sub3(at(r, edge.b), at(r, edge.a), dr);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) product[3 * i + j] = edge.weight * dx[i] * dr[j];
+        for (const int32_t k : {edge.free_a, edge.free_b}) {
+            if (k < 0) continue;
+            double* s = &out[9 * static_cast<size_t>(k)];
+            for (int q = 0; q < 9; ++q) s[q] += product[q];
+        }
     }
 }
 
@@ -48,8 +71,9 @@ void NodeRotations::reset(const Body& body, const vec<int32_t>& dof_to_global) {
     const size_t free_nodes = dof_to_global.size() / 3;
     vec<int32_t> free_of(body.x.size() / 3, -1);
     for (size_t k = 0; k < free_nodes; ++k) free_of[static_cast<size_t>(dof_to_global[3 * k]) / 3] = static_cast<int32_t>(k);
+    vec<Edge> edges = unique_edges(body, free_of);
     vec<double> shape(9 * free_nodes, 0.0), inverse_rest(9 * free_nodes, 0.0), rotation(9 * free_nodes, 0.0);
-    add_edge_products(body, free_of, body.rest.data(), body.rest.data(), inverse_rest);
+    add_edge_products(edges, body.rest.data(), body.rest.data(), inverse_rest);
     for (size_t k = 0; k < free_nodes; ++k) {
         Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> q(&inverse_rest[9 * k]);
         const double det = q.determinant(), size = q.squaredNorm();
@@ -58,12 +82,12 @@ void NodeRotations::reset(const Body& body, const vec<int32_t>& dof_to_global) {
         else q /= std::max(size, 1e-300);
         rotation[9 * k] = rotation[9 * k + 4] = rotation[9 * k + 8] = 1.0;
     }
-    free_of_.swap(free_of), shape_.swap(shape), inverse_rest_.swap(inverse_rest), rotation_.swap(rotation);
+    edges_.swap(edges), shape_.swap(shape), inverse_rest_.swap(inverse_rest), rotation_.swap(rotation);
 }
 
 const double* NodeRotations::update(const Body& body) {
     std::fill(shape_.begin(), shape_.end(), 0.0);
-    add_edge_products(body, free_of_, body.x.data(), body.rest.data(), shape_);
+    add_edge_products(edges_, body.x.data(), body.rest.data(), shape_);
     for (size_t k = 0; k < size(); ++k) {
         Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s(&shape_[9 * k]);
         s = (s * Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&inverse_rest_[9 * k])).eval();

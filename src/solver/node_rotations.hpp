@@ -27,8 +27,15 @@ public:
     /// The largest angle (rad, to second order) any node turned by in the last update.
     double last_turn() const { return last_turn_; }
 
+    /// An element edge with a free end: body nodes a < b, their free nodes (-1 if not free),
+    /// and how many elements share it.
+    struct Edge {
+        int32_t a, b, free_a, free_b;
+        double weight;
+    };
+
 private:
-    vec<int32_t> free_of_;   // per body node: its free node, -1 if not free
+    vec<Edge> edges_;
     vec<double> shape_;      // 9 per free node: S_i
     vec<double> inverse_rest_;  // 9 per free node: Q_i^-1 (Q_i / tr Q_i^2 where Q_i is singular)
     vec<double> rotation_;   // 9 per free node

@@ -238,6 +238,10 @@ private:
     double r_ = 0.0, r_max_ = 0.0; // residual norms (2 and max) at the current iterate
     double largest_change_ = 0.0, largest_speed_ = 0.0;  // of the last update taken
     double energy0_ = 0.0, energy_scale0_ = 0.0;  // mechanical energy at the start, its scale
+    // The elastic and field energies at the positions the last evaluate() left (their sum
+    // and the sum of their magnitudes), while nothing else has moved the bodies since.
+    double evaluated_energy_ = 0.0, evaluated_energy_scale_ = 0.0;
+    bool evaluated_energy_current_ = false;
     double field_push_ = 0.0;  // norm of the fields' push at the first iterate (N)
     bool first_evaluation_ = true;  // the next evaluate() is the step's first: it measures field_push_
     bool work_done_ = false;  // moving tools, other bodies or prescribed nodes work on the bodies
@@ -257,7 +261,10 @@ double NewtonStep::mechanical_energy(bool at_start, double& scale) const {
             kinetic += 0.5 * body.mass[k / 3] * v[k] * v[k];
         }
     });
-    const double potential = problem_.potential_energy(g_, 1.0, at_start, scale);
+    const double potential =
+        at_start || !evaluated_energy_current_
+            ? problem_.potential_energy(g_, 1.0, at_start, scale)
+            : problem_.potential_energy_from(g_, 1.0, evaluated_energy_, evaluated_energy_scale_, scale);
     scale += kinetic;
     return kinetic + potential;
 }
@@ -293,6 +300,7 @@ void NewtonStep::begin() {
     problem_.each([&](const SteppedBody& stepped, size_t) { in_contact_ |= stepped.body->field != nullptr; });
     energy_checked_ = false;
     first_evaluation_ = true;
+    evaluated_energy_current_ = false;
     problem_.each([&](SteppedBody& stepped, size_t) {
         Body& body = *stepped.body;
         save_start_state(stepped);
@@ -361,6 +369,7 @@ bool NewtonStep::build_multigrid() {
 // Moves every body to x = x0 + h v, then fills matrix_.residual with g(v), r_, r_max_ and phi_.
 // Every body moves first: the forces between bodies solved together see both ends.
 void NewtonStep::evaluate() {
+    evaluated_energy_current_ = false;  // the bodies move now; true again once the pass completes
     const double h = dt_;
     problem_.each([&](SteppedBody& stepped, size_t) {
         Body& body = *stepped.body;
@@ -369,6 +378,7 @@ void NewtonStep::evaluate() {
     Potential phi;
     double sum2 = 0.0, push2 = 0.0;
     r_max_ = 0.0;
+    evaluated_energy_ = evaluated_energy_scale_ = 0.0;
     problem_.each([&](SteppedBody& stepped, size_t offset) {
         Body& body = *stepped.body;
         const NewtonBodyState& state = *stepped.newton;
@@ -387,7 +397,10 @@ void NewtonStep::evaluate() {
             const double* base = stepped.workspace.stage_a[1].data();
             for (size_t j = 0; j < body.x.size(); ++j) damping[j] -= base[j];
         }
-        const double field = body.field ? body.field->energy(body.x.data()) + h * body.field->dissipation(body.v.data()) : 0.0;
+        const double field_energy = body.field ? body.field->energy(body.x.data()) : 0.0;
+        const double field = body.field ? field_energy + h * body.field->dissipation(body.v.data()) : 0.0;
+        evaluated_energy_ += elastic + field_energy;
+        evaluated_energy_scale_ += std::fabs(elastic) + std::fabs(field_energy);
         phi.value += elastic + field;
         phi.scale += std::fabs(elastic) + std::fabs(field);
         const vec<int32_t>& global = state.matrix.system.dof_to_global();
@@ -409,6 +422,7 @@ void NewtonStep::evaluate() {
     });
     r_ = std::sqrt(sum2);
     phi_ = phi;
+    evaluated_energy_current_ = true;
     if (first_evaluation_) field_push_ = std::sqrt(push2);
     first_evaluation_ = false;
 }
@@ -799,6 +813,7 @@ BodyStepResult NewtonStep::finish(bool converged, bool solver_failed, bool keep_
         end_kinematic_motion(body);
         sane = sane && body_state_is_sane(stepped);
     });
+    evaluated_energy_current_ = false;  // the kinematic nodes may have moved
     if (!sane) return fail(SH_ERR_UNSTABLE, kRolledBackReason);
     if (!energy_checked_ && energy_rose(kEnergyGrowth)) {
         // The last attempt keeps its finite iterate, as one that did not converge.

@@ -8,6 +8,19 @@
 #include <utility>
 
 namespace sh {
+namespace {
+
+// The work of f_ext + m g over m's free DOFs at positions x (J per unit load factor).
+double load_work(const SteppedBody& m, const double g[3], const double* x) {
+    double work = 0.0;
+    for (const int32_t j : m.newton->matrix.system.dof_to_global()) {
+        const size_t k = static_cast<size_t>(j);
+        work += m.body->applied_load(k, g) * x[k];
+    }
+    return work;
+}
+
+}  // namespace
 
 void NewtonProblem::prepare(SteppedBody* const* bodies, int32_t count, const sh_implicit_settings& settings) {
     SH_REQUIRE(!alone_, SH_ERR_INTERNAL, "a body's own Newton problem cannot take other bodies");
@@ -75,14 +88,22 @@ double NewtonProblem::potential_energy(const double g[3], double load_factor, bo
     each([&](const SteppedBody& m, size_t) {
         const Body& b = *m.body;
         const double* x = at_start ? m.workspace.x0.data() : b.x.data();
-        double work = 0.0;
-        for (const int32_t j : m.newton->matrix.system.dof_to_global()) {
-            const size_t k = static_cast<size_t>(j);
-            work += b.applied_load(k, g) * x[k];
-        }
+        const double work = load_work(m, g, x);
         const double elastic = b.elastic_energy(x), field = b.field ? b.field->energy(x) : 0.0;
         total += elastic + field - load_factor * work;
         scale += std::fabs(elastic) + std::fabs(field) + std::fabs(load_factor * work);
+    });
+    return total;
+}
+
+double NewtonProblem::potential_energy_from(const double g[3], double load_factor, double stored, double stored_scale,
+                                            double& scale) const {
+    double total = stored;
+    scale = stored_scale;
+    each([&](const SteppedBody& m, size_t) {
+        const double work = load_work(m, g, m.body->x.data());
+        total -= load_factor * work;
+        scale += std::fabs(load_factor * work);
     });
     return total;
 }

@@ -147,6 +147,12 @@ public:
     /// of f_ext + m g over the free DOFs (J). scale gets the terms' magnitudes.
     double potential_energy(const double g[3], double load_factor, bool at_start, double& scale) const;
 
+    /// potential_energy at the current positions where the elastic and field energies there
+    /// are already known: stored is their sum over the bodies, stored_scale the sum of their
+    /// magnitudes. Only the loads' work is computed.
+    double potential_energy_from(const double g[3], double load_factor, double stored, double stored_scale,
+                                 double& scale) const;
+
 private:
     /// Adds the values of m's own matrix into the joint one.
     void add_member_values(const CoupledMember& m);

@@ -225,10 +225,8 @@ void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
     }
 }
 
-void WarpedMultigrid::sweep(const double* r, double* z, bool forward) const {
-    const int32_t n = blocks_.node_count();
-    for (int32_t step = 0; step < n; ++step) {
-        const int32_t i = forward ? step : n - 1 - step;
+void WarpedMultigrid::backward_sweep(const double* r, double* z) const {
+    for (int32_t i = blocks_.node_count() - 1; i >= 0; --i) {
         double s[3] = {r[3 * static_cast<size_t>(i)], r[3 * static_cast<size_t>(i) + 1], r[3 * static_cast<size_t>(i) + 2]};
         for (int32_t k = blocks_.row_start()[i]; k < blocks_.row_start()[i + 1]; ++k)
             if (k != blocks_.diagonal(i)) subtract_block_product(blocks_, k, z, s);
@@ -291,7 +289,7 @@ void WarpedMultigrid::coarse_correction(double* z) {
 void WarpedMultigrid::apply(const double* r, double* z) {
     first_sweep(r, z);
     coarse_correction(z);
-    sweep(r, z, false);
+    backward_sweep(r, z);
 }
 
 double WarpedMultigrid::iteration_work() const {

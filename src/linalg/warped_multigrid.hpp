@@ -56,8 +56,8 @@ private:
     int32_t split_by_connection(int32_t nodes);
     /// coarse_ := P^T A0 P (A0 in blocks_) and its Cholesky factor.
     void build_coarse();
-    /// One block Gauss-Seidel sweep over the nodes, forward or backward, on z towards r.
-    void sweep(const double* r, double* z, bool forward) const;
+    /// One block Gauss-Seidel sweep over the nodes backward, on z towards r.
+    void backward_sweep(const double* r, double* z) const;
     /// The forward sweep from z = 0, then residual_ = r - A z. From zero only the blocks left
     /// of the diagonal meet a nonzero z, and the sweep zeroes each row's residual up to its
     /// diagonal, so that r - A z = -U z (U the blocks right of it): one pass over the blocks

@@ -113,14 +113,21 @@ void add_pair_modes(const PrincipalStiffnessLanes& k, const SingularFrameLanes& 
 }  // namespace
 
 SingularFrameLanes singular_frames(const Mat3L& F) {
-    const Mat3L r = polar_rotation(F);
-    const Mat3L m = mul_tn(r, F);
+    // F scaled to unit size first: the polar iteration's scaling multiplies |F|^8, which
+    // leaves the doubles' range for |F| beyond about 1e-40 or 1e39; the frame is the same.
+    const Lanes size = lanes_sqrt(ddot(F, F));
+    const Lanes scale = select(size > 0.0, 1.0 / select(size > 0.0, size, splat(1.0)), splat(1.0));
+    Mat3L unit;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) unit.m[i][j] = scale * F.m[i][j];
+    const Mat3L r = polar_rotation(unit);
+    const Mat3L m = mul_tn(r, unit);
     Lanes a[3][3];
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) a[i][j] = 0.5 * (m.m[i][j] + m.m[j][i]);
     SingularFrameLanes frame;
     symmetric_eigen(a, frame.v);
-    for (int i = 0; i < 3; ++i) frame.s[i] = a[i][i];
+    for (int i = 0; i < 3; ++i) frame.s[i] = a[i][i] / scale;
     frame.u = mul(r, frame.v);
     return frame;
 }

@@ -16,7 +16,8 @@ struct LinearMaterial {
     /// Its state keeps no rotation (see the table's kRotates).
     static constexpr bool kRotates = false;
     /// One element's tangent in a sparse solve's operations (the table's kTangentWork): a
-    /// constant dP/dF, less than the corotational law's rotation and rotated dP/dF.
+    /// constant dP/dF, estimated as the corotational tangent (measured) without its rotation.
+    /// A linear body's matrix does not change, so its steps seldom weigh it.
     static constexpr double kTangentWork = 500.0;
 
     /// Nothing of stress() is reused by differential().

@@ -8,7 +8,10 @@
 //   kProjectTangent                         true if dP/dF can be indefinite, so that the
 //                                           tangent stiffness projects it to positive
 //                                           semi-definite per element (in F's singular
-//                                           frame: such a law must be isotropic)
+//                                           frame: such a law must be isotropic, and
+//                                           provide principal_stiffness(s, lambda, mu),
+//                                           its dP/dF's eigensystem in the singular values
+//                                           s: see PrincipalStiffnessLanes)
 //   kRotates                                true if State holds the element's rotation R
 //                                           (state.R), and the law has
 //                                           stress_at(F, R, lambda, mu, state) and

@@ -48,7 +48,7 @@ void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* nea
 // lane, projected to positive semi-definite: from the law's analytic eigensystem in F's
 // singular frame.
 template <class Material>
-void projected_stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, StressDerivativeLanes& C) {
+void law_projected_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, StressDerivativeLanes& C) {
     const SingularFrameLanes frame = singular_frames(F);
     projected_stress_derivatives(Material::principal_stiffness(frame.s, lambda, mu), frame, C);
 }
@@ -121,7 +121,7 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
         visit_material(model, [&](auto law) {
             using Law = decltype(law);
             if constexpr (Law::kProjectTangent)
-                projected_stress_derivatives<Law>(F, lambda, mu, C);
+                law_projected_derivatives<Law>(F, lambda, mu, C);
             else
                 stress_derivatives<Law>(F, lambda, mu, warm ? &near : nullptr, C);
         });

@@ -168,6 +168,51 @@ void degenerate_stretches(void**) {
     check<sh::NeoHookeanMaterial>(fs);
 }
 
+/// Singular deformations: F = 0 and F of rank one and two (flattened and collapsed elements).
+void singular_deformations(void**) {
+    std::mt19937_64 rng(7);
+    Deformations fs;
+    for (int n = 0; n < 40; ++n) {
+        const Eigen::Matrix3d r1 = rotation(rng), r2 = rotation(rng);
+        fs.push_back(r1 * Eigen::Vector3d(0.8, 0.6, 0.0).asDiagonal() * r2);
+        fs.push_back(r1 * Eigen::Vector3d(1.1, 0.0, 0.0).asDiagonal() * r2);
+    }
+    fs.push_back(Eigen::Matrix3d::Zero());
+    check<sh::StvkMaterial>(fs);
+    check<sh::NeoHookeanMaterial>(fs);
+}
+
+/// F scaled far beyond any physical strain (1e-60 to 1e60): the frames stay orthonormal and
+/// exact, and the projected derivative finite and positive semi-definite. (The numerically
+/// differentiated reference loses its digits at such scales, so it is not compared.)
+template <class Law>
+void check_scaled(double scale, const Eigen::Matrix3d& f0) {
+    const Eigen::Matrix3d f = scale * f0;
+    sh::Mat3L F;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) F.m[i][j] = sh::splat(f(i, j));
+    const sh::SingularFrameLanes frame = sh::singular_frames(F);
+    check_frame(frame, 0, f);
+    sh::StressDerivativeLanes projected;
+    sh::projected_stress_derivatives(Law::principal_stiffness(frame.s, sh::splat(2.0), sh::splat(1.0)), frame,
+                                     projected);
+    StressDerivative mine;
+    for (int p = 0; p < 9; ++p)
+        for (int q = 0; q < 9; ++q) mine(p, q) = projected.c[p][q][0];
+    assert_true(mine.allFinite());
+    const Eigen::SelfAdjointEigenSolver<StressDerivative> eigen(mine);
+    assert_true(eigen.eigenvalues()(0) >= -1e-10 * mine.cwiseAbs().maxCoeff());
+}
+
+void extreme_scales(void**) {
+    std::mt19937_64 rng(8);
+    const Eigen::Matrix3d f0 = rotation(rng) * Eigen::Vector3d(0.7, 1.2, 0.9).asDiagonal() * rotation(rng);
+    for (const double scale : {1e-60, 1e-45, 1e-20, 1e20, 1e45, 1e60}) {
+        check_scaled<sh::StvkMaterial>(scale, f0);
+        check_scaled<sh::NeoHookeanMaterial>(scale, f0);
+    }
+}
+
 }  // namespace
 
 int main() {
@@ -176,6 +221,8 @@ int main() {
         cmocka_unit_test(mixed_elements),
         cmocka_unit_test(inverted_elements),
         cmocka_unit_test(degenerate_stretches),
+        cmocka_unit_test(singular_deformations),
+        cmocka_unit_test(extreme_scales),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <algorithm>
+#include <initializer_list>
 #include <random>
 #include <vector>
 
@@ -114,15 +115,20 @@ int check(const Deformations& fs) {
     return removed;
 }
 
+/// Appends r1 diag(s) r2 for each of stretches s, with one random pair of rotations r1, r2.
+void add_rotated(Deformations& fs, std::mt19937_64& rng, std::initializer_list<Eigen::Vector3d> stretches) {
+    const Eigen::Matrix3d r1 = rotation(rng), r2 = rotation(rng);
+    for (const Eigen::Vector3d& s : stretches) fs.push_back(r1 * s.asDiagonal() * r2);
+}
+
 /// Random deformations r1 diag(s) r2 with principal stretches in [low, high], det F > 0.
 Deformations random_deformations(double low, double high, unsigned seed) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> stretch(low, high);
     Deformations fs;
     for (int n = 0; n < 300; ++n) {
-        const Eigen::Matrix3d r1 = rotation(rng);
         const Eigen::Vector3d s(stretch(rng), stretch(rng), stretch(rng));
-        fs.push_back(r1 * s.asDiagonal() * rotation(rng));
+        add_rotated(fs, rng, {s});
     }
     return fs;
 }
@@ -144,26 +150,19 @@ void mixed_elements(void**) {
 void inverted_elements(void**) {
     std::mt19937_64 rng(5);
     Deformations fs;
-    for (int n = 0; n < 100; ++n) {
-        const Eigen::Matrix3d r1 = rotation(rng);
-        fs.push_back(r1 * Eigen::Vector3d(0.9, 0.7, -0.2 - 0.001 * n).asDiagonal() * rotation(rng));
-    }
+    for (int n = 0; n < 100; ++n) add_rotated(fs, rng, {Eigen::Vector3d(0.9, 0.7, -0.2 - 0.001 * n)});
     assert_true(check<sh::StvkMaterial>(fs) > 0);
     assert_true(check<sh::NeoHookeanMaterial>(fs) > 0);
 }
 
-/// Repeated singular values (the frame is not unique there) and the rest shape, in the same
-/// batches as distinct ones (each lane converges on its own).
+/// Repeated singular values (the frame is not unique there) and pure rotations (the rest
+/// shape, turned), in the same batches as distinct ones (each lane converges on its own).
 void degenerate_stretches(void**) {
     std::mt19937_64 rng(6);
     Deformations fs;
-    for (int n = 0; n < 100; ++n) {
-        const Eigen::Matrix3d r1 = rotation(rng), r2 = rotation(rng);
-        fs.push_back(r1 * Eigen::Vector3d(0.5, 0.5, 1.2).asDiagonal() * r2);
-        fs.push_back(r1 * Eigen::Vector3d(0.4, 0.4, 0.4).asDiagonal() * r2);
-        fs.push_back(r1 * r1.transpose());
-        fs.push_back(r1 * Eigen::Vector3d(0.3, 0.8, 1.6).asDiagonal() * r2);
-    }
+    for (int n = 0; n < 100; ++n)
+        add_rotated(fs, rng, {Eigen::Vector3d(0.5, 0.5, 1.2), Eigen::Vector3d(0.4, 0.4, 0.4), Eigen::Vector3d(1.0, 1.0, 1.0),
+                              Eigen::Vector3d(0.3, 0.8, 1.6)});
     check<sh::StvkMaterial>(fs);
     check<sh::NeoHookeanMaterial>(fs);
 }
@@ -172,11 +171,7 @@ void degenerate_stretches(void**) {
 void singular_deformations(void**) {
     std::mt19937_64 rng(7);
     Deformations fs;
-    for (int n = 0; n < 40; ++n) {
-        const Eigen::Matrix3d r1 = rotation(rng), r2 = rotation(rng);
-        fs.push_back(r1 * Eigen::Vector3d(0.8, 0.6, 0.0).asDiagonal() * r2);
-        fs.push_back(r1 * Eigen::Vector3d(1.1, 0.0, 0.0).asDiagonal() * r2);
-    }
+    for (int n = 0; n < 40; ++n) add_rotated(fs, rng, {Eigen::Vector3d(0.8, 0.6, 0.0), Eigen::Vector3d(1.1, 0.0, 0.0)});
     fs.push_back(Eigen::Matrix3d::Zero());
     check<sh::StvkMaterial>(fs);
     check<sh::NeoHookeanMaterial>(fs);

@@ -10,12 +10,6 @@ namespace {
 constexpr double kOffDiagonal2 = 1e-30;
 constexpr int kMaxSweeps = 8;
 
-SH_INLINE bool any_lane(LaneMask mask) {
-    for (int l = 0; l < kLanes; ++l)
-        if (mask[l]) return true;
-    return false;
-}
-
 SH_INLINE Lanes positive_part(Lanes x) { return select(x > 0.0, x, Lanes{}); }
 
 // One Jacobi rotation per lane in plane (p, q) of the symmetric a, zeroing a[p][q]

@@ -43,6 +43,13 @@ SH_INLINE Lanes lanes_sqrt(Lanes a) {
 #endif
 }
 
+/// True if any lane of mask is set.
+SH_INLINE bool any_lane(LaneMask mask) {
+    for (int l = 0; l < kLanes; ++l)
+        if (mask[l]) return true;
+    return false;
+}
+
 /// Sum of the lanes.
 SH_INLINE double lane_sum(Lanes a) {
     double s = 0.0;

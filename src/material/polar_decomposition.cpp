@@ -75,8 +75,7 @@ Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& f) {
 
 Mat3L polar_rotation(const Mat3L& F) {
     const LaneMask bad = ill_conditioned(F);
-    bool any_bad = false;
-    for (int l = 0; l < kLanes; ++l) any_bad |= bad[l] != 0;
+    const bool any_bad = any_lane(bad);
 
     // Bad lanes start from I (keeps Newton finite; the SVD below replaces them).
     Mat3L R = F;
@@ -137,8 +136,7 @@ Mat3L polar_rotation_near(const Mat3L& F, const Mat3L& near, double settled2) {
     // Nearly flat or inverted lanes are the cold path's (its SVD branch): the warm start
     // would converge to a rotation of the wrong sign there.
     const LaneMask bad = ill_conditioned(F);
-    for (int l = 0; l < kLanes; ++l)
-        if (bad[l]) return polar_rotation(F);
+    if (any_lane(bad)) return polar_rotation(F);
     Mat3L R = near;
     for (int iteration = 0; iteration < kMaxNearIterations; ++iteration)
         if (all_below(update_rotation(F, R), settled2)) return R;

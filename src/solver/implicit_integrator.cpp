@@ -211,10 +211,15 @@ private:
     BodyStepResult finish(bool converged, bool solver_failed, bool keep_best);
     /// Restores the bodies and reports status and reason.
     BodyStepResult fail(sh_status status, const char* reason);
+    /// Where mechanical_energy is taken: at the step's start; at the current iterate, which
+    /// the last evaluate() left and whose elastic and field energies it found; at the current
+    /// positions, computed afresh (after something else moved the bodies).
+    enum class EnergyAt { kStart, kLastEvaluation, kNow };
     /// Kinetic + potential energy of the bodies (J); scale gets the terms' magnitudes.
-    double mechanical_energy(bool at_start, double& scale) const;
-    /// True if the energy rose by more than fraction of its start scale with no outside work.
-    bool energy_rose(double fraction) const;
+    double mechanical_energy(EnergyAt at, double& scale) const;
+    /// True if the energy (at: kLastEvaluation or kNow) rose by more than fraction of its
+    /// start scale with no outside work.
+    bool energy_rose(double fraction, EnergyAt at) const;
 
     NewtonProblem& problem_;        // the bodies stepped
     NewtonMatrix& matrix_;          // problem_.matrix(): assembled, factorised and solved
@@ -239,9 +244,8 @@ private:
     double largest_change_ = 0.0, largest_speed_ = 0.0;  // of the last update taken
     double energy0_ = 0.0, energy_scale0_ = 0.0;  // mechanical energy at the start, its scale
     // The elastic and field energies at the positions the last evaluate() left (their sum
-    // and the sum of their magnitudes), while nothing else has moved the bodies since.
+    // and the sum of their magnitudes).
     double evaluated_energy_ = 0.0, evaluated_energy_scale_ = 0.0;
-    bool evaluated_energy_current_ = false;
     double field_push_ = 0.0;  // norm of the fields' push at the first iterate (N)
     bool first_evaluation_ = true;  // the next evaluate() is the step's first: it measures field_push_
     bool work_done_ = false;  // moving tools, other bodies or prescribed nodes work on the bodies
@@ -250,7 +254,8 @@ private:
 
 // Kinetic + potential energy (NewtonProblem::potential_energy) of the bodies, at the step's
 // start (x0, v0) or now; scale gets the terms' magnitudes.
-double NewtonStep::mechanical_energy(bool at_start, double& scale) const {
+double NewtonStep::mechanical_energy(EnergyAt at, double& scale) const {
+    const bool at_start = at == EnergyAt::kStart;
     double kinetic = 0.0;
     problem_.each([&](const SteppedBody& stepped, size_t) {
         const Body& body = *stepped.body;
@@ -262,9 +267,9 @@ double NewtonStep::mechanical_energy(bool at_start, double& scale) const {
         }
     });
     const double potential =
-        at_start || !evaluated_energy_current_
-            ? problem_.potential_energy(g_, 1.0, at_start, scale)
-            : problem_.potential_energy_from(g_, 1.0, evaluated_energy_, evaluated_energy_scale_, scale);
+        at == EnergyAt::kLastEvaluation
+            ? problem_.potential_energy_from(g_, 1.0, evaluated_energy_, evaluated_energy_scale_, scale)
+            : problem_.potential_energy(g_, 1.0, at_start, scale);
     scale += kinetic;
     return kinetic + potential;
 }
@@ -272,10 +277,10 @@ double NewtonStep::mechanical_energy(bool at_start, double& scale) const {
 // With no work done on the bodies from outside (moving tools, other bodies, prescribed motion),
 // the minimiser of the step's potential does not raise their mechanical energy: true if the
 // current iterate raised it by more than fraction times its start's scale (or to non-finite).
-bool NewtonStep::energy_rose(double fraction) const {
+bool NewtonStep::energy_rose(double fraction, EnergyAt at) const {
     if (work_done_) return false;
     double scale = 0.0;
-    const double energy = mechanical_energy(false, scale);
+    const double energy = mechanical_energy(at, scale);
     return !std::isfinite(energy) || energy - energy0_ > fraction * energy_scale0_ + 1e-12;
 }
 
@@ -300,7 +305,6 @@ void NewtonStep::begin() {
     problem_.each([&](const SteppedBody& stepped, size_t) { in_contact_ |= stepped.body->field != nullptr; });
     energy_checked_ = false;
     first_evaluation_ = true;
-    evaluated_energy_current_ = false;
     problem_.each([&](SteppedBody& stepped, size_t) {
         Body& body = *stepped.body;
         save_start_state(stepped);
@@ -313,7 +317,7 @@ void NewtonStep::begin() {
         std::fill(base.begin(), base.end(), 0.0);
         body.add_internal_forces(stepped.workspace.x0.data(), nullptr, base.data());
     });
-    if (!work_done_) energy0_ = mechanical_energy(true, energy_scale0_);
+    if (!work_done_) energy0_ = mechanical_energy(EnergyAt::kStart, energy_scale0_);
     reuse_ = s_.factor_reuse > 0.0 && matrix_.solver->is_direct();
     matrix_version_ = problem_.matrix_version();
     factor_current_ = reuse_ && allow_stale_ && matrix_.kept.valid && matrix_.kept.dt == dt_ &&
@@ -369,7 +373,6 @@ bool NewtonStep::build_multigrid() {
 // Moves every body to x = x0 + h v, then fills matrix_.residual with g(v), r_, r_max_ and phi_.
 // Every body moves first: the forces between bodies solved together see both ends.
 void NewtonStep::evaluate() {
-    evaluated_energy_current_ = false;  // the bodies move now; true again once the pass completes
     const double h = dt_;
     problem_.each([&](SteppedBody& stepped, size_t) {
         Body& body = *stepped.body;
@@ -422,7 +425,6 @@ void NewtonStep::evaluate() {
     });
     r_ = std::sqrt(sum2);
     phi_ = phi;
-    evaluated_energy_current_ = true;
     if (first_evaluation_) field_push_ = std::sqrt(push2);
     first_evaluation_ = false;
 }
@@ -778,7 +780,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
             // a kept factorisation go on until they are as good as factor_reuse asks.
             const double floor = matrix_.kept.roundoff_floor;
             if (!fresh && !(r_ <= std::max(target, floor) && r_max_ <= std::max(target_max, floor))) continue;
-            if (!energy_rose(kLinearisedEnergyGain)) return energy_checked_ = true;
+            if (!energy_rose(kLinearisedEnergyGain, EnergyAt::kLastEvaluation)) return energy_checked_ = true;
             // One update gained energy from nothing (large rotations, elements near inversion):
             // iterate towards the step's minimiser instead, as far as the iterations allow.
             linearised = false;
@@ -813,9 +815,8 @@ BodyStepResult NewtonStep::finish(bool converged, bool solver_failed, bool keep_
         end_kinematic_motion(body);
         sane = sane && body_state_is_sane(stepped);
     });
-    evaluated_energy_current_ = false;  // the kinematic nodes may have moved
     if (!sane) return fail(SH_ERR_UNSTABLE, kRolledBackReason);
-    if (!energy_checked_ && energy_rose(kEnergyGrowth)) {
+    if (!energy_checked_ && energy_rose(kEnergyGrowth, EnergyAt::kNow)) {  // the kinematic nodes may have moved
         // The last attempt keeps its finite iterate, as one that did not converge.
         if (!keep_best)
             return fail(SH_ERR_UNSTABLE, "the mechanical energy grew with no work done on the body (runaway); rolled back");

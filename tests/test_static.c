@@ -117,7 +117,9 @@ static void test_stvk_bar_newton(void** state) {
     sh_static_report report;
     assert_ok(sh_world_solve_static(b.world, &def, &report));
     print_message("StVK bar: strain %.6f, %d iterations, residual %.2e\n", strain, report.iterations, report.residual);
-    assert_true(report.iterations > 2 && report.residual <= 1e-10);
+    /* Stretched, the tangent is the exact Hessian (nothing to project): Newton converges
+     * quadratically, in a few iterations (4 here). */
+    assert_true(report.iterations > 2 && report.iterations <= 6 && report.residual <= 1e-10);
     for (int k = 1; k < report.history_count && k < 4; ++k)
         assert_true(report.residual_history[k] < report.residual_history[k - 1]);
     check_uniform_strain(&b, strain, 1e-8);

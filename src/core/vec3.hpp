@@ -1,6 +1,7 @@
 // Small 3-vector helpers over plain double[3] arrays.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -35,6 +36,13 @@ inline double block_norm(const double* m, size_t row, size_t column) {
     for (size_t r = 0; r < 3; ++r)
         for (size_t s = 0; s < 3; ++s) squares += m[r * row + s * column] * m[r * row + s * column];
     return std::sqrt(squares);
+}
+
+/// The largest |a_i| of n values (0 for none).
+inline double largest_magnitude(const double* a, size_t n) {
+    double largest = 0.0;
+    for (size_t i = 0; i < n; ++i) largest = std::max(largest, std::fabs(a[i]));
+    return largest;
 }
 
 /// True if every component is finite.

@@ -63,13 +63,20 @@ public:
     /// Elastic energy at positions x (J).
     virtual double elastic_energy(const double* x) const = 0;
 
+    /// An elastic energy and the magnitude its round-off is relative to.
+    struct ElasticEnergy {
+        double value = 0.0;  ///< J
+        /// J: eps times it is the order of value's round-off. |value|, plus the largest
+        /// coordinate times the sum of the elements' (springs') force norms: rounding the
+        /// positions to eps |x| moves each element's energy by its forces times that, which
+        /// near rest is far above eps |value|.
+        double scale = 0.0;
+    };
+
     /// Adds the elastic forces at x into f (add_internal_forces without damping) and returns
-    /// the elastic energy at x, as the two calls would; a body that can share their work in one
-    /// pass over its elements overrides it.
-    virtual double add_elastic_forces_and_energy(const double* x, double* f) const {
-        add_internal_forces(x, nullptr, f);
-        return elastic_energy(x);
-    }
+    /// the elastic energy at x, as the two calls would, with its round-off scale; from one
+    /// pass over the elements.
+    virtual ElasticEnergy add_elastic_forces_and_energy(const double* x, double* f) const = 0;
 
     /// Largest stable step of an undamped leapfrog step, 2 / omega_max, at state x (s).
     virtual double stable_step(const double* x) const = 0;

@@ -1,6 +1,7 @@
 #include "model/fem_body.hpp"
 
 #include "core/error.hpp"
+#include "core/vec3.hpp"
 #include "material/material_params.hpp"
 #include "material/material_table.hpp"
 #include "model/fem_kernel.hpp"
@@ -282,16 +283,17 @@ void FemBody::add_internal_forces(const double* xs, const double* vs, double* f)
     inverted_elements_ = std::max(inverted_elements_, inverted);
 }
 
-double FemBody::add_elastic_forces_and_energy(const double* xs, double* f) const {
-    double energy = 0.0;
+Body::ElasticEnergy FemBody::add_elastic_forces_and_energy(const double* xs, double* f) const {
+    EnergySum sum;
     int32_t inverted = 0;
     for_each_material([&](auto material, int model) {
         using Material = decltype(material);
         const vec<TetBlock>& blocks = blocks_[model];
-        inverted += add_fem_forces_and_energy<Material>(blocks.data(), blocks.size(), xs, f, rotations_.pass(model), &energy);
+        inverted += add_fem_forces_and_energy<Material>(blocks.data(), blocks.size(), xs, f, rotations_.pass(model), &sum);
     });
     inverted_elements_ = std::max(inverted_elements_, inverted);
-    return energy;
+    // Node 0's force is minus the others' sum: its rounding counts about as much again.
+    return {sum.value, std::fabs(sum.value) + 2.0 * largest_magnitude(xs, x.size()) * sum.force_norm};
 }
 
 double FemBody::elastic_energy(const double* xs) const {

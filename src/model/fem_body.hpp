@@ -58,7 +58,7 @@ public:
 
     void add_internal_forces(const double* x, const double* v, double* f) const override;
     double elastic_energy(const double* x) const override;
-    double add_elastic_forces_and_energy(const double* x, double* f) const override;
+    ElasticEnergy add_elastic_forces_and_energy(const double* x, double* f) const override;
     double stable_step(const double* x) const override;
     /// Per block lane, its law's kTangentWork (the material table).
     double tangent_work() const override;

@@ -169,13 +169,22 @@ SH_INLINE Lanes state_energy(const Mat3L& F, const TetBlock& b, const typename M
     else return Material::energy(F, b.lambda_w, b.mu_w);
 }
 
+/// Elastic energy of some elements and the size of the forces its round-off scales with.
+struct EnergySum {
+    double value = 0.0;  ///< J
+    /// Sum over the elements of the Frobenius norm of their forces on nodes 1-3 (N); a node
+    /// moved by dx changes an element's energy by its force there times dx, so rounding the
+    /// positions to eps |x| leaves about eps |x| times this in value.
+    double force_norm = 0.0;
+};
+
 /// The force loop; Damped adds -beta K(x) v through the material's differential; Energy adds
-/// the elastic energy into *energy from the same F and stress state.
+/// the elastic energy and force norms into *energy from the same F and stress state.
 template <class Material, bool Damped, bool Energy>
 int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const double* x, const double* v,
-                            double beta, double* f, const KeptRotations& rotations, double* energy) {
+                            double beta, double* f, const KeptRotations& rotations, EnergySum* energy) {
     int32_t inverted = 0;  // elements with det F <= 0 (unused lanes weigh 0)
-    Lanes energy_sum = Lanes{};
+    Lanes energy_sum = Lanes{}, force_norm = Lanes{};
     for (size_t k = 0; k < block_count; ++k) {
         const TetBlock& b = blocks[k];
         const Mat3L F = mul(gather_edges(b, x), b.Bm);
@@ -190,12 +199,16 @@ int32_t add_fem_forces_loop(const TetBlock* blocks, size_t block_count, const do
                 for (int j = 0; j < 3; ++j) P.m[i][j] += beta * dP.m[i][j];
         }
         const Mat3L H = mul_nt(P, b.Bm);  // column a-1: force on node a
+        if constexpr (Energy) force_norm += lanes_sqrt(ddot(H, H));
         for (int a = 1; a < 4; ++a) scatter_add_xyz<false>(f, b.node[a], H.m[0][a - 1], H.m[1][a - 1], H.m[2][a - 1]);
         // f0 = -(f1 + f2 + f3)
         scatter_add_xyz<true>(f, b.node[0], H.m[0][0] + H.m[0][1] + H.m[0][2], H.m[1][0] + H.m[1][1] + H.m[1][2],
                               H.m[2][0] + H.m[2][1] + H.m[2][2]);
     }
-    if constexpr (Energy) *energy += lane_sum(energy_sum);
+    if constexpr (Energy) {
+        energy->value += lane_sum(energy_sum);
+        energy->force_norm += lane_sum(force_norm);
+    }
     return inverted;
 }
 
@@ -209,11 +222,12 @@ int32_t add_fem_forces(const TetBlock* blocks, size_t block_count, const double*
     return add_fem_forces_loop<Material, false, false>(blocks, block_count, x, nullptr, 0.0, f, rotations, nullptr);
 }
 
-/// add_fem_forces without damping, adding the blocks' elastic energy (J) into *energy from the
-/// same pass: one gather, F and stress per element where fem_energy would repeat them.
+/// add_fem_forces without damping, adding the blocks' elastic energy and force norms into
+/// *energy from the same pass: one gather, F and stress per element where fem_energy would
+/// repeat them.
 template <class Material>
 int32_t add_fem_forces_and_energy(const TetBlock* blocks, size_t block_count, const double* x, double* f,
-                                  const KeptRotations& rotations, double* energy) {
+                                  const KeptRotations& rotations, EnergySum* energy) {
     return add_fem_forces_loop<Material, false, true>(blocks, block_count, x, nullptr, 0.0, f, rotations, energy);
 }
 

@@ -1,6 +1,7 @@
 #include "model/spring_body.hpp"
 
 #include "core/error.hpp"
+#include "core/vec3.hpp"
 #include "linalg/sparse_system.hpp"
 
 #include <algorithm>
@@ -102,8 +103,10 @@ int32_t SpringBody::remove_springs(const vec<uint8_t>& broken) {
     return removed;
 }
 
-void SpringBody::add_internal_forces(const double* xs, const double* vs, double* f) const {
-    const double c = vs ? law_.damping() : 0.0;
+// Visits every spring at positions xs: visit(s, a, b, d, l) with its end nodes a and b,
+// d = x_b - x_a and l = |d|.
+template <class Visit>
+void SpringBody::each_spring(const double* xs, Visit&& visit) const {
     for (size_t s = 0; s < rest_length_.size(); ++s) {
         const size_t a = static_cast<size_t>(springs_[2 * s]), b = static_cast<size_t>(springs_[2 * s + 1]);
         double d[3], l2 = 0.0;
@@ -111,31 +114,50 @@ void SpringBody::add_internal_forces(const double* xs, const double* vs, double*
             d[k] = xs[3 * b + k] - xs[3 * a + k];
             l2 += d[k] * d[k];
         }
-        const double l = std::sqrt(l2);
-        if (!(l > 0.0)) continue;  // coincident ends have no direction: no force
+        visit(s, a, b, d, std::sqrt(l2));
+    }
+}
+
+// Adds tension t along d / l to node a and its opposite to node b; returns |t|.
+static double add_tension(double t, const double* d, double l, size_t a, size_t b, double* f) {
+    for (int k = 0; k < 3; ++k) {
+        const double fk = t * d[k] / l;
+        f[3 * a + k] += fk;
+        f[3 * b + k] -= fk;
+    }
+    return std::fabs(t);
+}
+
+void SpringBody::add_internal_forces(const double* xs, const double* vs, double* f) const {
+    const double c = vs ? law_.damping() : 0.0;
+    each_spring(xs, [&](size_t s, size_t a, size_t b, const double* d, double l) {
+        if (!(l > 0.0)) return;  // coincident ends have no direction: no force
         double t = law_.tension(l, rest_length_[s]);
         if (c > 0.0) {
             double rate = 0.0;
             for (int k = 0; k < 3; ++k) rate += (vs[3 * b + k] - vs[3 * a + k]) * d[k];
             t += c * rate / l;
         }
-        for (int k = 0; k < 3; ++k) {
-            const double fk = t * d[k] / l;
-            f[3 * a + k] += fk;
-            f[3 * b + k] -= fk;
-        }
-    }
+        add_tension(t, d, l, a, b, f);
+    });
 }
 
 double SpringBody::elastic_energy(const double* xs) const {
     double energy = 0.0;
-    for (size_t s = 0; s < rest_length_.size(); ++s) {
-        const size_t a = static_cast<size_t>(springs_[2 * s]), b = static_cast<size_t>(springs_[2 * s + 1]);
-        double l2 = 0.0;
-        for (int k = 0; k < 3; ++k) l2 += (xs[3 * b + k] - xs[3 * a + k]) * (xs[3 * b + k] - xs[3 * a + k]);
-        energy += law_.energy(std::sqrt(l2), rest_length_[s]);
-    }
+    each_spring(xs, [&](size_t s, size_t, size_t, const double*, double l) { energy += law_.energy(l, rest_length_[s]); });
     return energy;
+}
+
+Body::ElasticEnergy SpringBody::add_elastic_forces_and_energy(const double* xs, double* f) const {
+    ElasticEnergy e;
+    double tensions = 0.0;
+    each_spring(xs, [&](size_t s, size_t a, size_t b, const double* d, double l) {
+        e.value += law_.energy(l, rest_length_[s]);
+        if (l > 0.0) tensions += add_tension(law_.tension(l, rest_length_[s]), d, l, a, b, f);
+    });
+    // A spring's two end forces: each node's rounding moves its energy by |t| times that.
+    e.scale = std::fabs(e.value) + 2.0 * largest_magnitude(xs, x.size()) * tensions;
+    return e;
 }
 
 // One spring's tangent in a sparse solve's operations (Body::tangent_work): a 3x3 block from

@@ -20,6 +20,7 @@ public:
     void add_internal_forces(const double* x, const double* v, double* f) const override;
     bool has_internal_damping() const override { return law_.damping() > 0.0; }
     double elastic_energy(const double* x) const override;
+    ElasticEnergy add_elastic_forces_and_energy(const double* x, double* f) const override;
     double stable_step(const double* x) const override;
     /// kSpringTangentWork per spring.
     double tangent_work() const override;
@@ -56,6 +57,8 @@ public:
 
 private:
     int32_t root_of(int32_t node) const;
+    template <class Visit>
+    void each_spring(const double* xs, Visit&& visit) const;
 
     vec<int32_t> springs_;      ///< 2 per spring
     vec<double> rest_length_;   ///< l0 per spring (m)

@@ -391,7 +391,7 @@ void NewtonStep::evaluate() {
         if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
         if (first_evaluation_)
             for (const int32_t j : state.matrix.system.dof_to_global()) push2 += f[static_cast<size_t>(j)] * f[static_cast<size_t>(j)];
-        const double elastic = body.add_elastic_forces_and_energy(body.x.data(), f);
+        const Body::ElasticEnergy elastic = body.add_elastic_forces_and_energy(body.x.data(), f);
         double* damping = nullptr;  // -D0 v, the lagged internal damping force
         if (body.has_internal_damping()) {
             damping = stepped.workspace.stage_a[2].data();
@@ -402,10 +402,10 @@ void NewtonStep::evaluate() {
         }
         const double field_energy = body.field ? body.field->energy(body.x.data()) : 0.0;
         const double field = body.field ? field_energy + h * body.field->dissipation(body.v.data()) : 0.0;
-        evaluated_energy_ += elastic + field_energy;
-        evaluated_energy_scale_ += std::fabs(elastic) + std::fabs(field_energy);
-        phi.value += elastic + field;
-        phi.scale += std::fabs(elastic) + std::fabs(field);
+        evaluated_energy_ += elastic.value + field_energy;
+        evaluated_energy_scale_ += elastic.scale + std::fabs(field_energy);
+        phi.value += elastic.value + field;
+        phi.scale += elastic.scale + std::fabs(field);
         const vec<int32_t>& global = state.matrix.system.dof_to_global();
         for (size_t d = 0; d < global.size(); ++d) {
             const size_t j = static_cast<size_t>(global[d]), node = j / 3;

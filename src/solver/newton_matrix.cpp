@@ -1,5 +1,7 @@
 #include "solver/newton_matrix.hpp"
 
+#include "core/vec3.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -45,8 +47,7 @@ LinearSolverPtr make_analysed_solver(const SparseSystem& system, const sh_implic
 }
 
 double force_roundoff(const SparseSystem& system, const vec<double>& x, double scale) {
-    double largest = 0.0;
-    for (const double c : x) largest = std::max(largest, std::fabs(c));
+    const double largest = largest_magnitude(x.data(), x.size());
     double sum = 0.0;
     for (int32_t d = 0; d < system.dof_count(); ++d) {
         const double k = scale * system.values()[static_cast<size_t>(system.diagonal_slot(d))];

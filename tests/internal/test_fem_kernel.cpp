@@ -1,7 +1,8 @@
 // The element kernel's fused pass (model/fem_kernel.hpp: add_fem_forces_and_energy), which the
 // implicit step's evaluations use, against the separate force and energy passes
 // (add_fem_forces, fem_energy) for every law of the material table, on randomly shaped and
-// deformed tets; and its forces against central differences of its own energy (f = -dE/dx).
+// deformed tets; its force norms against each tet's forces alone; and its forces against
+// central differences of its own energy (f = -dE/dx).
 #include "material/material_table.hpp"
 #include "model/fem_kernel.hpp"
 
@@ -72,19 +73,51 @@ Scene make_scene(unsigned seed) {
     return s;
 }
 
+/// Law's forces, energy and force norms at x by the fused pass.
+template <class Law>
+sh::EnergySum fused_sum(const Scene& s, const double* x, std::vector<double>& f) {
+    f.assign(3 * kNodes, 0.0);
+    sh::EnergySum energy;
+    sh::add_fem_forces_and_energy<Law>(s.blocks.data(), s.blocks.size(), x, f.data(), sh::KeptRotations{}, &energy);
+    return energy;
+}
+
 /// Law's forces and energy at x by the fused pass.
 template <class Law>
 double fused(const Scene& s, const double* x, std::vector<double>& f) {
-    f.assign(3 * kNodes, 0.0);
-    double energy = 0.0;
-    sh::add_fem_forces_and_energy<Law>(s.blocks.data(), s.blocks.size(), x, f.data(), sh::KeptRotations{}, &energy);
-    return energy;
+    return fused_sum<Law>(s, x, f).value;
+}
+
+/// The sum over the tets of the Frobenius norm of their forces on nodes 1-3, each tet's forces
+/// from the force pass over a copy of the blocks where only that tet has moduli.
+template <class Law>
+double separate_force_norms(const Scene& s) {
+    double sum = 0.0;
+    for (size_t k = 0; k < s.blocks.size(); ++k)
+        for (int l = 0; l < sh::kLanes; ++l) {
+            if (s.blocks[k].mu_w[l] == 0.0) continue;  // an unused lane
+            std::vector<sh::TetBlock> alone = s.blocks;
+            for (size_t j = 0; j < alone.size(); ++j)
+                for (int m = 0; m < sh::kLanes; ++m)
+                    if (j != k || m != l) alone[j].lambda_w[m] = alone[j].mu_w[m] = 0.0;
+            std::vector<double> f(3 * kNodes, 0.0);
+            sh::add_fem_forces<Law>(alone.data(), alone.size(), s.x.data(), nullptr, 0.0, f.data());
+            double squares = 0.0;
+            for (int a = 1; a < 4; ++a)
+                for (int c = 0; c < 3; ++c) squares += f[3 * static_cast<size_t>(s.blocks[k].node[a][l]) + c] * f[3 * static_cast<size_t>(s.blocks[k].node[a][l]) + c];
+            sum += std::sqrt(squares);
+        }
+    return sum;
 }
 
 template <class Law>
 void check_law(const Scene& s) {
     std::vector<double> f_fused, f_separate(3 * kNodes, 0.0);
-    const double e_fused = fused<Law>(s, s.x.data(), f_fused);
+    const sh::EnergySum sum = fused_sum<Law>(s, s.x.data(), f_fused);
+    const double e_fused = sum.value;
+    // Its force norms are the tets' own, one at a time (the nodes of a tet are distinct).
+    const double norms = separate_force_norms<Law>(s);
+    assert_true(norms > 0.0 && std::abs(sum.force_norm - norms) <= 1e-12 * norms);
     sh::add_fem_forces<Law>(s.blocks.data(), s.blocks.size(), s.x.data(), nullptr, 0.0, f_separate.data());
     const double e_separate = sh::fem_energy<Law>(s.blocks.data(), s.blocks.size(), s.x.data());
     // The same forces and energy as the separate passes.

@@ -106,7 +106,7 @@ void add_pair_modes(const PrincipalStiffnessLanes& k, const SingularFrameLanes& 
 
 }  // namespace
 
-SingularFrameLanes singular_frames(const Mat3L& F) {
+SingularFrameLanes singular_frames(const Mat3L& F, const Mat3L* near) {
     // F scaled to unit size first: the polar iteration's scaling multiplies |F|^8, which
     // leaves the doubles' range for |F| beyond about 1e-40 or 1e39; the frame is the same.
     const Lanes size = lanes_sqrt(ddot(F, F));
@@ -114,7 +114,7 @@ SingularFrameLanes singular_frames(const Mat3L& F) {
     Mat3L unit;
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) unit.m[i][j] = scale * F.m[i][j];
-    const Mat3L r = polar_rotation(unit);
+    const Mat3L r = near ? polar_rotation_near(unit, *near) : polar_rotation(unit);  // the same rotation as F's
     const Mat3L m = mul_tn(r, unit);
     Lanes a[3][3];
     for (int i = 0; i < 3; ++i)

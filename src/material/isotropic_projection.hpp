@@ -26,8 +26,9 @@ struct SingularFrameLanes {
 /// F's singular frames, from its polar rotations r (F = r S, S symmetric, det r = +1): v and s
 /// are S's eigenvectors and eigenvalues (cyclic Jacobi, to round-off) and u = r v. S is
 /// symmetric and about as large as F, so its eigenvalues are as accurate as F's entries, where
-/// those of F^T F (which square F's) would lose the small singular values.
-SingularFrameLanes singular_frames(const Mat3L& F);
+/// those of F^T F (which square F's) would lose the small singular values. near, if not null,
+/// holds rotations close to r (an earlier pass's) to start the polar iteration from.
+SingularFrameLanes singular_frames(const Mat3L& F, const Mat3L* near = nullptr);
 
 /// An isotropic law's dP/dF in its singular frame per lane, from its energy psi(s) as a
 /// function of the signed singular values s (psi_i = d psi / d s_i):

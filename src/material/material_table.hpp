@@ -27,7 +27,11 @@
 //   State                                   what stress() computes that differential() reuses
 //   jacobian(F, state)                      det F, for the inverted-element count
 //   stress(F, lambda, mu, state)            the first Piola-Kirchhoff stress P(F)
-//   differential(F, state, dF, lambda, mu)  its differential dP(F)[dF]
+//   differential(F, state, dF, lambda, mu)  its differential dP(F)[dF], which the
+//                                           stiffness-proportional damping force takes and
+//                                           a law that does not project its tangent forms
+//                                           it from (the corotational law's holds R fixed,
+//                                           for a dissipating damping)
 //   energy(F, lambda, mu)                   the energy density psi(F)
 // lambda and mu are the Lame parameters of the material's small-strain limit: every law
 // reduces to linear elasticity for small strains. Every law is homogeneous of degree one in

@@ -22,18 +22,13 @@ struct StiffnessLanes {
     Lanes block[4][4][3][3];
 };
 
-// dP/dF per lane of a batch of elements of one material model, symmetrised; a law that keeps
-// a rotation finds it from near where the caller has one (the body's last pass's: see
-// BlockRotations).
+// dP/dF per lane of a batch of elements of one material model (a law that does not project:
+// see the material table), from its differential on the unit basis of F, symmetrised.
 template <class Material>
-void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* near, StressDerivativeLanes& C) {
+void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, StressDerivativeLanes& C) {
+    static_assert(!Material::kRotates, "a law that keeps a rotation projects its tangent");
     typename Material::State state;
-    if constexpr (Material::kRotates) {
-        Mat3L R;  // the batch's own: the body's are the force passes' (BlockRotations)
-        Material::stress_at(F, kept_rotation(F, 0, KeptRotations{near, &R}), lambda, mu, state);
-    } else {
-        Material::stress(F, lambda, mu, state);
-    }
+    Material::stress(F, lambda, mu, state);
     for (int q = 0; q < 9; ++q) {
         Mat3L dF{};
         dF.m[q / 3][q % 3] = splat(1.0);
@@ -46,10 +41,11 @@ void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* nea
 
 // dP/dF of a law that projects (all isotropic: see the material table's kProjectTangent) per
 // lane, projected to positive semi-definite: from the law's analytic eigensystem in F's
-// singular frame.
+// singular frame, whose polar rotation starts from near where the body keeps its elements'
+// rotations (the last force pass's: see BlockRotations).
 template <class Material>
-void law_projected_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, StressDerivativeLanes& C) {
-    const SingularFrameLanes frame = singular_frames(F);
+void law_projected_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* near, StressDerivativeLanes& C) {
+    const SingularFrameLanes frame = singular_frames(F, near);
     projected_stress_derivatives(Material::principal_stiffness(frame.s, lambda, mu), frame, C);
 }
 
@@ -121,9 +117,9 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
         visit_material(model, [&](auto law) {
             using Law = decltype(law);
             if constexpr (Law::kProjectTangent)
-                law_projected_derivatives<Law>(F, lambda, mu, C);
+                law_projected_derivatives<Law>(F, lambda, mu, warm ? &near : nullptr, C);
             else
-                stress_derivatives<Law>(F, lambda, mu, warm ? &near : nullptr, C);
+                stress_derivatives<Law>(F, lambda, mu, C);
         });
         StiffnessLanes K;
         element_stiffness(C, g, volume, K);

@@ -1,9 +1,12 @@
 // The laws' analytic eigensystems of dP/dF, projected to positive semi-definite in F's singular
 // frame (material/isotropic_projection.hpp), against an independent reference: dP/dF formed
-// numerically from each law's differential dP(F)[dF] on the nine unit directions, fully
-// eigendecomposed (Eigen's SelfAdjointEigenSolver) with its negative eigenvalues set to zero.
-// For the laws that project (StVK, neo-Hookean) at stretched, compressed, inverted and
-// degenerate deformations.
+// from each law's differential dP(F)[dF] on the nine unit directions (for the corotational
+// law, whose differential holds R fixed, from the exact differential derived by hand below and
+// itself checked against central differences of P), fully eigendecomposed (Eigen's
+// SelfAdjointEigenSolver) with its negative eigenvalues set to zero. For the laws that project
+// (StVK, neo-Hookean, corotational) at stretched, compressed, inverted and degenerate
+// deformations.
+#include "material/corotational_material.hpp"
 #include "material/isotropic_projection.hpp"
 #include "material/neohookean_material.hpp"
 #include "material/stvk_material.hpp"
@@ -52,6 +55,59 @@ StressDerivative derivative(const Eigen::Matrix3d& f, double lambda, double mu) 
     return 0.5 * (c + c.transpose());
 }
 
+/// F's polar rotation from Eigen's SVD (det +1: the smallest singular value takes the sign).
+Eigen::Matrix3d polar(const Eigen::Matrix3d& f) {
+    Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d u = svd.matrixU();
+    if ((u * svd.matrixV().transpose()).determinant() < 0.0) u.col(2) = -u.col(2);
+    return u * svd.matrixV().transpose();
+}
+
+/// The corotational P = R (2 mu (S - I) + lambda tr(S - I) I) = 2 mu (F - R) + lambda (tr S - 3) R.
+Eigen::Matrix3d corotational_stress(const Eigen::Matrix3d& f, double lambda, double mu) {
+    const Eigen::Matrix3d r = polar(f);
+    return 2.0 * mu * (f - r) + lambda * ((r.transpose() * f).trace() - 3.0) * r;
+}
+
+/// Its exact dP/dF: dP = 2 mu dF + lambda tr(R^T dF) R + (lambda (tr S - 3) - 2 mu) dR (d tr S =
+/// tr(R^T dF), as R^T dR is skew and S symmetric), with dR = R [w]x where, from R^T F = S
+/// symmetric, (tr S I - S) w = axial(R^T dF - dF^T R). Symmetrised, as derivative() is.
+StressDerivative corotational_derivative(const Eigen::Matrix3d& f, double lambda, double mu) {
+    const Eigen::Matrix3d r = polar(f), s = r.transpose() * f;
+    const Eigen::Matrix3d a = s.trace() * Eigen::Matrix3d::Identity() - s;
+    StressDerivative c;
+    for (int q = 0; q < 9; ++q) {
+        Eigen::Matrix3d df = Eigen::Matrix3d::Zero();
+        df(q / 3, q % 3) = 1.0;
+        const Eigen::Matrix3d m = r.transpose() * df, skew = m - m.transpose();
+        const Eigen::Vector3d w = a.partialPivLu().solve(Eigen::Vector3d(skew(2, 1), skew(0, 2), skew(1, 0)));
+        Eigen::Matrix3d wx;
+        wx << 0.0, -w(2), w(1), w(2), 0.0, -w(0), -w(1), w(0), 0.0;
+        const Eigen::Matrix3d dp = 2.0 * mu * df + lambda * m.trace() * r + (lambda * (s.trace() - 3.0) - 2.0 * mu) * r * wx;
+        for (int p = 0; p < 9; ++p) c(p, q) = dp(p / 3, p % 3);
+    }
+    return 0.5 * (c + c.transpose());
+}
+
+/// The reference dP/dF of Law at f: its differential's, or the corotational law's exact one.
+template <class Law>
+StressDerivative reference(const Eigen::Matrix3d& f, double lambda, double mu) {
+    if constexpr (Law::kRotates) return corotational_derivative(f, lambda, mu);
+    else return derivative<Law>(f, lambda, mu);
+}
+
+/// True if the reference is defined at f: for the corotational law, every pair of F's signed
+/// singular values sums to more than 0 (R's change is singular where two cancel).
+template <class Law>
+bool reference_defined(const sh::SingularFrameLanes& frame, int l) {
+    if (!Law::kRotates) return true;
+    const double s[3] = {frame.s[0][l], frame.s[1][l], frame.s[2][l]};
+    const double size = std::max({std::abs(s[0]), std::abs(s[1]), std::abs(s[2])});
+    for (int a = 0; a < 3; ++a)
+        if (!(s[(a + 1) % 3] + s[(a + 2) % 3] > 1e-6 * size)) return false;
+    return true;
+}
+
 /// The reference: c's eigendecomposition with the negative eigenvalues set to zero.
 StressDerivative clamped(const StressDerivative& c) {
     const Eigen::SelfAdjointEigenSolver<StressDerivative> eigen(c);
@@ -92,10 +148,16 @@ int check_lanes(const Eigen::Matrix3d* fs, int count) {
     int removed = 0;
     for (int l = 0; l < count; ++l) {
         check_frame(frame, l, fs[l]);
-        const StressDerivative c = derivative<Law>(fs[l], 2.0, 1.0);
         StressDerivative mine;
         for (int p = 0; p < 9; ++p)
             for (int q = 0; q < 9; ++q) mine(p, q) = projected.c[p][q][l];
+        if (!reference_defined<Law>(frame, l)) {  // finite and positive semi-definite only
+            assert_true(mine.allFinite());
+            const Eigen::SelfAdjointEigenSolver<StressDerivative> eigen(mine);
+            assert_true(eigen.eigenvalues()(0) >= -1e-10 * std::max(mine.cwiseAbs().maxCoeff(), 1.0));
+            continue;
+        }
+        const StressDerivative c = reference<Law>(fs[l], 2.0, 1.0);
         // The reference's projection, which is positive semi-definite.
         const double scale = c.cwiseAbs().maxCoeff();
         assert_true((mine - clamped(c)).cwiseAbs().maxCoeff() <= 1e-10 * scale);
@@ -138,12 +200,14 @@ Deformations random_deformations(double low, double high, unsigned seed) {
 void compressed_elements(void**) {
     assert_true(check<sh::StvkMaterial>(random_deformations(0.2, 0.9, 1)) > 0);
     assert_true(check<sh::NeoHookeanMaterial>(random_deformations(0.1, 0.6, 2)) > 0);
+    assert_true(check<sh::CorotationalMaterial>(random_deformations(0.2, 0.9, 9)) > 0);
 }
 
 /// Stretched and mixed deformations, definite or not.
 void mixed_elements(void**) {
     check<sh::StvkMaterial>(random_deformations(0.3, 2.0, 3));
     check<sh::NeoHookeanMaterial>(random_deformations(0.3, 2.0, 4));
+    check<sh::CorotationalMaterial>(random_deformations(0.3, 2.0, 10));
 }
 
 /// Inverted elements (one negative principal stretch).
@@ -153,6 +217,7 @@ void inverted_elements(void**) {
     for (int n = 0; n < 100; ++n) add_rotated(fs, rng, {Eigen::Vector3d(0.9, 0.7, -0.2 - 0.001 * n)});
     assert_true(check<sh::StvkMaterial>(fs) > 0);
     assert_true(check<sh::NeoHookeanMaterial>(fs) > 0);
+    assert_true(check<sh::CorotationalMaterial>(fs) > 0);
 }
 
 /// Repeated singular values (the frame is not unique there) and pure rotations (the rest
@@ -165,6 +230,7 @@ void degenerate_stretches(void**) {
                               Eigen::Vector3d(0.3, 0.8, 1.6)});
     check<sh::StvkMaterial>(fs);
     check<sh::NeoHookeanMaterial>(fs);
+    check<sh::CorotationalMaterial>(fs);
 }
 
 /// Singular deformations: F = 0 and F of rank one and two (flattened and collapsed elements).
@@ -175,6 +241,7 @@ void singular_deformations(void**) {
     fs.push_back(Eigen::Matrix3d::Zero());
     check<sh::StvkMaterial>(fs);
     check<sh::NeoHookeanMaterial>(fs);
+    check<sh::CorotationalMaterial>(fs);
 }
 
 /// F scaled far beyond any physical strain (1e-60 to 1e60): the frames stay orthonormal and
@@ -205,6 +272,27 @@ void extreme_scales(void**) {
     for (const double scale : {1e-60, 1e-45, 1e-20, 1e20, 1e45, 1e60}) {
         check_scaled<sh::StvkMaterial>(scale, f0);
         check_scaled<sh::NeoHookeanMaterial>(scale, f0);
+        check_scaled<sh::CorotationalMaterial>(scale, f0);
+    }
+}
+
+/// The corotational reference above against central differences of its stress, at stretched,
+/// compressed and inverted deformations.
+void corotational_reference_is_the_derivative(void**) {
+    std::mt19937_64 rng(11);
+    for (const Eigen::Vector3d& s : {Eigen::Vector3d(1.3, 0.8, 1.1), Eigen::Vector3d(0.5, 0.4, 0.9),
+                                     Eigen::Vector3d(0.9, 0.7, -0.3)}) {
+        const Eigen::Matrix3d f = rotation(rng) * s.asDiagonal() * rotation(rng);
+        const StressDerivative c = corotational_derivative(f, 2.0, 1.0);
+        StressDerivative numeric;
+        const double h = 1e-6;
+        for (int q = 0; q < 9; ++q) {
+            Eigen::Matrix3d df = Eigen::Matrix3d::Zero();
+            df(q / 3, q % 3) = h;
+            const Eigen::Matrix3d dp = (corotational_stress(f + df, 2.0, 1.0) - corotational_stress(f - df, 2.0, 1.0)) / (2.0 * h);
+            for (int p = 0; p < 9; ++p) numeric(p, q) = dp(p / 3, p % 3);
+        }
+        assert_true((c - numeric).cwiseAbs().maxCoeff() <= 1e-7 * c.cwiseAbs().maxCoeff());
     }
 }
 
@@ -218,6 +306,7 @@ int main() {
         cmocka_unit_test(degenerate_stretches),
         cmocka_unit_test(singular_deformations),
         cmocka_unit_test(extreme_scales),
+        cmocka_unit_test(corotational_reference_is_the_derivative),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -31,12 +31,16 @@ struct CorotationalMaterial {
     /// dP/dF's eigensystem at F's signed singular values s (see PrincipalStiffnessLanes):
     /// psi_i = 2 mu (s_i - 1) + lambda (sum s - 3), so the stretches' block is
     /// 2 mu I + lambda 1 1^T, every shear mode 2 mu, and the turn mode of axes b, c
-    /// (psi_b + psi_c) / (s_b + s_c) = 2 mu + (2 lambda (sum s - 3) - 4 mu) / (s_b + s_c). A
-    /// pair whose stretches cancel (s_b + s_c <= 0, an element flattened or inverted across
-    /// them) has no defined turn: its mode is left out (zero), as projecting keeps no
-    /// negative part of it either.
+    /// (psi_b + psi_c) / (s_b + s_c) = 2 mu + (2 lambda (sum s - 3) - 4 mu) / (s_b + s_c). As a
+    /// pair's stretches cancel (an element flattened or inverted across them) that grows
+    /// without bound, negative (which projecting drops) or, where the third axis is stretched
+    /// past about 3 + 2 mu / lambda, positive: the sum is taken as at least kTurnFloor of the
+    /// largest stretch there, so that one degenerate element cannot make the matrix
+    /// arbitrarily stiff (nor its round-off estimate, which the diagonal sets).
     static SH_INLINE PrincipalStiffnessLanes principal_stiffness(const Lanes (&s)[3], Lanes lambda, Lanes mu) {
         const Lanes volumetric = 2.0 * lambda * (s[0] + s[1] + s[2] - 3.0) - 4.0 * mu;
+        const Lanes size = max_lane(max_lane(abs_lane(s[0]), abs_lane(s[1])), abs_lane(s[2]));
+        const Lanes floor = select(size > 0.0, kTurnFloor * size, splat(kTurnFloor));
         PrincipalStiffnessLanes k;
         for (int a = 0; a < 3; ++a) {
             const int b = (a + 1) % 3, c = (a + 2) % 3;
@@ -44,11 +48,13 @@ struct CorotationalMaterial {
             k.stretch[b][c] = k.stretch[c][b] = lambda;
             k.shear[a] = 2.0 * mu;
             const Lanes sum = s[b] + s[c];
-            const Lanes safe = select(sum > 0.0, sum, splat(1.0));
-            k.turn[a] = select(sum > 0.0, 2.0 * mu + volumetric / safe, Lanes{});
+            k.turn[a] = 2.0 * mu + volumetric / select(sum > floor, sum, floor);
         }
         return k;
     }
+    /// The least stretch sum of a pair that principal_stiffness divides by, relative to the
+    /// largest stretch: the turn stiffness stays below about 2000 (lambda + mu) there.
+    static constexpr double kTurnFloor = 1e-3;
 
     /// The polar rotation, reused by differential().
     struct State {

@@ -27,6 +27,12 @@ SH_INLINE Lanes splat(double s) { return Lanes{} + s; }
 /// Element-wise select: mask ? a : b.
 SH_INLINE Lanes select(LaneMask mask, Lanes a, Lanes b) { return mask ? a : b; }
 
+/// |a| per lane.
+SH_INLINE Lanes abs_lane(Lanes a) { return select(a < 0.0, -a, a); }
+
+/// max(a, b) per lane.
+SH_INLINE Lanes max_lane(Lanes a, Lanes b) { return select(a > b, a, b); }
+
 /// Element-wise square root (vectorised where the target has it).
 SH_INLINE Lanes lanes_sqrt(Lanes a) {
 #if defined(__AVX512F__)

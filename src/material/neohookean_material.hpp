@@ -109,20 +109,29 @@ struct NeoHookeanMaterial {
     static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) {
         Lanes m, l, alpha;
         parameters(lambda, mu, m, l, alpha);
-        // Written in H = F - I with its first-order terms cancelled by hand, so that psi's
-        // round-off is relative to psi itself, not to the O(mu |H|) terms that cancel near rest
-        // (a stiff body at rest otherwise has energy noise above the implicit step's estimate):
-        // Ic - 3 = 4q = 2 tr H + |H|^2, J - 1 = j1 = tr H + i2(H) + det H, and with
+        // Written in the Green strain E = (H + H^T + H^T H) / 2, H = F - I, with the terms of
+        // first order in it cancelled by hand, so that psi's round-off is relative to psi
+        // itself, near rest and turned alike (a stiff body at rest otherwise carries energy
+        // noise of O(mu eps) per element, far above the implicit step's estimate). With
         // l (1 - a) = -3m/4, psi = m/2 (q - log(1 + q)) + 3m/4 (2q - j1) + l/2 j1^2, where
-        // 2q - j1 = (|H|^2 + tr(H H) - tr(H)^2) / 2 - det H.
+        // q = (Ic - 3)/4 = tr E / 2 and j1 = J - 1. From J^2 = det(I + 2E) =
+        // 1 + 2 tr E + 2 (tr^2 E - tr E^2) + 8 det E, both j1 = (J^2 - 1)/(J + 1) and
+        // 2q - j1 = (tr E j1 - 2 (tr^2 E - tr E^2) - 8 det E)/(J + 1) are products of small
+        // quantities; an element inverted past J = -1/2, whose energy is large, takes them
+        // directly.
         const Mat3L H = add_diagonal(F, splat(-1.0));
-        const Lanes tr = trace(H), hh = ddot(H, H), dh = det(H);
-        Lanes h2 = Lanes{};  // tr(H H)
+        Mat3L E;
         for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) h2 += H.m[i][j] * H.m[j][i];
-        const Lanes j1 = tr + 0.5 * (tr * tr - h2) + dh, second = 0.5 * (hh + h2 - tr * tr) - dh;
+            for (int j = 0; j < 3; ++j)
+                E.m[i][j] = 0.5 * (H.m[i][j] + H.m[j][i] + H.m[0][i] * H.m[0][j] + H.m[1][i] * H.m[1][j] + H.m[2][i] * H.m[2][j]);
+        const Lanes tr = trace(E), tr_square = ddot(E, E), second_invariant = tr * tr - tr_square;
+        const Lanes J = det(F), plus = J + 1.0;
+        const LaneMask near_rest = plus > 0.5;
+        const Lanes safe = select(near_rest, plus, splat(1.0));
+        const Lanes j1 = select(near_rest, (2.0 * tr + 2.0 * second_invariant + 8.0 * det(E)) / safe, J - 1.0);
+        const Lanes second = select(near_rest, (tr * j1 - 2.0 * second_invariant - 8.0 * det(E)) / safe, tr - j1);
         Lanes g;
-        for (int k = 0; k < kLanes; ++k) g[k] = q_minus_log1p(0.25 * (2.0 * tr[k] + hh[k]));
+        for (int k = 0; k < kLanes; ++k) g[k] = q_minus_log1p(0.5 * tr[k]);
         return 0.5 * m * g + 0.75 * m * second + 0.5 * l * j1 * j1;
     }
 };

@@ -408,9 +408,9 @@ void NewtonStep::evaluate() {
         const double field_energy = body.field ? body.field->energy(body.x.data()) : 0.0;
         const double field = body.field ? field_energy + h * body.field->dissipation(body.v.data()) : 0.0;
         evaluated_energy_ += elastic.value + field_energy;
-        evaluated_energy_scale_ += elastic.scale + std::fabs(field_energy);
+        evaluated_energy_scale_ += std::fabs(elastic.value) + std::fabs(field_energy);  // magnitudes
         phi.value += elastic.value + field;
-        phi.scale += elastic.scale + std::fabs(field);
+        phi.scale += elastic.scale + std::fabs(field);  // what its round-off is relative to
         const vec<int32_t>& global = state.matrix.system.dof_to_global();
         for (size_t d = 0; d < global.size(); ++d) {
             const size_t j = static_cast<size_t>(global[d]), node = j / 3;

@@ -96,16 +96,19 @@ StressDerivative reference(const Eigen::Matrix3d& f, double lambda, double mu) {
     else return derivative<Law>(f, lambda, mu);
 }
 
-/// True if the reference is defined at f: for the corotational law, every pair of F's signed
-/// singular values sums to more than 0 (R's change is singular where two cancel).
+/// True if the law's eigensystem is the reference's at f: for the corotational law, every
+/// pair of F's signed singular values sums to more than its kTurnFloor of the largest (R's
+/// change is singular where two cancel, and the law bounds the turn stiffness there).
 template <class Law>
 bool reference_defined(const sh::SingularFrameLanes& frame, int l) {
-    if (!Law::kRotates) return true;
-    const double s[3] = {frame.s[0][l], frame.s[1][l], frame.s[2][l]};
-    const double size = std::max({std::abs(s[0]), std::abs(s[1]), std::abs(s[2])});
-    for (int a = 0; a < 3; ++a)
-        if (!(s[(a + 1) % 3] + s[(a + 2) % 3] > 1e-6 * size)) return false;
-    return true;
+    if constexpr (!Law::kRotates) return true;
+    else {
+        const double s[3] = {frame.s[0][l], frame.s[1][l], frame.s[2][l]};
+        const double size = std::max({std::abs(s[0]), std::abs(s[1]), std::abs(s[2])});
+        for (int a = 0; a < 3; ++a)
+            if (!(s[(a + 1) % 3] + s[(a + 2) % 3] > Law::kTurnFloor * size)) return false;
+        return true;
+    }
 }
 
 /// The reference: c's eigendecomposition with the negative eigenvalues set to zero.
@@ -276,6 +279,34 @@ void extreme_scales(void**) {
     }
 }
 
+/// An element collapsed onto a stretched line (F of rank one, or nearly: s = (5, d, d)), or
+/// inverted across a pair whose stretches nearly cancel beside a long third axis: the exact
+/// turn stiffness grows as 1 / (s_b + s_c) without bound there; the corotational law's
+/// projected derivative stays finite, positive semi-definite and below a few thousand times
+/// its moduli.
+void corotational_turn_stays_bounded(void**) {
+    std::mt19937_64 rng(12);
+    Deformations fs;
+    for (const double d : {1e-3, 1e-9, 1e-15, 0.0})
+        add_rotated(fs, rng, {Eigen::Vector3d(5.0, d, d), Eigen::Vector3d(4.0, 1.0, -1.0 + d)});
+    for (const Eigen::Matrix3d& f : fs) {
+        sh::Mat3L F;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) F.m[i][j] = sh::splat(f(i, j));
+        const sh::SingularFrameLanes frame = sh::singular_frames(F);
+        sh::StressDerivativeLanes projected;
+        sh::projected_stress_derivatives(sh::CorotationalMaterial::principal_stiffness(frame.s, sh::splat(4.0), sh::splat(1.0)),
+                                         frame, projected);
+        StressDerivative mine;
+        for (int p = 0; p < 9; ++p)
+            for (int q = 0; q < 9; ++q) mine(p, q) = projected.c[p][q][0];
+        assert_true(mine.allFinite());
+        assert_true(mine.cwiseAbs().maxCoeff() <= 1e4 * (4.0 + 1.0));
+        const Eigen::SelfAdjointEigenSolver<StressDerivative> eigen(mine);
+        assert_true(eigen.eigenvalues()(0) >= -1e-10 * mine.cwiseAbs().maxCoeff());
+    }
+}
+
 /// The corotational reference above against central differences of its stress, at stretched,
 /// compressed and inverted deformations.
 void corotational_reference_is_the_derivative(void**) {
@@ -307,6 +338,7 @@ int main() {
         cmocka_unit_test(singular_deformations),
         cmocka_unit_test(extreme_scales),
         cmocka_unit_test(corotational_reference_is_the_derivative),
+        cmocka_unit_test(corotational_turn_stays_bounded),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

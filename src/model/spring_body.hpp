@@ -57,6 +57,8 @@ public:
 
 private:
     int32_t root_of(int32_t node) const;
+    /// Calls visit(s, a, b, d, l) for every spring s at positions xs: its end nodes a and b,
+    /// d = x_b - x_a and l = |d|.
     template <class Visit>
     void each_spring(const double* xs, Visit&& visit) const;
 

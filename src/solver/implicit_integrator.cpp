@@ -220,8 +220,9 @@ private:
     /// the last evaluate() left and whose elastic and field energies it found; at the current
     /// positions, computed afresh (after something else moved the bodies).
     enum class EnergyAt { kStart, kLastEvaluation, kNow };
-    /// Kinetic + potential energy of the bodies (J); scale gets the terms' magnitudes.
-    double mechanical_energy(EnergyAt at, double& scale) const;
+    /// Kinetic + potential energy of the bodies (J); scale, if not null, gets the terms'
+    /// magnitudes (at kStart or kNow: the last evaluation keeps its energies only).
+    double mechanical_energy(EnergyAt at, double* scale) const;
     /// True if the energy (at: kLastEvaluation or kNow) rose by more than fraction of its
     /// start scale with no outside work.
     bool energy_rose(double fraction, EnergyAt at) const;
@@ -248,9 +249,8 @@ private:
     double r_ = 0.0, r_max_ = 0.0; // residual norms (2 and max) at the current iterate
     double largest_change_ = 0.0, largest_speed_ = 0.0;  // of the last update taken
     double energy0_ = 0.0, energy_scale0_ = 0.0;  // mechanical energy at the start, its scale
-    // The elastic and field energies at the positions the last evaluate() left (their sum
-    // and the sum of their magnitudes).
-    double evaluated_energy_ = 0.0, evaluated_energy_scale_ = 0.0;
+    // The elastic and field energies at the positions the last evaluate() left.
+    double evaluated_energy_ = 0.0;
     double field_push_ = 0.0;  // norm of the fields' push at the first iterate (N)
     bool first_evaluation_ = true;  // the next evaluate() is the step's first: it measures field_push_
     bool work_done_ = false;  // moving tools, other bodies or prescribed nodes work on the bodies
@@ -258,8 +258,8 @@ private:
 };
 
 // Kinetic + potential energy (NewtonProblem::potential_energy) of the bodies, at the step's
-// start (x0, v0) or now; scale gets the terms' magnitudes.
-double NewtonStep::mechanical_energy(EnergyAt at, double& scale) const {
+// start (x0, v0) or now.
+double NewtonStep::mechanical_energy(EnergyAt at, double* scale) const {
     const bool at_start = at == EnergyAt::kStart;
     double kinetic = 0.0;
     problem_.each([&](const SteppedBody& stepped, size_t) {
@@ -271,11 +271,12 @@ double NewtonStep::mechanical_energy(EnergyAt at, double& scale) const {
             kinetic += 0.5 * body.mass[k / 3] * v[k] * v[k];
         }
     });
+    double potential_scale = 0.0;
     const double potential =
         at == EnergyAt::kLastEvaluation
-            ? problem_.potential_energy_from(g_, 1.0, evaluated_energy_, evaluated_energy_scale_, scale)
-            : problem_.potential_energy(g_, 1.0, at_start, scale);
-    scale += kinetic;
+            ? problem_.potential_energy_from(g_, 1.0, evaluated_energy_)
+            : problem_.potential_energy(g_, 1.0, at_start, potential_scale);
+    if (scale) *scale = potential_scale + kinetic;
     return kinetic + potential;
 }
 
@@ -284,8 +285,7 @@ double NewtonStep::mechanical_energy(EnergyAt at, double& scale) const {
 // current iterate raised it by more than fraction times its start's scale (or to non-finite).
 bool NewtonStep::energy_rose(double fraction, EnergyAt at) const {
     if (work_done_) return false;
-    double scale = 0.0;
-    const double energy = mechanical_energy(at, scale);
+    const double energy = mechanical_energy(at, nullptr);
     return !std::isfinite(energy) || energy - energy0_ > fraction * energy_scale0_ + 1e-12;
 }
 
@@ -322,7 +322,7 @@ void NewtonStep::begin() {
         std::fill(base.begin(), base.end(), 0.0);
         body.add_internal_forces(stepped.workspace.x0.data(), nullptr, base.data());
     });
-    if (!work_done_) energy0_ = mechanical_energy(EnergyAt::kStart, energy_scale0_);
+    if (!work_done_) energy0_ = mechanical_energy(EnergyAt::kStart, &energy_scale0_);
     reuse_ = s_.factor_reuse > 0.0 && matrix_.solver->is_direct();
     matrix_version_ = problem_.matrix_version();
     factor_current_ = reuse_ && allow_stale_ && matrix_.kept.valid && matrix_.kept.dt == dt_ &&
@@ -386,7 +386,7 @@ void NewtonStep::evaluate() {
     Potential phi;
     double sum2 = 0.0, push2 = 0.0;
     r_max_ = 0.0;
-    evaluated_energy_ = evaluated_energy_scale_ = 0.0;
+    evaluated_energy_ = 0.0;
     problem_.each([&](SteppedBody& stepped, size_t offset) {
         Body& body = *stepped.body;
         const NewtonBodyState& state = *stepped.newton;
@@ -408,7 +408,6 @@ void NewtonStep::evaluate() {
         const double field_energy = body.field ? body.field->energy(body.x.data()) : 0.0;
         const double field = body.field ? field_energy + h * body.field->dissipation(body.v.data()) : 0.0;
         evaluated_energy_ += elastic.value + field_energy;
-        evaluated_energy_scale_ += std::fabs(elastic.value) + std::fabs(field_energy);  // magnitudes
         phi.value += elastic.value + field;
         phi.scale += elastic.scale + std::fabs(field);  // what its round-off is relative to
         const vec<int32_t>& global = state.matrix.system.dof_to_global();

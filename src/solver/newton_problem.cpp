@@ -96,15 +96,9 @@ double NewtonProblem::potential_energy(const double g[3], double load_factor, bo
     return total;
 }
 
-double NewtonProblem::potential_energy_from(const double g[3], double load_factor, double stored, double stored_scale,
-                                            double& scale) const {
+double NewtonProblem::potential_energy_from(const double g[3], double load_factor, double stored) const {
     double total = stored;
-    scale = stored_scale;
-    each([&](const SteppedBody& m, size_t) {
-        const double work = load_work(m, g, m.body->x.data());
-        total -= load_factor * work;
-        scale += std::fabs(load_factor * work);
-    });
+    each([&](const SteppedBody& m, size_t) { total -= load_factor * load_work(m, g, m.body->x.data()); });
     return total;
 }
 

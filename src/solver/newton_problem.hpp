@@ -148,10 +148,8 @@ public:
     double potential_energy(const double g[3], double load_factor, bool at_start, double& scale) const;
 
     /// potential_energy at the current positions where the elastic and field energies there
-    /// are already known: stored is their sum over the bodies, stored_scale the sum of their
-    /// magnitudes. Only the loads' work is computed.
-    double potential_energy_from(const double g[3], double load_factor, double stored, double stored_scale,
-                                 double& scale) const;
+    /// are already known (stored: their sum over the bodies). Only the loads' work is computed.
+    double potential_energy_from(const double g[3], double load_factor, double stored) const;
 
 private:
     /// Adds the values of m's own matrix into the joint one.

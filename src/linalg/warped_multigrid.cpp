@@ -18,6 +18,12 @@ inline void subtract_block_product(const BlockMatrix& a, int32_t k, const double
     s[2] -= b[6] * zj[0] + b[7] * zj[1] + b[8] * zj[2];
 }
 
+// out = d s for a 3x3 block d (row-major): a node's Gauss-Seidel update from its inverse
+// diagonal block.
+inline void block_times(const double* d, const double (&s)[3], double* out) {
+    for (int c = 0; c < 3; ++c) out[c] = d[3 * c] * s[0] + d[3 * c + 1] * s[1] + d[3 * c + 2] * s[2];
+}
+
 // Free nodes per coarse node the grid aims at: about 4 fine cells per coarse cell along each
 // axis on a structured mesh (4x4x4 coarse cells for a 15^3-cell cube: 5-7 CG iterations to a
 // relative residual of 0.025 through large rotations). Finer grids cost more per cycle than
@@ -230,11 +236,7 @@ void WarpedMultigrid::backward_sweep(const double* r, double* z) const {
         double s[3] = {r[3 * static_cast<size_t>(i)], r[3 * static_cast<size_t>(i) + 1], r[3 * static_cast<size_t>(i) + 2]};
         for (int32_t k = blocks_.row_start()[i]; k < blocks_.row_start()[i + 1]; ++k)
             if (k != blocks_.diagonal(i)) subtract_block_product(blocks_, k, z, s);
-        const double* d = &inverse_diagonal_[9 * static_cast<size_t>(i)];
-        double* zi = z + 3 * static_cast<size_t>(i);
-        zi[0] = d[0] * s[0] + d[1] * s[1] + d[2] * s[2];
-        zi[1] = d[3] * s[0] + d[4] * s[1] + d[5] * s[2];
-        zi[2] = d[6] * s[0] + d[7] * s[1] + d[8] * s[2];
+        block_times(&inverse_diagonal_[9 * static_cast<size_t>(i)], s, z + 3 * static_cast<size_t>(i));
     }
 }
 
@@ -245,9 +247,7 @@ void WarpedMultigrid::first_sweep(const double* r, double* z) {
     for (int32_t i = 0; i < n; ++i) {
         double s[3] = {r[3 * static_cast<size_t>(i)], r[3 * static_cast<size_t>(i) + 1], r[3 * static_cast<size_t>(i) + 2]};
         for (int32_t k = start[i]; k < blocks_.diagonal(i); ++k) subtract_block_product(blocks_, k, z, s);
-        const double* d = &inverse_diagonal_[9 * static_cast<size_t>(i)];
-        double* zi = z + 3 * static_cast<size_t>(i);
-        for (int c = 0; c < 3; ++c) zi[c] = d[3 * c] * s[0] + d[3 * c + 1] * s[1] + d[3 * c + 2] * s[2];
+        block_times(&inverse_diagonal_[9 * static_cast<size_t>(i)], s, z + 3 * static_cast<size_t>(i));
     }
     for (int32_t i = 0; i < n; ++i) {
         double s[3] = {0.0, 0.0, 0.0};

@@ -17,7 +17,7 @@ SH_INLINE Lanes positive_part(Lanes x) { return select(x > 0.0, x, Lanes{}); }
 // v <- v J gathers the rotations.
 SH_INLINE void jacobi_turn(Lanes (&a)[3][3], Mat3L& v, int p, int q) {
     const Lanes apq = a[p][q], d = a[q][q] - a[p][p];
-    const Lanes magnitude = select(d < 0.0, -d, d) + lanes_sqrt(d * d + 4.0 * apq * apq);
+    const Lanes magnitude = abs_lane(d) + lanes_sqrt(d * d + 4.0 * apq * apq);
     const Lanes sign = select(d < 0.0, splat(-1.0), splat(1.0));
     const Lanes t = select(magnitude > 0.0, 2.0 * apq * sign / select(magnitude > 0.0, magnitude, splat(1.0)), Lanes{});
     const Lanes c = 1.0 / lanes_sqrt(1.0 + t * t), s = t * c;

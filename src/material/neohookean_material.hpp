@@ -124,12 +124,12 @@ struct NeoHookeanMaterial {
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j)
                 E.m[i][j] = 0.5 * (H.m[i][j] + H.m[j][i] + H.m[0][i] * H.m[0][j] + H.m[1][i] * H.m[1][j] + H.m[2][i] * H.m[2][j]);
-        const Lanes tr = trace(E), tr_square = ddot(E, E), second_invariant = tr * tr - tr_square;
+        const Lanes tr = trace(E), second_invariant = tr * tr - ddot(E, E), third = 8.0 * det(E);
         const Lanes J = det(F), plus = J + 1.0;
         const LaneMask near_rest = plus > 0.5;
         const Lanes safe = select(near_rest, plus, splat(1.0));
-        const Lanes j1 = select(near_rest, (2.0 * tr + 2.0 * second_invariant + 8.0 * det(E)) / safe, J - 1.0);
-        const Lanes second = select(near_rest, (tr * j1 - 2.0 * second_invariant - 8.0 * det(E)) / safe, tr - j1);
+        const Lanes j1 = select(near_rest, (2.0 * tr + 2.0 * second_invariant + third) / safe, J - 1.0);
+        const Lanes second = select(near_rest, (tr * j1 - 2.0 * second_invariant - third) / safe, tr - j1);
         Lanes g;
         for (int k = 0; k < kLanes; ++k) g[k] = q_minus_log1p(0.5 * tr[k]);
         return 0.5 * m * g + 0.75 * m * second + 0.5 * l * j1 * j1;

@@ -18,8 +18,8 @@ double dot(const vec<double>& a, const vec<double>& b) {
 }  // namespace
 
 void PreconditionedCgWork::resize(size_t n) {
-    vec<double> fresh[4] = {vec<double>(n), vec<double>(n), vec<double>(n), vec<double>(n)};
-    r.swap(fresh[0]), z.swap(fresh[1]), p.swap(fresh[2]), q.swap(fresh[3]);
+    vec<double> fresh[5] = {vec<double>(n), vec<double>(n), vec<double>(n), vec<double>(n), vec<double>(n)};
+    r.swap(fresh[0]), z.swap(fresh[1]), p.swap(fresh[2]), q.swap(fresh[3]), az.swap(fresh[4]);
 }
 
 PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::function<void(const double*, double*)>& multiply,
@@ -34,11 +34,12 @@ PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::fun
     out.relative_residual = b_norm > 0.0 ? 1.0 : 0.0;
     out.converged = !(b_norm > 0.0);
     if (out.converged) return out;
-    preconditioner.apply(r.data(), z.data());
+    // q = A p: from the preconditioner's A z where it gives it (the same for every apply).
+    const bool fused = preconditioner.apply_with_product(r.data(), z.data(), q.data());
     std::copy(z.begin(), z.end(), p.begin());
     double rz = dot(r, z);
     while (out.iterations < max_iterations) {
-        multiply(p.data(), q.data());
+        if (!fused) multiply(p.data(), q.data());
         ++out.iterations;
         const double curvature = dot(p, q);
         if (!(curvature > 0.0) || !(rz > 0.0)) break;
@@ -52,11 +53,15 @@ PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::fun
             out.converged = true;
             break;
         }
-        preconditioner.apply(r.data(), z.data());
+        // A z lands in az (work.z's partner) while q still holds A p_old.
+        if (fused) preconditioner.apply_with_product(r.data(), z.data(), work.az.data());
+        else preconditioner.apply(r.data(), z.data());
         const double rz_next = dot(r, z);
         const double beta = rz_next / rz;
         rz = rz_next;
         for (size_t i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];
+        if (fused)
+            for (size_t i = 0; i < n; ++i) q[i] = work.az[i] + beta * q[i];
     }
     out.seconds = now_seconds() - t0;
     return out;

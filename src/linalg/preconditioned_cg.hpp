@@ -16,13 +16,21 @@ public:
     virtual ~Preconditioner() = default;
     /// z = M^-1 r (dof_count values each; they must not overlap).
     virtual void apply(const double* r, double* z) = 0;
+    /// apply(), and az = A z where the preconditioner can form it for less than a product
+    /// with A (the system's matrix); returns false, az untouched, where it cannot.
+    virtual bool apply_with_product(const double* r, double* z, double* az) {
+        (void)az;
+        apply(r, z);
+        return false;
+    }
 };
 
 /// solve_preconditioned_cg's vectors, kept by its caller beside the matrix so that a solve
 /// allocates nothing (sized for a.dof_count() by resize).
 struct PreconditionedCgWork {
     vec<double> r, z, p, q;  ///< residual, preconditioned residual, direction, A direction
-    /// Sizes the four vectors for n DOFs; throws std::bad_alloc, changing nothing else.
+    vec<double> az;          ///< A z, where the preconditioner forms it
+    /// Sizes the vectors for n DOFs; throws std::bad_alloc, changing nothing else.
     void resize(size_t n);
 };
 
@@ -46,7 +54,9 @@ PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolv
                                                double* x, double tolerance, int max_iterations,
                                                PreconditionedCgWork& work);
 
-/// The same with any preconditioner; multiply(x, y) computes y = A x.
+/// The same with any preconditioner; multiply(x, y) computes y = A x. Where the
+/// preconditioner returns A z beside z (apply_with_product), A p follows from the recurrence
+/// A p = A z + beta A p_old, and multiply serves only where it does not.
 PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::function<void(const double*, double*)>& multiply,
                                                Preconditioner& preconditioner, const double* b, double* x,
                                                double tolerance, int max_iterations, PreconditionedCgWork& work);

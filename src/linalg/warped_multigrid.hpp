@@ -37,9 +37,14 @@ public:
     void prepare(const SparseSystem& a, const double* rotations);
     /// z = one V-cycle applied to r.
     void apply(const double* r, double* z) override;
+    /// The V-cycle, and az = A z for half a product: the backward sweep leaves each node's
+    /// row of A z equal to r but for the blocks left of its diagonal times the changes the
+    /// sweep made after it (Eisenstat's observation), so only those blocks are read again.
+    bool apply_with_product(const double* r, double* z, double* az) override;
     /// y = A x with the prepared matrix (the product CG needs, from the same blocks).
     void multiply(const double* x, double* y) const { blocks_.multiply(x, y); }
-    /// One apply's work plus one product's, in a sparse solve's operations (FactorWork).
+    /// One apply's work plus CG's product (half a product, apply_with_product), in a sparse
+    /// solve's operations (FactorWork).
     double iteration_work() const;
     /// Coarse nodes (grid nodes some free node's cell has), for reports and tests.
     int32_t coarse_nodes() const { return coarse_count_; }
@@ -56,8 +61,9 @@ private:
     int32_t split_by_connection(int32_t nodes);
     /// coarse_ := P^T A0 P (A0 in blocks_) and its Cholesky factor.
     void build_coarse();
-    /// One block Gauss-Seidel sweep over the nodes backward, on z towards r.
-    void backward_sweep(const double* r, double* z) const;
+    /// One block Gauss-Seidel sweep over the nodes backward, on z towards r; change_ := what
+    /// it added to z.
+    void backward_sweep(const double* r, double* z);
     /// The forward sweep from z = 0, then residual_ = r - A z. From zero only the blocks left
     /// of the diagonal meet a nonzero z, and the sweep zeroes each row's residual up to its
     /// diagonal, so that r - A z = -U z (U the blocks right of it): one pass over the blocks
@@ -76,6 +82,7 @@ private:
     Eigen::LLT<Eigen::MatrixXd> coarse_;  // factor of P^T A0 P (3 per coarse node)
     Eigen::VectorXd coarse_rhs_;          // restricted residual, then the coarse solution
     vec<double> residual_;                // 3 per node
+    vec<double> change_;                  // 3 per node: the backward sweep's change of z
     vec<int32_t> scratch_;                // the grid's node numbers, then the union-find's parents
 };
 

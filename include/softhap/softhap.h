@@ -429,14 +429,11 @@ typedef struct sh_implicit_settings {
                                          Newton iteration (exact Newton); must be in [0, 1);
                                          default 0.25 */
     int32_t max_substeps;           /**< with on_unstable = SH_UNSTABLE_SUBSTEP: a step whose
-                                         energy runs away, state turns non-finite or linear
-                                         solve fails is retried as 2, 4, ... equal sub-steps up
-                                         to this many; one whose Newton loop only misses its
-                                         tolerance, once as 2 (shorter steps seldom make such a
-                                         loop converge, and each pays it again); if the last
-                                         still does not converge it keeps its best iterate and
-                                         counts SH_WARN_NOT_CONVERGED. 1 = no retry; >= 1;
-                                         default 16 */
+                                         Newton loop does not converge (or whose energy runs
+                                         away) is retried as 2, 4, ... equal sub-steps up to this
+                                         many; if the last still does not converge it keeps its
+                                         best iterate and counts SH_WARN_NOT_CONVERGED. 1 = no
+                                         retry; >= 1; default 16 */
 } sh_implicit_settings;
 
 /** What a step larger than the body's critical step does. */

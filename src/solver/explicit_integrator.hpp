@@ -26,10 +26,6 @@ struct BodyStepResult {
     int32_t factorizations = 0;     ///< implicit: factorisations in this step
     bool not_converged = false;     ///< implicit: Newton missed its tolerance and the step kept
                                     ///< its best iterate (stable stays true)
-    bool newton_short = false;      ///< implicit, not stable: Newton only missed its tolerance
-                                    ///< (its cap, or a line search that could not lower the
-                                    ///< potential further) after lowering it; the linear
-                                    ///< solver worked and the state stayed sane
 };
 
 

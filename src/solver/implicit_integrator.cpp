@@ -812,9 +812,7 @@ BodyStepResult NewtonStep::finish(bool converged, bool solver_failed, bool keep_
             return fail(SH_ERR_SOLVER, "the sparse factorisation or solve failed (matrix not positive definite, or a "
                                        "non-finite value)");
         if (solver_failed) return fail(SH_ERR_NOT_CONVERGED, "the linear solver did not converge");
-        fail(SH_ERR_NOT_CONVERGED, "Newton iterations did not reach newton_tolerance");
-        result_.newton_short = progressed;
-        return result_;
+        return fail(SH_ERR_NOT_CONVERGED, "Newton iterations did not reach newton_tolerance");
     }
     result_.not_converged = !converged;
     result_.status = SH_OK;

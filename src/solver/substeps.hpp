@@ -21,8 +21,7 @@ constexpr int32_t kMaxContactSubsteps = 1024;
 constexpr int32_t kMaxHapticSubsteps = 64;
 
 // An implicit body's failed step is retried in 2, 4, ... sub-steps up to its settings'
-// implicit.max_substeps (the host's cap: how much time it gives one step), counted here too;
-// one that only missed Newton's tolerance, once (World::run_attempts).
+// implicit.max_substeps (the host's cap: how much time it gives one step), counted here too.
 
 /// How many equal sub-steps to take, and whether the cap clamped it.
 struct SubstepCount {

@@ -415,11 +415,7 @@ void World::restore_step_start(size_t index) {
 // The step as attempts of 1, 2, 4, ... times the contact sub-steps: a body whose attempt
 // failed goes back to the step's start and, if it may (an implicit body sub-stepping within
 // its max_substeps), takes part in the next attempt, whose last allowed one keeps its best
-// iterate; the others' failures are final. A body whose attempt only fell short of Newton's
-// tolerance (newton_short) takes one more attempt, which keeps its best iterate: shorter
-// steps cure instability, but seldom a Newton loop that makes too little progress (elements
-// turned inside out, a contact's kinks), and each of their sub-steps pays the whole loop
-// again (a collapsed armadillo under a tool: 400 factorisations per step to 16 sub-steps). A body that fails an attempt of one sub-step is
+// iterate; the others' failures are final. A body that fails an attempt of one sub-step is
 // already back at the step's start (every integrator restores its own start on failure), so
 // the start is copied only for attempts of more sub-steps.
 void World::run_attempts(double dt, sh_step_report& r) {
@@ -428,15 +424,13 @@ void World::run_attempts(double dt, sh_step_report& r) {
     skip.assign(slots_.size(), 0);  // within the capacity reserved in add_body
     for (size_t index = 0; index < slots_.size(); ++index) {
         scratch_.bodies[index].failed = false;
-        scratch_.bodies[index].failure = BodyStepResult{};
         if (slots_.is_live(index) && base > 1) save_step_start(index);
     }
     for (int32_t factor = 1;; factor *= 2) {
         for (size_t index = 0; index < slots_.size(); ++index) {
             if (!slots_.is_live(index)) continue;
             const StepSettings& s = slots_[index].stepped->settings;
-            BodyAttempt& attempt = scratch_.bodies[index];
-            attempt.keep_best = sub_steps_on_failure(s) && (!may_retry_in(s, 2 * factor) || attempt.failure.newton_short);
+            scratch_.bodies[index].keep_best = sub_steps_on_failure(s) && !may_retry_in(s, 2 * factor);
         }
         run_substeps(dt, base * factor, r);
         bool retry = false;

@@ -185,10 +185,9 @@ class World(WorldContacts):
           integrator: "symplectic_euler", "forward_euler", "rk2", "rk4" or "implicit_euler";
           damping_mass: Rayleigh alpha (1/s); damping_stiffness: Rayleigh beta (s);
           on_unstable: "substep" or "reject": explicit steps above the critical step are
-          sub-stepped or rejected; implicit steps that run away or whose solve fails are
-          retried in up to max_substeps sub-steps, those that only miss Newton's tolerance in
-          2, and then keep their best iterate ("SH_WARN_NOT_CONVERGED" in the step report's
-          warnings), or rejected;
+          sub-stepped or rejected; implicit steps that do not converge are retried in up to
+          max_substeps sub-steps and then keep their best iterate ("SH_WARN_NOT_CONVERGED" in
+          the step report's warnings), or rejected;
           runaway_speed: a node faster than this (m/s) rolls the step back;
           implicit_euler only (sh_implicit_settings): linear_solver "default" (CHOLMOD when
           built in, else "ldlt"), "cholmod", "ldlt" or "cg"; newton_max_iterations (1: one

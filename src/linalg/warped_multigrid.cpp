@@ -18,6 +18,11 @@ inline void subtract_block_product(const BlockMatrix& a, int32_t k, const double
     s[2] -= b[6] * zj[0] + b[7] * zj[1] + b[8] * zj[2];
 }
 
+// s -= the sum of A_k x_j over the stored blocks first <= k < last (a range of one row).
+inline void subtract_row_blocks(const BlockMatrix& a, int32_t first, int32_t last, const double* x, double (&s)[3]) {
+    for (int32_t k = first; k < last; ++k) subtract_block_product(a, k, x, s);
+}
+
 // out = d s for a 3x3 block d (row-major): a node's Gauss-Seidel update from its inverse
 // diagonal block.
 inline void block_times(const double* d, const double (&s)[3], double* out) {
@@ -235,8 +240,8 @@ void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
 void WarpedMultigrid::backward_sweep(const double* r, double* z) {
     for (int32_t i = blocks_.node_count() - 1; i >= 0; --i) {
         double s[3] = {r[3 * static_cast<size_t>(i)], r[3 * static_cast<size_t>(i) + 1], r[3 * static_cast<size_t>(i) + 2]};
-        for (int32_t k = blocks_.row_start()[i]; k < blocks_.diagonal(i); ++k) subtract_block_product(blocks_, k, z, s);
-        for (int32_t k = blocks_.diagonal(i) + 1; k < blocks_.row_start()[i + 1]; ++k) subtract_block_product(blocks_, k, z, s);
+        subtract_row_blocks(blocks_, blocks_.row_start()[i], blocks_.diagonal(i), z, s);
+        subtract_row_blocks(blocks_, blocks_.diagonal(i) + 1, blocks_.row_start()[i + 1], z, s);
         double* zi = z + 3 * static_cast<size_t>(i);
         double updated[3];
         block_times(&inverse_diagonal_[9 * static_cast<size_t>(i)], s, updated);
@@ -253,12 +258,12 @@ void WarpedMultigrid::first_sweep(const double* r, double* z) {
     std::fill(z, z + 3 * static_cast<size_t>(n), 0.0);
     for (int32_t i = 0; i < n; ++i) {
         double s[3] = {r[3 * static_cast<size_t>(i)], r[3 * static_cast<size_t>(i) + 1], r[3 * static_cast<size_t>(i) + 2]};
-        for (int32_t k = start[i]; k < blocks_.diagonal(i); ++k) subtract_block_product(blocks_, k, z, s);
+        subtract_row_blocks(blocks_, start[i], blocks_.diagonal(i), z, s);
         block_times(&inverse_diagonal_[9 * static_cast<size_t>(i)], s, z + 3 * static_cast<size_t>(i));
     }
     for (int32_t i = 0; i < n; ++i) {
         double s[3] = {0.0, 0.0, 0.0};
-        for (int32_t k = blocks_.diagonal(i) + 1; k < start[i + 1]; ++k) subtract_block_product(blocks_, k, z, s);
+        subtract_row_blocks(blocks_, blocks_.diagonal(i) + 1, start[i + 1], z, s);
         std::copy(s, s + 3, &residual_[3 * static_cast<size_t>(i)]);
     }
 }
@@ -302,11 +307,11 @@ void WarpedMultigrid::apply(const double* r, double* z) {
 bool WarpedMultigrid::apply_with_product(const double* r, double* z, double* az) {
     apply(r, z);
     // Node i's sweep solved its row for r with the nodes before it (j < i) not yet changed:
-    // (A z)_i = r_i + sum over j < i of A_ij change_j.
+    // (A z)_i = r_i + sum over j < i of A_ij change_j = r_i - s.
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
-        double s[3] = {-r[3 * static_cast<size_t>(i)], -r[3 * static_cast<size_t>(i) + 1], -r[3 * static_cast<size_t>(i) + 2]};
-        for (int32_t k = blocks_.row_start()[i]; k < blocks_.diagonal(i); ++k) subtract_block_product(blocks_, k, change_.data(), s);
-        for (int c = 0; c < 3; ++c) az[3 * static_cast<size_t>(i) + static_cast<size_t>(c)] = -s[c];
+        double s[3] = {0.0, 0.0, 0.0};
+        subtract_row_blocks(blocks_, blocks_.row_start()[i], blocks_.diagonal(i), change_.data(), s);
+        for (size_t c = 0; c < 3; ++c) az[3 * static_cast<size_t>(i) + c] = r[3 * static_cast<size_t>(i) + c] - s[c];
     }
     return true;
 }
@@ -314,8 +319,8 @@ bool WarpedMultigrid::apply_with_product(const double* r, double* z, double* az)
 double WarpedMultigrid::iteration_work() const {
     // 18 operations per stored block for three and a half passes' worth: the first sweep with
     // its residual (one pass, measured no cheaper than 1.7 of the others), the backward sweep
-    // and the half product CG's A p takes from it; the transfers; the dense coarse solve. They count half a sparse solve's
-    // operation each: the blocks (4-5 MB at 20 k tets) stay in cache across the cycle where a
+    // and the half product CG's A p takes from it; the transfers; the dense coarse solve. They
+    // count half a sparse solve's operation each: the blocks (4-5 MB at 20 k tets) stay in cache across the cycle where a
     // factor (29 MB) streams from memory (measured: 0.6 ms per iteration, rotations included,
     // against 4.2 ms per solve on the 20,250-tet cube).
     const double blocks = static_cast<double>(blocks_.block_count());

@@ -138,13 +138,19 @@ void block_product_matches_the_sparse_product(void**) {
     for (size_t d = 0; d < n; ++d) assert_true(std::fabs(y[d] - z[d]) <= 1e-12 * (1.0 + std::fabs(y[d])));
 }
 
+// A multigrid built for the block (cells, turned by angle) at its rest shape and prepared
+// with its matrix and every node's rotation of turn.
+void prepare_block(int cells, double angle, double turn, Block& block, sh::WarpedMultigrid& multigrid) {
+    build_block(cells, angle, block);
+    multigrid.build(block.a, block.rest.data());
+    multigrid.prepare(block.a, rotations_of(static_cast<size_t>(block.a.dof_count()) / 3, turn).data());
+}
+
 void cycle_is_symmetric_positive_definite(void**) {
     Block block;
-    build_block(6, 0.0, block);
     sh::WarpedMultigrid multigrid;
-    multigrid.build(block.a, block.rest.data());
+    prepare_block(6, 0.0, 0.5, block, multigrid);  // any rotations: still SPD
     const size_t n = static_cast<size_t>(block.a.dof_count());
-    multigrid.prepare(block.a, rotations_of(n / 3, 0.5).data());  // any rotations: still SPD
     const std::vector<double> r1 = wave(n, 0.0), r2 = wave(n, 1.3);
     std::vector<double> z1(n), z2(n);
     multigrid.apply(r1.data(), z1.data());
@@ -159,11 +165,9 @@ void product_beside_the_cycle_is_the_matrix_times_its_output(void**) {
     // apply_with_product's A z comes from the sweep's changes, not from a product: it must
     // equal the sparse system's own product of the same z, and z must be apply()'s.
     Block block;
-    build_block(6, 0.7, block);
     sh::WarpedMultigrid multigrid;
-    multigrid.build(block.a, block.rest.data());
+    prepare_block(6, 0.7, 0.7, block, multigrid);
     const size_t n = static_cast<size_t>(block.a.dof_count());
-    multigrid.prepare(block.a, rotations_of(n / 3, 0.7).data());
     const std::vector<double> r = wave(n, 0.2);
     std::vector<double> z(n), az(n), plain(n), product(n);
     multigrid.apply(r.data(), plain.data());

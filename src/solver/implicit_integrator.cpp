@@ -206,6 +206,7 @@ private:
     void settle_update(double slope, double roundoff);
     /// Newton iterations the step may take.
     int iteration_cap() const;
+    bool touching() const;
     /// The scale the residual's tolerance is relative to.
     double residual_scale() const;
     /// Copies the current free velocities into the matrix's previous_v.
@@ -252,8 +253,10 @@ private:
     // The elastic and field energies at the positions the last evaluate() left.
     double evaluated_energy_ = 0.0;
     double field_push_ = 0.0;  // norm of the fields' push at the first iterate (N)
+    bool touched_ = false;  // a field (contact) pushed on a body or held energy at some evaluation this step
     bool first_evaluation_ = true;  // the next evaluate() is the step's first: it measures field_push_
-    bool work_done_ = false;  // moving tools, other bodies or prescribed nodes work on the bodies
+    bool work_done_ = false;  // prescribed nodes move: they work on the bodies
+    bool field_work_ = false;  // moving tools or other bodies work on the bodies once they touch
     bool energy_checked_ = false;  // the final iterate passed the linearised energy check
 };
 
@@ -280,11 +283,11 @@ double NewtonStep::mechanical_energy(EnergyAt at, double* scale) const {
     return kinetic + potential;
 }
 
-// With no work done on the bodies from outside (moving tools, other bodies, prescribed motion),
-// the minimiser of the step's potential does not raise their mechanical energy: true if the
+// With no work done on the bodies from outside (prescribed motion, or moving tools and other
+// bodies once they touch: candidates that have not touched did nothing), the minimiser of the step's potential does not raise their mechanical energy: true if the
 // current iterate raised it by more than fraction times its start's scale (or to non-finite).
 bool NewtonStep::energy_rose(double fraction, EnergyAt at) const {
-    if (work_done_) return false;
+    if (work_done_ || (field_work_ && touched_)) return false;
     const double energy = mechanical_energy(at, nullptr);
     return !std::isfinite(energy) || energy - energy0_ > fraction * energy_scale0_ + 1e-12;
 }
@@ -305,8 +308,8 @@ double NewtonStep::extent() const {
 }
 
 void NewtonStep::begin() {
-    work_done_ = false;
-    krylov_ = krylov_update_ = krylov_failed_ = assembled_ = in_contact_ = false;
+    work_done_ = field_work_ = false;
+    krylov_ = krylov_update_ = krylov_failed_ = assembled_ = in_contact_ = touched_ = false;
     problem_.each([&](const SteppedBody& stepped, size_t) { in_contact_ |= stepped.body->field != nullptr; });
     energy_checked_ = false;
     first_evaluation_ = true;
@@ -315,7 +318,7 @@ void NewtonStep::begin() {
         save_start_state(stepped);
         begin_kinematic_motion(body, dt_);
         for (size_t j = 0; j < body.v.size() && !work_done_; ++j) work_done_ = body.kinematic[j / 3] && body.v[j] != 0.0;
-        work_done_ = work_done_ || (body.field && body.field->does_work());
+        field_work_ = field_work_ || (body.field && body.field->does_work());
         // The internal damping's lagged base: elastic forces at the start state.
         if (!body.has_internal_damping()) return;
         vec<double>& base = stepped.workspace.stage_a[1];
@@ -393,9 +396,12 @@ void NewtonStep::evaluate() {
         double* f = stepped.workspace.stage_a[0].data();
         std::fill(f, f + body.x.size(), 0.0);
         // The field first: the step's first evaluation measures its push (iterate()).
-        if (body.field) body.field->add_forces(body.x.data(), body.v.data(), f);
-        if (first_evaluation_)
-            for (const int32_t j : state.matrix.system.dof_to_global()) push2 += f[static_cast<size_t>(j)] * f[static_cast<size_t>(j)];
+        double body_push2 = 0.0;
+        if (body.field) {
+            body.field->add_forces(body.x.data(), body.v.data(), f);
+            for (const int32_t j : state.matrix.system.dof_to_global()) body_push2 += f[static_cast<size_t>(j)] * f[static_cast<size_t>(j)];
+        }
+        push2 += body_push2;
         const Body::ElasticEnergy elastic = body.add_elastic_forces_and_energy(body.x.data(), f);
         double* damping = nullptr;  // -D0 v, the lagged internal damping force
         if (body.has_internal_damping()) {
@@ -406,6 +412,7 @@ void NewtonStep::evaluate() {
             for (size_t j = 0; j < body.x.size(); ++j) damping[j] -= base[j];
         }
         const double field_energy = body.field ? body.field->energy(body.x.data()) : 0.0;
+        touched_ = touched_ || body_push2 > 0.0 || field_energy != 0.0;
         const double field = body.field ? field_energy + h * body.field->dissipation(body.v.data()) : 0.0;
         evaluated_energy_ += elastic.value + field_energy;
         phi.value += elastic.value + field;
@@ -703,10 +710,15 @@ BodyStepResult NewtonStep::run(bool keep_best) {
 }
 
 // Newton iterations the step may take. Contacts switch on and off within a step, which a
-// single update cannot follow: a body in contact iterates.
+// single update cannot follow: a body in contact iterates. Candidates that have not touched
+// (a tool hovering near the organ) cost nothing: the step runs as without them until an
+// iterate touches, then iterate() raises the cap.
 int NewtonStep::iteration_cap() const {
-    return std::max(in_contact_ ? kContactNewtonIterations : 1, s_.newton_max_iterations);
+    return std::max(touching() ? kContactNewtonIterations : 1, s_.newton_max_iterations);
 }
+
+// A contact field pushed on a body or held energy at some iterate of this step.
+bool NewtonStep::touching() const { return in_contact_ && touched_; }
 
 // The residual's scale: the first one, or the impulse of the loads over the step, the field's
 // push at the first iterate counted with f_ext. A body held still against a tool balances that
@@ -760,7 +772,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
         const bool fresh = fresh_;
         if (!(slope < 0.0) || !line_search(slope, fresh)) {
             if (!fresh) {  // the kept factorisation is too far from the current tangent
-                krylov_ = !krylov_failed_ && !in_contact_ && krylov_pays();
+                krylov_ = !krylov_failed_ && !touching() && krylov_pays();
                 factor_current_ = krylov_;
                 continue;
             }
@@ -782,6 +794,10 @@ bool NewtonStep::iterate(bool& solver_failed) {
         factor_current_ = reuse_ && allow_stale_;  // exact Newton (or CG): a tangent per iterate
         ++result_.newton_iterations;
         result_.newton_residual = residual0 > 0.0 ? r_ / residual0 : 0.0;
+        if ((linearised || towards_minimiser) && touching()) {  // an update reached a contact: converge it
+            linearised = towards_minimiser = false;
+            max_iterations = iteration_cap();
+        }
         if (linearised) {
             // One update with the tangent at its iterate is the linearised step; updates with
             // a kept factorisation go on until they are as good as factor_reuse asks.

@@ -9,10 +9,26 @@
 namespace sh {
 namespace {
 
-double dot(const vec<double>& a, const vec<double>& b) {
+double dot(const double* a, const double* b, size_t n) {
     double s = 0.0;
-    for (size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
+    for (size_t i = 0; i < n; ++i) s += a[i] * b[i];
     return s;
+}
+
+double dot(const vec<double>& a, const vec<double>& b) { return dot(a.data(), b.data(), a.size()); }
+
+// x := c x with c = x^T b / x^T A x, the quadratic's minimiser along x (0 where c is not
+// positive and finite: a guess pointing uphill, or none), and r := b - A x.
+void start_along(const std::function<void(const double*, double*)>& multiply, const double* b, double* x,
+                 vec<double>& r, vec<double>& ax) {
+    const size_t n = r.size();
+    multiply(x, ax.data());
+    const double c = dot(x, b, n) / dot(x, ax.data(), n);
+    const bool along = std::isfinite(c) && c > 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        x[i] = along ? c * x[i] : 0.0;
+        r[i] = along ? b[i] - c * ax[i] : b[i];
+    }
 }
 
 }  // namespace
@@ -23,16 +39,18 @@ void PreconditionedCgWork::resize(size_t n) {
 }
 
 PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::function<void(const double*, double*)>& multiply,
-                                               Preconditioner& preconditioner, const double* b, double* x,
+                                               Preconditioner& preconditioner, const double* b, double* x, bool warm,
                                                double tolerance, int max_iterations, PreconditionedCgWork& work) {
     const double t0 = now_seconds();
     PreconditionedCgResult out;
     const size_t n = static_cast<size_t>(dof_count);
     vec<double>&r = work.r, &z = work.z, &p = work.p, &q = work.q;
-    for (size_t i = 0; i < n; ++i) x[i] = 0.0, r[i] = b[i];
-    const double b_norm = std::sqrt(dot(r, r));
-    out.relative_residual = b_norm > 0.0 ? 1.0 : 0.0;
-    out.converged = !(b_norm > 0.0);
+    const double b_norm = std::sqrt(dot(b, b, n));
+    if (warm && b_norm > 0.0) start_along(multiply, b, x, r, q);
+    else
+        for (size_t i = 0; i < n; ++i) x[i] = 0.0, r[i] = b[i];
+    out.relative_residual = b_norm > 0.0 ? std::sqrt(dot(r, r)) / b_norm : 0.0;
+    out.converged = out.relative_residual <= tolerance;
     if (out.converged) return out;
     // q = A p: from the preconditioner's A z where it gives it (the same for every apply).
     const bool fused = preconditioner.apply_with_product(r.data(), z.data(), q.data());
@@ -77,8 +95,8 @@ PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolv
         void apply(const double* r, double* z) override { solver.solve(a, r, z); }
     } factorisation(a, preconditioner);
     return solve_preconditioned_cg(
-        a.dof_count(), [&](const double* in, double* out) { a.multiply(in, out); }, factorisation, b, x, tolerance,
-        max_iterations, work);
+        a.dof_count(), [&](const double* in, double* out) { a.multiply(in, out); }, factorisation, b, x, false,
+        tolerance, max_iterations, work);
 }
 
 }  // namespace sh

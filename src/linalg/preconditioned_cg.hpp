@@ -56,9 +56,13 @@ PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolv
 
 /// The same with any preconditioner; multiply(x, y) computes y = A x. Where the
 /// preconditioner returns A z beside z (apply_with_product), A p follows from the recurrence
-/// A p = A z + beta A p_old, and multiply serves only where it does not.
+/// A p = A z + beta A p_old, and multiply serves only where it does not. With warm, x holds on
+/// entry a direction to start along (the solution of a nearby system, such as the last time
+/// step's): CG starts from its multiple that minimises the quadratic, c = x^T b / x^T A x, for
+/// one more product, or from 0 where c is not positive and finite. The quadratic is then below
+/// its value at 0 from the start, so every iterate is still a descent direction.
 PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::function<void(const double*, double*)>& multiply,
-                                               Preconditioner& preconditioner, const double* b, double* x,
+                                               Preconditioner& preconditioner, const double* b, double* x, bool warm,
                                                double tolerance, int max_iterations, PreconditionedCgWork& work);
 
 }  // namespace sh

@@ -187,13 +187,85 @@ void negative_curvature_stops(void**) {
     for (const double v : x) assert_true(v == 0.0);
 }
 
+// solve_preconditioned_cg started along x's entry values (warm), preconditioned by solver.
+sh::PreconditionedCgResult warm_cg(const sh::SparseSystem& a, sh::LinearSolver& solver, const std::vector<double>& b,
+                                   std::vector<double>& x, double tolerance, int max_iterations) {
+    struct Factorisation final : sh::Preconditioner {
+        const sh::SparseSystem& a;
+        sh::LinearSolver& solver;
+        Factorisation(const sh::SparseSystem& a_, sh::LinearSolver& solver_) : a(a_), solver(solver_) {}
+        void apply(const double* r, double* z) override { solver.solve(a, r, z); }
+    } factorisation(a, solver);
+    sh::PreconditionedCgWork work;
+    work.resize(b.size());
+    return sh::solve_preconditioned_cg(
+        a.dof_count(), [&](const double* in, double* out) { a.multiply(in, out); }, factorisation, b.data(), x.data(),
+        true, tolerance, max_iterations, work);
+}
+
+// Started along the solution of a nearby system (the last time step's), CG needs fewer
+// iterations to the same solution, and every capped iterate is still a descent direction.
+void warm_start_along_a_nearby_solution(void**) {
+    sh::SparseSystem a;
+    assemble(a, 10.0, -0.4);  // a poor preconditioner, as the multigrid is on a hard system
+    sh::LinearSolverPtr preconditioner = factorised(a);
+    const size_t n = static_cast<size_t>(a.dof_count());
+    const std::vector<double> b = right_hand_side(n);
+    assemble(a, 49.0, 0.22);  // the nearby system
+    std::vector<double> nearby(n), reference(n);
+    factorised(a)->solve(a, b.data(), nearby.data());
+    assemble(a, 50.0, 0.2);  // the current one
+    factorised(a)->solve(a, b.data(), reference.data());
+    // To an inexact Newton update's tolerance (cold: 7 iterations, warm: 3) and to 1e-10.
+    std::vector<double> cold(n), warm = nearby;
+    const int cold_iterations = cg(a, *preconditioner, b, cold, 1e-3, 50).iterations;
+    assert_true(warm_cg(a, *preconditioner, b, warm, 1e-3, 50).iterations < cold_iterations - 2);
+    warm = nearby;
+    assert_true(warm_cg(a, *preconditioner, b, warm, 1e-10, 50).converged);
+    for (size_t d = 0; d < n; ++d) assert_true(std::fabs(warm[d] - reference[d]) <= 1e-8 * std::fabs(reference[d]) + 1e-12);
+    for (int cap = 1; cap <= 3; ++cap) {
+        std::vector<double> x = nearby;
+        warm_cg(a, *preconditioner, b, x, 1e-14, cap);
+        double bx = 0.0;
+        for (size_t d = 0; d < n; ++d) bx += b[d] * x[d];
+        assert_true(bx > 0.0);
+        assert_true(quadratic(a, b, x) < 0.0);
+    }
+}
+
+// Started along the exact solution, CG is done without an iteration; along a direction
+// that points uphill, or one that is not finite, it starts from 0 as a cold solve does.
+void warm_start_takes_only_a_downhill_direction(void**) {
+    sh::SparseSystem a;
+    assemble(a, 30.0, 0.3);
+    sh::LinearSolverPtr solver = factorised(a);
+    sh::LinearSolverPtr preconditioner = factorised(a);
+    const size_t n = static_cast<size_t>(a.dof_count());
+    const std::vector<double> b = right_hand_side(n);
+    std::vector<double> exact(n);
+    solver->solve(a, b.data(), exact.data());
+    std::vector<double> x = exact;
+    const sh::PreconditionedCgResult at_solution = warm_cg(a, *preconditioner, b, x, 1e-10, 10);
+    assert_true(at_solution.converged);
+    assert_int_equal(at_solution.iterations, 0);
+    for (size_t d = 0; d < n; ++d) assert_true(std::fabs(x[d] - exact[d]) <= 1e-10 * std::fabs(exact[d]) + 1e-14);
+    std::vector<double> cold(n);
+    const int cold_iterations = cg(a, *preconditioner, b, cold, 1e-12, 10).iterations;
+    for (const double sign : {-1.0, std::nan("")}) {
+        for (size_t d = 0; d < n; ++d) x[d] = sign * exact[d];
+        assert_int_equal(warm_cg(a, *preconditioner, b, x, 1e-12, 10).iterations, cold_iterations);
+        for (size_t d = 0; d < n; ++d) assert_true(x[d] == cold[d]);
+    }
+}
+
 }  // namespace
 
 int main() {
     const CMUnitTest tests[] = {
         cmocka_unit_test(product_matches_the_dense_matrix),  cmocka_unit_test(nearby_factorisation_preconditions),
         cmocka_unit_test(iterates_descend),                  cmocka_unit_test(exact_factorisation_takes_one_iteration),
-        cmocka_unit_test(negative_curvature_stops),
+        cmocka_unit_test(negative_curvature_stops),         cmocka_unit_test(warm_start_along_a_nearby_solution),
+        cmocka_unit_test(warm_start_takes_only_a_downhill_direction),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -95,8 +95,8 @@ int cg_iterations(const sh::SparseSystem& a, sh::WarpedMultigrid& multigrid, con
     work.resize(n);
     std::vector<double> x(n);
     const sh::PreconditionedCgResult result = sh::solve_preconditioned_cg(
-        a.dof_count(), [&](const double* in, double* out) { a.multiply(in, out); }, multigrid, b.data(), x.data(), 1e-8,
-        500, work);
+        a.dof_count(), [&](const double* in, double* out) { a.multiply(in, out); }, multigrid, b.data(), x.data(), false,
+        1e-8, 500, work);
     assert_true(result.converged);
     return result.iterations;
 }

@@ -742,7 +742,7 @@ void NewtonStep::keep_velocities() {
 // stopped because the linear solver failed.
 bool NewtonStep::iterate(bool& solver_failed) {
     int max_iterations = iteration_cap();
-    bool linearised = max_iterations == 1;
+    bool linearised = max_iterations == 1, contact_mode = touching();
     const double residual0 = residual_scale();
     const double gravity_norm = std::sqrt(g_[0] * g_[0] + g_[1] * g_[1] + g_[2] * g_[2]);
     // A linearised step's updates with a kept factorisation go on until both norms are down
@@ -794,9 +794,11 @@ bool NewtonStep::iterate(bool& solver_failed) {
         factor_current_ = reuse_ && allow_stale_;  // exact Newton (or CG): a tangent per iterate
         ++result_.newton_iterations;
         result_.newton_residual = residual0 > 0.0 ? r_ / residual0 : 0.0;
-        if ((linearised || towards_minimiser) && touching()) {  // an update reached a contact: converge it
+        if (!contact_mode && touching()) {  // an update reached a contact: converge it as contact does
+            contact_mode = true;
             linearised = towards_minimiser = false;
             max_iterations = iteration_cap();
+            if (krylov_) give_up_krylov();  // contact's updates are exact, as they always were
         }
         if (linearised) {
             // One update with the tangent at its iterate is the linearised step; updates with

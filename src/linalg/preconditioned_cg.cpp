@@ -51,7 +51,10 @@ PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::fun
         for (size_t i = 0; i < n; ++i) x[i] = 0.0, r[i] = b[i];
     out.relative_residual = b_norm > 0.0 ? std::sqrt(dot(r, r)) / b_norm : 0.0;
     out.converged = out.relative_residual <= tolerance;
-    if (out.converged) return out;
+    if (out.converged) {  // b = 0, or the start along x already meets the tolerance
+        out.seconds = now_seconds() - t0;
+        return out;
+    }
     // q = A p: from the preconditioner's A z where it gives it (the same for every apply).
     const bool fused = preconditioner.apply_with_product(r.data(), z.data(), q.data());
     std::copy(z.begin(), z.end(), p.begin());

@@ -91,12 +91,7 @@ PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::fun
 PreconditionedCgResult solve_preconditioned_cg(const SparseSystem& a, LinearSolver& preconditioner, const double* b,
                                                double* x, double tolerance, int max_iterations,
                                                PreconditionedCgWork& work) {
-    struct Factorisation final : Preconditioner {
-        const SparseSystem& a;
-        LinearSolver& solver;
-        Factorisation(const SparseSystem& a_, LinearSolver& solver_) : a(a_), solver(solver_) {}
-        void apply(const double* r, double* z) override { solver.solve(a, r, z); }
-    } factorisation(a, preconditioner);
+    FactorisationPreconditioner factorisation(a, preconditioner);
     return solve_preconditioned_cg(
         a.dof_count(), [&](const double* in, double* out) { a.multiply(in, out); }, factorisation, b, x, false,
         tolerance, max_iterations, work);

@@ -25,6 +25,19 @@ public:
     }
 };
 
+/// A direct solver's factorisation of a matrix with a's pattern as the preconditioner:
+/// z = (factorised matrix)^-1 r.
+class FactorisationPreconditioner final : public Preconditioner {
+public:
+    /// Keeps references to both: they must outlive it.
+    FactorisationPreconditioner(const SparseSystem& a, LinearSolver& solver) : a_(a), solver_(solver) {}
+    void apply(const double* r, double* z) override { solver_.solve(a_, r, z); }
+
+private:
+    const SparseSystem& a_;
+    LinearSolver& solver_;
+};
+
 /// solve_preconditioned_cg's vectors, kept by its caller beside the matrix so that a solve
 /// allocates nothing (sized for a.dof_count() by resize).
 struct PreconditionedCgWork {

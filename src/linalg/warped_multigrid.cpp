@@ -320,9 +320,9 @@ double WarpedMultigrid::iteration_work() const {
     // 18 operations per stored block for three and a half passes' worth: the first sweep with
     // its residual (one pass, measured no cheaper than 1.7 of the others), the backward sweep
     // and the half product CG's A p takes from it; the transfers; the dense coarse solve. They
-    // count half a sparse solve's operation each: the blocks (4-5 MB at 20 k tets) stay in cache across the cycle where a
-    // factor (29 MB) streams from memory (measured: 0.6 ms per iteration, rotations included,
-    // against 4.2 ms per solve on the 20,250-tet cube).
+    // count half a sparse solve's operation each: the blocks (4-5 MB at 20 k tets) stay in
+    // cache across the cycle where a factor (29 MB) streams from memory (measured: 0.6 ms per
+    // iteration, rotations included, against 4.2 ms per solve on the 20,250-tet cube).
     const double blocks = static_cast<double>(blocks_.block_count());
     const double coarse = 3.0 * coarse_count_;
     return 0.5 * (3.5 * 18.0 * blocks + 120.0 * blocks_.node_count() + 2.0 * coarse * coarse);

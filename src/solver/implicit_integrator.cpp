@@ -206,7 +206,6 @@ private:
     void settle_update(double slope, double roundoff);
     /// Newton iterations the step may take.
     int iteration_cap() const;
-    bool touching() const;
     /// The scale the residual's tolerance is relative to.
     double residual_scale() const;
     /// Copies the current free velocities into the matrix's previous_v.
@@ -253,7 +252,9 @@ private:
     // The elastic and field energies at the positions the last evaluate() left.
     double evaluated_energy_ = 0.0;
     double field_push_ = 0.0;  // norm of the fields' push at the first iterate (N)
-    bool touched_ = false;  // a field (contact) pushed on a body or held energy at some evaluation this step
+    // A contact field pushed on a body or held energy at some evaluation this step (a body
+    // with contact candidates that have not touched steps as one without them).
+    bool touched_ = false;
     bool first_evaluation_ = true;  // the next evaluate() is the step's first: it measures field_push_
     bool work_done_ = false;  // prescribed nodes move: they work on the bodies
     bool field_work_ = false;  // moving tools or other bodies work on the bodies once they touch
@@ -284,8 +285,9 @@ double NewtonStep::mechanical_energy(EnergyAt at, double* scale) const {
 }
 
 // With no work done on the bodies from outside (prescribed motion, or moving tools and other
-// bodies once they touch: candidates that have not touched did nothing), the minimiser of the step's potential does not raise their mechanical energy: true if the
-// current iterate raised it by more than fraction times its start's scale (or to non-finite).
+// bodies once they touch: candidates that have not touched did nothing), the minimiser of the
+// step's potential does not raise their mechanical energy: true if the current iterate raised
+// it by more than fraction times its start's scale (or to non-finite).
 bool NewtonStep::energy_rose(double fraction, EnergyAt at) const {
     if (work_done_ || (field_work_ && touched_)) return false;
     const double energy = mechanical_energy(at, nullptr);
@@ -395,11 +397,14 @@ void NewtonStep::evaluate() {
         const NewtonBodyState& state = *stepped.newton;
         double* f = stepped.workspace.stage_a[0].data();
         std::fill(f, f + body.x.size(), 0.0);
-        // The field first: the step's first evaluation measures its push (iterate()).
+        // The field first: its push on the free DOFs, for the step's first evaluation
+        // (iterate()) and until it has touched.
         double body_push2 = 0.0;
         if (body.field) {
             body.field->add_forces(body.x.data(), body.v.data(), f);
-            for (const int32_t j : state.matrix.system.dof_to_global()) body_push2 += f[static_cast<size_t>(j)] * f[static_cast<size_t>(j)];
+            if (first_evaluation_ || !touched_)
+                for (const int32_t j : state.matrix.system.dof_to_global())
+                    body_push2 += f[static_cast<size_t>(j)] * f[static_cast<size_t>(j)];
         }
         push2 += body_push2;
         const Body::ElasticEnergy elastic = body.add_elastic_forces_and_energy(body.x.data(), f);
@@ -714,11 +719,8 @@ BodyStepResult NewtonStep::run(bool keep_best) {
 // (a tool hovering near the organ) cost nothing: the step runs as without them until an
 // iterate touches, then iterate() raises the cap.
 int NewtonStep::iteration_cap() const {
-    return std::max(touching() ? kContactNewtonIterations : 1, s_.newton_max_iterations);
+    return std::max(touched_ ? kContactNewtonIterations : 1, s_.newton_max_iterations);
 }
-
-// A contact field pushed on a body or held energy at some iterate of this step.
-bool NewtonStep::touching() const { return in_contact_ && touched_; }
 
 // The residual's scale: the first one, or the impulse of the loads over the step, the field's
 // push at the first iterate counted with f_ext. A body held still against a tool balances that
@@ -742,7 +744,7 @@ void NewtonStep::keep_velocities() {
 // stopped because the linear solver failed.
 bool NewtonStep::iterate(bool& solver_failed) {
     int max_iterations = iteration_cap();
-    bool linearised = max_iterations == 1, contact_mode = touching();
+    bool linearised = max_iterations == 1, contact_mode = touched_;
     const double residual0 = residual_scale();
     const double gravity_norm = std::sqrt(g_[0] * g_[0] + g_[1] * g_[1] + g_[2] * g_[2]);
     // A linearised step's updates with a kept factorisation go on until both norms are down
@@ -772,7 +774,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
         const bool fresh = fresh_;
         if (!(slope < 0.0) || !line_search(slope, fresh)) {
             if (!fresh) {  // the kept factorisation is too far from the current tangent
-                krylov_ = !krylov_failed_ && !touching() && krylov_pays();
+                krylov_ = !krylov_failed_ && !touched_ && krylov_pays();
                 factor_current_ = krylov_;
                 continue;
             }
@@ -794,7 +796,7 @@ bool NewtonStep::iterate(bool& solver_failed) {
         factor_current_ = reuse_ && allow_stale_;  // exact Newton (or CG): a tangent per iterate
         ++result_.newton_iterations;
         result_.newton_residual = residual0 > 0.0 ? r_ / residual0 : 0.0;
-        if (!contact_mode && touching()) {  // an update reached a contact: converge it as contact does
+        if (!contact_mode && touched_) {  // an update reached a contact: converge it as contact does
             contact_mode = true;
             linearised = towards_minimiser = false;
             max_iterations = iteration_cap();

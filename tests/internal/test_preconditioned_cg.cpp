@@ -190,12 +190,7 @@ void negative_curvature_stops(void**) {
 // solve_preconditioned_cg started along x's entry values (warm), preconditioned by solver.
 sh::PreconditionedCgResult warm_cg(const sh::SparseSystem& a, sh::LinearSolver& solver, const std::vector<double>& b,
                                    std::vector<double>& x, double tolerance, int max_iterations) {
-    struct Factorisation final : sh::Preconditioner {
-        const sh::SparseSystem& a;
-        sh::LinearSolver& solver;
-        Factorisation(const sh::SparseSystem& a_, sh::LinearSolver& solver_) : a(a_), solver(solver_) {}
-        void apply(const double* r, double* z) override { solver.solve(a, r, z); }
-    } factorisation(a, solver);
+    sh::FactorisationPreconditioner factorisation(a, solver);
     sh::PreconditionedCgWork work;
     work.resize(b.size());
     return sh::solve_preconditioned_cg(

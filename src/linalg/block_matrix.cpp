@@ -15,6 +15,9 @@ int32_t find_block(const vec<int32_t>& row_start, const vec<int32_t>& column, in
     return found != last && *found == col ? static_cast<int32_t>(found - column.data()) : -1;
 }
 
+// Index in columns_'s doubles of entry (row, col) of block k.
+int32_t lane_slot(int32_t k, int32_t row, int32_t col) { return 4 * (3 * k + col) + row; }
+
 }  // namespace
 
 void BlockMatrix::build_pattern(const SparseSystem& system) {
@@ -54,12 +57,12 @@ void BlockMatrix::build_pattern(const SparseSystem& system) {
             const int32_t own = find_block(row_start, column, r / 3, c / 3);
             const int32_t other = find_block(row_start, column, c / 3, r / 3);
             SH_REQUIRE(own >= 0 && other >= 0, SH_ERR_INTERNAL, "block matrix: entry (%d, %d) has no block", r, c);
-            slot[static_cast<size_t>(k)] = 9 * own + 3 * (r % 3) + c % 3;
-            mirror[static_cast<size_t>(k)] = 9 * other + 3 * (c % 3) + r % 3;
+            slot[static_cast<size_t>(k)] = lane_slot(own, r % 3, c % 3);
+            mirror[static_cast<size_t>(k)] = lane_slot(other, c % 3, r % 3);
         }
-    vec<double> values(9 * column.size(), 0.0);
+    vec<Node4> columns(3 * column.size(), Node4{});
     row_start_.swap(row_start), column_.swap(column), diagonal_.swap(diagonal);
-    slot_.swap(slot), mirror_.swap(mirror), values_.swap(values);
+    slot_.swap(slot), mirror_.swap(mirror), columns_.swap(columns);
     node_count_ = n;
     pattern_id_ = system.pattern_id();
 }
@@ -67,23 +70,19 @@ void BlockMatrix::build_pattern(const SparseSystem& system) {
 void BlockMatrix::load_values(const SparseSystem& system) {
     SH_REQUIRE(matches(system), SH_ERR_INTERNAL, "block matrix: values of another pattern");
     const double* v = system.values().data();
+    double* lanes = reinterpret_cast<double*>(columns_.data());  // GCC: a vector aliases its element type
     for (size_t k = 0; k < slot_.size(); ++k) {
-        values_[static_cast<size_t>(slot_[k])] = v[k];
-        values_[static_cast<size_t>(mirror_[k])] = v[k];
+        lanes[static_cast<size_t>(slot_[k])] = v[k];
+        lanes[static_cast<size_t>(mirror_[k])] = v[k];
     }
 }
 
 void BlockMatrix::multiply(const double* x, double* y) const {
     for (int32_t i = 0; i < node_count_; ++i) {
-        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-        for (int32_t k = row_start_[static_cast<size_t>(i)]; k < row_start_[static_cast<size_t>(i) + 1]; ++k) {
-            const double* b = &values_[9 * static_cast<size_t>(k)];
-            const double* xj = x + 3 * static_cast<size_t>(column_[static_cast<size_t>(k)]);
-            s0 += b[0] * xj[0] + b[1] * xj[1] + b[2] * xj[2];
-            s1 += b[3] * xj[0] + b[4] * xj[1] + b[5] * xj[2];
-            s2 += b[6] * xj[0] + b[7] * xj[1] + b[8] * xj[2];
-        }
-        y[3 * static_cast<size_t>(i)] = s0, y[3 * static_cast<size_t>(i) + 1] = s1, y[3 * static_cast<size_t>(i) + 2] = s2;
+        Node4 s{};
+        for (int32_t k = row_start_[static_cast<size_t>(i)]; k < row_start_[static_cast<size_t>(i) + 1]; ++k)
+            s += block_times(block(k), load_node(x + 3 * static_cast<size_t>(column_[static_cast<size_t>(k)])));
+        store_node(s, y + 3 * static_cast<size_t>(i));
     }
 }
 

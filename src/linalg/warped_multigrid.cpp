@@ -9,26 +9,6 @@
 namespace sh {
 namespace {
 
-// s -= A_k z_j for stored block k = (i, j) of a.
-inline void subtract_block_product(const BlockMatrix& a, int32_t k, const double* z, double (&s)[3]) {
-    const double* b = a.block(k);
-    const double* zj = z + 3 * static_cast<size_t>(a.column()[k]);
-    s[0] -= b[0] * zj[0] + b[1] * zj[1] + b[2] * zj[2];
-    s[1] -= b[3] * zj[0] + b[4] * zj[1] + b[5] * zj[2];
-    s[2] -= b[6] * zj[0] + b[7] * zj[1] + b[8] * zj[2];
-}
-
-// s -= the sum of A_k x_j over the stored blocks first <= k < last (a range of one row).
-inline void subtract_row_blocks(const BlockMatrix& a, int32_t first, int32_t last, const double* x, double (&s)[3]) {
-    for (int32_t k = first; k < last; ++k) subtract_block_product(a, k, x, s);
-}
-
-// out = d s for a 3x3 block d (row-major): a node's Gauss-Seidel update from its inverse
-// diagonal block.
-inline void block_times(const double* d, const double (&s)[3], double* out) {
-    for (int c = 0; c < 3; ++c) out[c] = d[3 * c] * s[0] + d[3 * c + 1] * s[1] + d[3 * c + 2] * s[2];
-}
-
 // Free nodes per coarse node the grid aims at: about 4 fine cells per coarse cell along each
 // axis on a structured mesh (4x4x4 coarse cells for a 15^3-cell cube: 5-7 CG iterations to a
 // relative residual of 0.025 through large rotations). Finer grids cost more per cycle than
@@ -189,7 +169,9 @@ void WarpedMultigrid::build_coarse() {
     for (int32_t a = 0; a < blocks_.node_count(); ++a)
         for (int32_t k = blocks_.row_start()[a]; k < blocks_.row_start()[a + 1]; ++k) {
             const int32_t b = blocks_.column()[k];
-            const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> block(blocks_.block(k));
+            Eigen::Matrix3d block;
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) block(r, c) = blocks_.entry(k, r, c);
             for (int p = 0; p < 8; ++p) {
                 const int32_t I = corner_[8 * static_cast<size_t>(a) + p];
                 if (I < 0) continue;
@@ -215,10 +197,11 @@ void WarpedMultigrid::build(const SparseSystem& a0, const double* rest) {
     const int32_t nodes = blocks_.node_count();
     build_prolongation(rest, nodes);
     build_coarse();
-    inverse_diagonal_.assign(9 * static_cast<size_t>(nodes), 0.0);
+    inverse_diagonal_.assign(3 * static_cast<size_t>(nodes), Node4{});
     rotation_.assign(9 * static_cast<size_t>(nodes), 0.0);
-    residual_.assign(3 * static_cast<size_t>(nodes), 0.0);
-    change_.assign(3 * static_cast<size_t>(nodes), 0.0);
+    z_.assign(static_cast<size_t>(nodes), Node4{});
+    residual_.assign(static_cast<size_t>(nodes), Node4{});
+    change_.assign(static_cast<size_t>(nodes), Node4{});
     built_ = true;
 }
 
@@ -227,53 +210,51 @@ void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
     blocks_.load_values(a);
     std::copy(rotations, rotations + rotation_.size(), rotation_.begin());
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
-        const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> d(blocks_.block(blocks_.diagonal(i)));
+        Eigen::Matrix3d d;
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) d(r, c) = blocks_.entry(blocks_.diagonal(i), r, c);
         const Eigen::LLT<Eigen::Matrix3d> cholesky(d);
         const Eigen::Matrix3d inverse = cholesky.solve(Eigen::Matrix3d::Identity());
         SH_REQUIRE(cholesky.info() == Eigen::Success && inverse.allFinite(), SH_ERR_SOLVER,
                    "multigrid: the diagonal block of free node %d is not positive definite", i);
-        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> out(&inverse_diagonal_[9 * static_cast<size_t>(i)]);
-        out = inverse;
+        for (int c = 0; c < 3; ++c)
+            inverse_diagonal_[3 * static_cast<size_t>(i) + static_cast<size_t>(c)] =
+                Node4{inverse(0, c), inverse(1, c), inverse(2, c), 0.0};
     }
 }
 
 void WarpedMultigrid::backward_sweep(const double* r, double* z) {
+    const int32_t* start = blocks_.row_start();
     for (int32_t i = blocks_.node_count() - 1; i >= 0; --i) {
-        double s[3] = {r[3 * static_cast<size_t>(i)], r[3 * static_cast<size_t>(i) + 1], r[3 * static_cast<size_t>(i) + 2]};
-        subtract_row_blocks(blocks_, blocks_.row_start()[i], blocks_.diagonal(i), z, s);
-        subtract_row_blocks(blocks_, blocks_.diagonal(i) + 1, blocks_.row_start()[i + 1], z, s);
-        double* zi = z + 3 * static_cast<size_t>(i);
-        double updated[3];
-        block_times(&inverse_diagonal_[9 * static_cast<size_t>(i)], s, updated);
-        for (int c = 0; c < 3; ++c) {
-            change_[3 * static_cast<size_t>(i) + static_cast<size_t>(c)] = updated[c] - zi[c];
-            zi[c] = updated[c];
-        }
+        const size_t n = static_cast<size_t>(i);
+        const int32_t diagonal = blocks_.diagonal(i);
+        Node4 s = blocks_.subtract_row_blocks(start[i], diagonal, z_.data(), load_node(r + 3 * n));
+        s = blocks_.subtract_row_blocks(diagonal + 1, start[i + 1], z_.data(), s);
+        const Node4 updated = block_times(&inverse_diagonal_[3 * n], s);
+        change_[n] = updated - z_[n];
+        z_[n] = updated;
+        store_node(updated, z + 3 * n);
     }
 }
 
-void WarpedMultigrid::first_sweep(const double* r, double* z) {
+void WarpedMultigrid::first_sweep(const double* r) {
     const int32_t n = blocks_.node_count();
     const int32_t* start = blocks_.row_start();
-    std::fill(z, z + 3 * static_cast<size_t>(n), 0.0);
+    std::fill(z_.begin(), z_.end(), Node4{});
     for (int32_t i = 0; i < n; ++i) {
-        double s[3] = {r[3 * static_cast<size_t>(i)], r[3 * static_cast<size_t>(i) + 1], r[3 * static_cast<size_t>(i) + 2]};
-        subtract_row_blocks(blocks_, start[i], blocks_.diagonal(i), z, s);
-        block_times(&inverse_diagonal_[9 * static_cast<size_t>(i)], s, z + 3 * static_cast<size_t>(i));
+        const Node4 s = blocks_.subtract_row_blocks(start[i], blocks_.diagonal(i), z_.data(), load_node(r + 3 * static_cast<size_t>(i)));
+        z_[static_cast<size_t>(i)] = block_times(&inverse_diagonal_[3 * static_cast<size_t>(i)], s);
     }
-    for (int32_t i = 0; i < n; ++i) {
-        double s[3] = {0.0, 0.0, 0.0};
-        subtract_row_blocks(blocks_, blocks_.diagonal(i) + 1, start[i + 1], z, s);
-        std::copy(s, s + 3, &residual_[3 * static_cast<size_t>(i)]);
-    }
+    for (int32_t i = 0; i < n; ++i)
+        residual_[static_cast<size_t>(i)] = blocks_.subtract_row_blocks(blocks_.diagonal(i) + 1, start[i + 1], z_.data(), Node4{});
 }
 
-void WarpedMultigrid::coarse_correction(double* z) {
+void WarpedMultigrid::coarse_correction() {
     const int32_t n = blocks_.node_count();
     coarse_rhs_.setZero();
     for (int32_t i = 0; i < n; ++i) {
         const double* R = &rotation_[9 * static_cast<size_t>(i)];
-        const double* e = &residual_[3 * static_cast<size_t>(i)];
+        const Node4 e = residual_[static_cast<size_t>(i)];
         double local[3];
         for (int c = 0; c < 3; ++c) local[c] = R[c] * e[0] + R[3 + c] * e[1] + R[6 + c] * e[2];  // R^T e
         for (int p = 0; p < 8; ++p) {
@@ -293,25 +274,26 @@ void WarpedMultigrid::coarse_correction(double* z) {
             for (int c = 0; c < 3; ++c) local[c] += w * coarse_rhs_[3 * I + c];
         }
         const double* R = &rotation_[9 * static_cast<size_t>(i)];
-        double* zi = z + 3 * static_cast<size_t>(i);
+        Node4& zi = z_[static_cast<size_t>(i)];
         for (int c = 0; c < 3; ++c) zi[c] += R[3 * c] * local[0] + R[3 * c + 1] * local[1] + R[3 * c + 2] * local[2];
     }
 }
 
 void WarpedMultigrid::apply(const double* r, double* z) {
-    first_sweep(r, z);
-    coarse_correction(z);
+    first_sweep(r);
+    coarse_correction();
     backward_sweep(r, z);
 }
 
 bool WarpedMultigrid::apply_with_product(const double* r, double* z, double* az) {
     apply(r, z);
     // Node i's sweep solved its row for r with the nodes before it (j < i) not yet changed:
-    // (A z)_i = r_i + sum over j < i of A_ij change_j = r_i - s.
+    // (A z)_i = r_i + sum over j < i of A_ij change_j.
+    const int32_t* start = blocks_.row_start();
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
-        double s[3] = {0.0, 0.0, 0.0};
-        subtract_row_blocks(blocks_, blocks_.row_start()[i], blocks_.diagonal(i), change_.data(), s);
-        for (size_t c = 0; c < 3; ++c) az[3 * static_cast<size_t>(i) + c] = r[3 * static_cast<size_t>(i) + c] - s[c];
+        const size_t n = static_cast<size_t>(i);
+        store_node(load_node(r + 3 * n) - blocks_.subtract_row_blocks(start[i], blocks_.diagonal(i), change_.data(), Node4{}),
+                   az + 3 * n);
     }
     return true;
 }

@@ -61,28 +61,29 @@ private:
     int32_t split_by_connection(int32_t nodes);
     /// coarse_ := P^T A0 P (A0 in blocks_) and its Cholesky factor.
     void build_coarse();
-    /// One block Gauss-Seidel sweep over the nodes backward, on z towards r; change_ := what
-    /// it added to z.
+    /// One block Gauss-Seidel sweep over the nodes backward, on z_ towards r; change_ := what
+    /// it added to z_, and z := z_ (3 per node).
     void backward_sweep(const double* r, double* z);
-    /// The forward sweep from z = 0, then residual_ = r - A z. From zero only the blocks left
-    /// of the diagonal meet a nonzero z, and the sweep zeroes each row's residual up to its
-    /// diagonal, so that r - A z = -U z (U the blocks right of it): one pass over the blocks
-    /// where a full sweep and a product make two.
-    void first_sweep(const double* r, double* z);
-    /// z += R P (coarse solve of P^T R^T residual_).
-    void coarse_correction(double* z);
+    /// The forward sweep from z_ = 0, then residual_ = r - A z_. From zero only the blocks
+    /// left of the diagonal meet a nonzero z_, and the sweep zeroes each row's residual up to
+    /// its diagonal, so that r - A z_ = -U z_ (U the blocks right of it): one pass over the
+    /// blocks where a full sweep and a product make two.
+    void first_sweep(const double* r);
+    /// z_ += R P (coarse solve of P^T R^T residual_).
+    void coarse_correction();
 
     bool built_ = false;
     BlockMatrix blocks_;           // the current matrix (A0 while building)
-    vec<double> inverse_diagonal_; // 9 per node: the current diagonal blocks' inverses
+    vec<Node4> inverse_diagonal_;  // 3 columns per node: the current diagonal blocks' inverses
     vec<double> rotation_;         // 9 per node
     vec<int32_t> corner_;          // 8 per node: the coarse nodes of its grid cell (-1: weight 0)
     vec<double> weight_;           // 8 per node: their trilinear weights
     int32_t coarse_count_ = 0;
     Eigen::LLT<Eigen::MatrixXd> coarse_;  // factor of P^T A0 P (3 per coarse node)
     Eigen::VectorXd coarse_rhs_;          // restricted residual, then the coarse solution
-    vec<double> residual_;                // 3 per node
-    vec<double> change_;                  // 3 per node: the backward sweep's change of z
+    vec<Node4> z_;                        // the cycle's iterate
+    vec<Node4> residual_;                 // r - A z_ after the first sweep
+    vec<Node4> change_;                   // the backward sweep's change of z_
     vec<int32_t> scratch_;                // the grid's node numbers, then the union-find's parents
 };
 

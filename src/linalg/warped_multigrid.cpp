@@ -139,10 +139,9 @@ int32_t WarpedMultigrid::split_by_connection(int32_t nodes) {
     vec<int32_t>& parent = scratch_;
     parent.resize(8 * static_cast<size_t>(nodes));
     for (size_t a = 0; a < parent.size(); ++a) parent[a] = static_cast<int32_t>(a);
-    for (int32_t i = 0; i < nodes; ++i)
-        for (int32_t k = blocks_.row_start()[i]; k < blocks_.row_start()[i + 1]; ++k) {
-            const int32_t j = blocks_.column()[k];
-            if (j <= i) continue;
+    for (int32_t j = 0; j < nodes; ++j)
+        for (int32_t b = blocks_.first_block()[j]; b < blocks_.first_block()[j + 1]; ++b) {
+            const int32_t i = blocks_.row_node()[b];
             for (int p = 0; p < 8; ++p) {
                 const int32_t grid_node = corner_[8 * static_cast<size_t>(i) + p];
                 if (grid_node < 0) continue;
@@ -163,26 +162,36 @@ int32_t WarpedMultigrid::split_by_connection(int32_t nodes) {
     return count;
 }
 
-void WarpedMultigrid::build_coarse() {
+// coarse += P_a^T block P_b: block (a, b) spread over the coarse nodes of a's and b's cells.
+void WarpedMultigrid::add_coarse_block(int32_t a, int32_t b, const Eigen::Matrix3d& block, Eigen::MatrixXd& coarse) const {
+    for (int p = 0; p < 8; ++p) {
+        const int32_t I = corner_[8 * static_cast<size_t>(a) + p];
+        if (I < 0) continue;
+        const double wa = weight_[8 * static_cast<size_t>(a) + p];
+        for (int q = 0; q < 8; ++q) {
+            const int32_t J = corner_[8 * static_cast<size_t>(b) + q];
+            if (J < 0) continue;
+            coarse.block<3, 3>(3 * I, 3 * J) += wa * weight_[8 * static_cast<size_t>(b) + q] * block;
+        }
+    }
+}
+
+void WarpedMultigrid::build_coarse(const double* values) {
     const Eigen::Index n = 3 * static_cast<Eigen::Index>(coarse_count_);
     Eigen::MatrixXd coarse = Eigen::MatrixXd::Zero(n, n);
-    for (int32_t a = 0; a < blocks_.node_count(); ++a)
-        for (int32_t k = blocks_.row_start()[a]; k < blocks_.row_start()[a + 1]; ++k) {
-            const int32_t b = blocks_.column()[k];
-            Eigen::Matrix3d block;
+    for (int32_t j = 0; j < blocks_.node_count(); ++j) {
+        Eigen::Matrix3d block;
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) block(r, c) = blocks_.diagonal_entry(values, j, r, c);
+        add_coarse_block(j, j, block, coarse);
+        for (int32_t b = blocks_.first_block()[j]; b < blocks_.first_block()[j + 1]; ++b) {
             for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c) block(r, c) = blocks_.entry(k, r, c);
-            for (int p = 0; p < 8; ++p) {
-                const int32_t I = corner_[8 * static_cast<size_t>(a) + p];
-                if (I < 0) continue;
-                const double wa = weight_[8 * static_cast<size_t>(a) + p];
-                for (int q = 0; q < 8; ++q) {
-                    const int32_t J = corner_[8 * static_cast<size_t>(b) + q];
-                    if (J < 0) continue;
-                    coarse.block<3, 3>(3 * I, 3 * J) += wa * weight_[8 * static_cast<size_t>(b) + q] * block;
-                }
-            }
+                for (int c = 0; c < 3; ++c) block(r, c) = blocks_.entry(values, j, b, r, c);
+            const int32_t i = blocks_.row_node()[b];
+            add_coarse_block(i, j, block, coarse);
+            add_coarse_block(j, i, block.transpose(), coarse);
         }
+    }
     coarse.diagonal().array() += kCoarseShift * coarse.diagonal().mean();
     coarse_.compute(coarse);
     SH_REQUIRE(coarse_.info() == Eigen::Success, SH_ERR_SOLVER,
@@ -192,14 +201,15 @@ void WarpedMultigrid::build_coarse() {
 
 void WarpedMultigrid::build(const SparseSystem& a0, const double* rest) {
     built_ = false;
-    blocks_.build_pattern(a0);
-    blocks_.load_values(a0);
+    blocks_.build(a0);
     const int32_t nodes = blocks_.node_count();
     build_prolongation(rest, nodes);
-    build_coarse();
+    build_coarse(a0.values().data());
     inverse_diagonal_.assign(3 * static_cast<size_t>(nodes), Node4{});
     rotation_.assign(9 * static_cast<size_t>(nodes), 0.0);
     z_.assign(static_cast<size_t>(nodes), Node4{});
+    pushed_.assign(static_cast<size_t>(nodes), Node4{});
+    product_lanes_.assign(2 * static_cast<size_t>(nodes), Node4{});
     residual_.assign(static_cast<size_t>(nodes), Node4{});
     change_.assign(static_cast<size_t>(nodes), Node4{});
     built_ = true;
@@ -207,12 +217,12 @@ void WarpedMultigrid::build(const SparseSystem& a0, const double* rest) {
 
 void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
     SH_REQUIRE(built_for(a), SH_ERR_INTERNAL, "multigrid: prepared with another pattern than it was built for");
-    blocks_.load_values(a);
+    values_ = a.values().data();
     std::copy(rotations, rotations + rotation_.size(), rotation_.begin());
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
         Eigen::Matrix3d d;
         for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) d(r, c) = blocks_.entry(blocks_.diagonal(i), r, c);
+            for (int c = 0; c < 3; ++c) d(r, c) = blocks_.diagonal_entry(values_, i, r, c);
         const Eigen::LLT<Eigen::Matrix3d> cholesky(d);
         const Eigen::Matrix3d inverse = cholesky.solve(Eigen::Matrix3d::Identity());
         SH_REQUIRE(cholesky.info() == Eigen::Success && inverse.allFinite(), SH_ERR_SOLVER,
@@ -224,13 +234,14 @@ void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
 }
 
 void WarpedMultigrid::backward_sweep(const double* r, double* z) {
-    const int32_t* start = blocks_.row_start();
-    for (int32_t i = blocks_.node_count() - 1; i >= 0; --i) {
-        const size_t n = static_cast<size_t>(i);
-        const int32_t diagonal = blocks_.diagonal(i);
-        Node4 s = blocks_.subtract_row_blocks(start[i], diagonal, z_.data(), load_node(r + 3 * n));
-        s = blocks_.subtract_row_blocks(diagonal + 1, start[i + 1], z_.data(), s);
+    // Row J sums its right part from the pushes of the nodes after it (already new) and its
+    // left part from the blocks it holds (the nodes before it, not yet changed).
+    std::fill(pushed_.begin(), pushed_.end(), Node4{});
+    for (int32_t j = blocks_.node_count() - 1; j >= 0; --j) {
+        const size_t n = static_cast<size_t>(j);
+        const Node4 s = load_node(r + 3 * n) - pushed_[n] - blocks_.pull(values_, j, z_.data());
         const Node4 updated = block_times(&inverse_diagonal_[3 * n], s);
+        blocks_.push(values_, j, updated, pushed_.data());
         change_[n] = updated - z_[n];
         z_[n] = updated;
         store_node(updated, z + 3 * n);
@@ -238,15 +249,13 @@ void WarpedMultigrid::backward_sweep(const double* r, double* z) {
 }
 
 void WarpedMultigrid::first_sweep(const double* r) {
-    const int32_t n = blocks_.node_count();
-    const int32_t* start = blocks_.row_start();
-    std::fill(z_.begin(), z_.end(), Node4{});
-    for (int32_t i = 0; i < n; ++i) {
-        const Node4 s = blocks_.subtract_row_blocks(start[i], blocks_.diagonal(i), z_.data(), load_node(r + 3 * static_cast<size_t>(i)));
-        z_[static_cast<size_t>(i)] = block_times(&inverse_diagonal_[3 * static_cast<size_t>(i)], s);
+    // residual_ gathers -U z_ from each node's push once its value is final.
+    std::fill(residual_.begin(), residual_.end(), Node4{});
+    for (int32_t j = 0; j < blocks_.node_count(); ++j) {
+        const size_t n = static_cast<size_t>(j);
+        z_[n] = block_times(&inverse_diagonal_[3 * n], load_node(r + 3 * n) - blocks_.pull(values_, j, z_.data()));
+        blocks_.push(values_, j, -z_[n], residual_.data());
     }
-    for (int32_t i = 0; i < n; ++i)
-        residual_[static_cast<size_t>(i)] = blocks_.subtract_row_blocks(blocks_.diagonal(i) + 1, start[i + 1], z_.data(), Node4{});
 }
 
 void WarpedMultigrid::coarse_correction() {
@@ -287,25 +296,22 @@ void WarpedMultigrid::apply(const double* r, double* z) {
 
 bool WarpedMultigrid::apply_with_product(const double* r, double* z, double* az) {
     apply(r, z);
-    // Node i's sweep solved its row for r with the nodes before it (j < i) not yet changed:
-    // (A z)_i = r_i + sum over j < i of A_ij change_j.
-    const int32_t* start = blocks_.row_start();
-    for (int32_t i = 0; i < blocks_.node_count(); ++i) {
-        const size_t n = static_cast<size_t>(i);
-        store_node(load_node(r + 3 * n) - blocks_.subtract_row_blocks(start[i], blocks_.diagonal(i), change_.data(), Node4{}),
-                   az + 3 * n);
+    // Node j's sweep solved its row for r with the nodes before it (i < j) not yet changed:
+    // (A z)_j = r_j + sum over i < j of A_ji change_i.
+    for (int32_t j = 0; j < blocks_.node_count(); ++j) {
+        const size_t n = static_cast<size_t>(j);
+        store_node(load_node(r + 3 * n) + blocks_.pull(values_, j, change_.data()), az + 3 * n);
     }
     return true;
 }
 
 double WarpedMultigrid::iteration_work() const {
-    // 18 operations per stored block for three and a half passes' worth: the first sweep with
-    // its residual (one pass, measured no cheaper than 1.7 of the others), the backward sweep
-    // and the half product CG's A p takes from it; the transfers; the dense coarse solve. They
-    // count half a sparse solve's operation each: the blocks (4-5 MB at 20 k tets) stay in
-    // cache across the cycle where a factor (29 MB) streams from memory (measured: 0.6 ms per
-    // iteration, rotations included, against 4.2 ms per solve on the 20,250-tet cube).
-    const double blocks = static_cast<double>(blocks_.block_count());
+    // 18 operations per block of the full matrix for three and a half passes' worth: the
+    // first sweep with its residual (one pass), the backward sweep and the half product CG's
+    // A p takes from it; the transfers; the dense coarse solve. They count half a sparse
+    // solve's operation each: the stored triangle (2.5 MB at 20 k tets) stays in cache across
+    // the cycle where a factor (29 MB) streams from memory.
+    const double blocks = 2.0 * static_cast<double>(blocks_.block_count()) + blocks_.node_count();
     const double coarse = 3.0 * coarse_count_;
     return 0.5 * (3.5 * 18.0 * blocks + 120.0 * blocks_.node_count() + 2.0 * coarse * coarse);
 }

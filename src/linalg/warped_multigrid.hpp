@@ -10,9 +10,10 @@
 #pragma once
 
 #include "core/memory.hpp"
-#include "linalg/block_matrix.hpp"
+#include "linalg/node_lanes.hpp"
 #include "linalg/preconditioned_cg.hpp"
 #include "linalg/sparse_system.hpp"
+#include "linalg/upper_blocks.hpp"
 
 #include <Eigen/Dense>
 
@@ -31,8 +32,9 @@ public:
     bool built_for(const SparseSystem& system) const { return built_ && blocks_.matches(system); }
     /// Forgets the hierarchy (a new pattern, step size or material needs a new one).
     void clear() { built_ = false; }
-    /// Takes a's current values and the free nodes' rotations (9 per free node, row-major,
-    /// rest frame to current) for the following applies. Throws SH_ERR_SOLVER naming the
+    /// Takes a's current values (read in place by the following applies: a must stay as it
+    /// is until then) and the free nodes' rotations (9 per free node, row-major, rest frame to
+    /// current). Throws SH_ERR_SOLVER naming the
     /// node whose diagonal block is not positive definite.
     void prepare(const SparseSystem& a, const double* rotations);
     /// z = one V-cycle applied to r.
@@ -42,7 +44,7 @@ public:
     /// sweep made after it (Eisenstat's observation), so only those blocks are read again.
     bool apply_with_product(const double* r, double* z, double* az) override;
     /// y = A x with the prepared matrix (the product CG needs, from the same blocks).
-    void multiply(const double* x, double* y) const { blocks_.multiply(x, y); }
+    void multiply(const double* x, double* y) { blocks_.multiply(values_, x, y, product_lanes_.data()); }
     /// One apply's work plus CG's product (half a product, apply_with_product), in a sparse
     /// solve's operations (FactorWork).
     double iteration_work() const;
@@ -59,8 +61,10 @@ private:
     /// holds (parts joined by elements: blocks_'s pattern), so that a cut, or legs that share
     /// grid cells but no element, are not tied together; renumbers corner_, returns the count.
     int32_t split_by_connection(int32_t nodes);
-    /// coarse_ := P^T A0 P (A0 in blocks_) and its Cholesky factor.
-    void build_coarse();
+    /// coarse_ := P^T A0 P (A0's values) and its Cholesky factor.
+    void build_coarse(const double* values);
+    /// coarse += P_a^T block P_b (the coarse image of the matrix's block (a, b)).
+    void add_coarse_block(int32_t a, int32_t b, const Eigen::Matrix3d& block, Eigen::MatrixXd& coarse) const;
     /// One block Gauss-Seidel sweep over the nodes backward, on z_ towards r; change_ := what
     /// it added to z_, and z := z_ (3 per node).
     void backward_sweep(const double* r, double* z);
@@ -73,7 +77,8 @@ private:
     void coarse_correction();
 
     bool built_ = false;
-    BlockMatrix blocks_;           // the current matrix (A0 while building)
+    UpperBlocks blocks_;           // the system's block structure
+    const double* values_ = nullptr;  // the prepared system's values
     vec<Node4> inverse_diagonal_;  // 3 columns per node: the current diagonal blocks' inverses
     vec<double> rotation_;         // 9 per node
     vec<int32_t> corner_;          // 8 per node: the coarse nodes of its grid cell (-1: weight 0)
@@ -84,6 +89,8 @@ private:
     vec<Node4> z_;                        // the cycle's iterate
     vec<Node4> residual_;                 // r - A z_ after the first sweep
     vec<Node4> change_;                   // the backward sweep's change of z_
+    vec<Node4> pushed_;                   // the backward sweep's sums from the nodes after each
+    vec<Node4> product_lanes_;            // multiply's scratch
     vec<int32_t> scratch_;                // the grid's node numbers, then the union-find's parents
 };
 

@@ -1,14 +1,14 @@
 // The warped two-level multigrid preconditioner (linalg/warped_multigrid.hpp) on blocks of tets
 // whose system is a graph Laplacian per tet with an x-y coupling (anisotropic, so that a
-// rotation changes it) plus a per-node mass: its block copy against the sparse product; the
+// rotation changes it) plus a per-node mass: its node-block product against the sparse product; the
 // cycle is a symmetric positive definite operator (CG needs both), and the product it forms
 // beside itself is the matrix's; CG's iterations stay nearly
 // flat as the mesh is refined (what a multigrid buys over the condition number's growth); and
 // a matrix rotated rigidly as a whole is preconditioned exactly as well as the unrotated one
 // when the cycle is given the rotation, and worse without it.
-#include "linalg/block_matrix.hpp"
 #include "linalg/preconditioned_cg.hpp"
 #include "linalg/sparse_system.hpp"
+#include "linalg/upper_blocks.hpp"
 #include "linalg/warped_multigrid.hpp"
 
 #include "kuhn_block.hpp"
@@ -127,14 +127,14 @@ int iterations(int cells, double solved_angle, double given_angle) {
 void block_product_matches_the_sparse_product(void**) {
     Block block;
     build_block(4, 0.3, block);
-    sh::BlockMatrix blocks;
-    blocks.build_pattern(block.a);
-    blocks.load_values(block.a);
+    sh::UpperBlocks blocks;
+    blocks.build(block.a);
     const size_t n = static_cast<size_t>(block.a.dof_count());
     const std::vector<double> x = wave(n, 0.4);
     std::vector<double> y(n), z(n);
+    std::vector<sh::Node4> lanes(2 * n / 3);
     block.a.multiply(x.data(), y.data());
-    blocks.multiply(x.data(), z.data());
+    blocks.multiply(block.a.values().data(), x.data(), z.data(), lanes.data());
     for (size_t d = 0; d < n; ++d) assert_true(std::fabs(y[d] - z[d]) <= 1e-12 * (1.0 + std::fabs(y[d])));
 }
 

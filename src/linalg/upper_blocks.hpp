@@ -1,0 +1,98 @@
+// A SparseSystem's stored upper triangle read by 3x3 node blocks, in place. Column node J of
+// the system holds the blocks (I, J), I < J, in DOF columns 3J, 3J + 1 and 3J + 2, three
+// contiguous rows each: block (I, J)'s column c is three values in a row. So each stored block
+// serves both triangles without a copy: as A_IJ times a node (its columns, pushed into row I)
+// and as A_JI = A_IJ^T times a node (dot products with its columns, pulled into row J). A block
+// Gauss-Seidel sweep that visits the nodes in order pulls row J's left part from these blocks
+// and pushes its new value into the rows it meets, reading each stored block once per sweep
+// where a full copy of the matrix is read twice (the cycle's passes stream 2.5 MB instead of
+// 6.5 MB at 20 k tets, from cache).
+#pragma once
+
+#include "core/memory.hpp"
+#include "linalg/node_lanes.hpp"
+#include "linalg/sparse_system.hpp"
+
+#include <cstdint>
+
+namespace sh {
+
+/// The node blocks of a SparseSystem's pattern (see the file comment); the values are read
+/// from the system given to each call, which must have the pattern built from.
+class UpperBlocks {
+public:
+    /// The block structure of system's pattern (allocates; on failure it is as it was).
+    void build(const SparseSystem& system);
+    /// True if built from system's current pattern.
+    bool matches(const SparseSystem& system) const { return pattern_id_ != 0 && pattern_id_ == system.pattern_id(); }
+
+    int32_t node_count() const { return node_count_; }                                  ///< free nodes
+    int64_t block_count() const { return static_cast<int64_t>(row_node_.size()); }     ///< blocks (I, J), I < J
+    const int32_t* first_block() const { return first_block_.data(); }                 ///< per column node J, node_count() + 1
+    const int32_t* row_node() const { return row_node_.data(); }                       ///< I of each block
+
+    /// Entry (row, col) of block b of column node J (each 0..2) in values (the system's).
+    double entry(const double* values, int32_t node, int32_t b, int row, int col) const {
+        return values[column_start_[3 * static_cast<size_t>(node) + static_cast<size_t>(col)] +
+                      3 * static_cast<size_t>(b - first_block_[static_cast<size_t>(node)]) + static_cast<size_t>(row)];
+    }
+    /// Entry (row, col) of node J's diagonal block.
+    double diagonal_entry(const double* values, int32_t node, int row, int col) const;
+
+    /// The sum over node J's blocks of A_JI x_I (x in node lanes, fourth lanes 0).
+    Node4 pull(const double* values, int32_t node, const Node4* x) const {
+        Node4 dot[3] = {};
+        const int32_t begin = first_block_[static_cast<size_t>(node)], end = first_block_[static_cast<size_t>(node) + 1];
+        const double* column[3];
+        columns(values, node, column);
+        for (int32_t b = begin; b < end; ++b) {
+            const Node4 xi = x[row_node_[static_cast<size_t>(b)]];
+            const size_t at = 3 * static_cast<size_t>(b - begin);
+            for (int c = 0; c < 3; ++c) dot[c] += load_column(column[c] + at) * xi;
+        }
+        return Node4{lane_sum3(dot[0]), lane_sum3(dot[1]), lane_sum3(dot[2]), 0.0};
+    }
+    /// out_I += A_IJ u over node J's blocks.
+    void push(const double* values, int32_t node, Node4 u, Node4* out) const {
+        const int32_t begin = first_block_[static_cast<size_t>(node)], end = first_block_[static_cast<size_t>(node) + 1];
+        const double* column[3];
+        columns(values, node, column);
+        for (int32_t b = begin; b < end; ++b) {
+            const size_t at = 3 * static_cast<size_t>(b - begin);
+            out[row_node_[static_cast<size_t>(b)]] +=
+                load_column(column[0] + at) * u[0] + load_column(column[1] + at) * u[1] + load_column(column[2] + at) * u[2];
+        }
+    }
+    /// y = A x for the full symmetric matrix (3 per node each; x and y must not overlap);
+    /// lanes: 2 node_count() node lanes of scratch.
+    void multiply(const double* values, const double* x, double* y, Node4* lanes) const;
+    /// Node J's diagonal block times x (node lanes).
+    Node4 diagonal_times(const double* values, int32_t node, Node4 x) const {
+        Node4 out{};
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) out[r] += diagonal_entry(values, node, r, c) * x[c];
+        return out;
+    }
+
+private:
+    // Where node J's DOF columns start in the values (the first block's column c).
+    void columns(const double* values, int32_t node, const double* (&out)[3]) const {
+        for (int c = 0; c < 3; ++c) out[c] = values + column_start_[3 * static_cast<size_t>(node) + static_cast<size_t>(c)];
+    }
+    // Three values from p, the fourth lane 0 whatever p[3] is (the next entry of the column).
+    static Node4 load_column(const double* p) {
+        Node4 v;
+        __builtin_memcpy(&v, p, sizeof v);
+        typedef long long Bits __attribute__((vector_size(4 * sizeof(long long))));
+        return reinterpret_cast<Node4>(reinterpret_cast<Bits>(v) & Bits{-1, -1, -1, 0});
+    }
+    static double lane_sum3(Node4 v) { return v[0] + v[1] + v[2]; }
+
+    int32_t node_count_ = 0;
+    uint64_t pattern_id_ = 0;
+    vec<int32_t> first_block_;   // node_count_ + 1
+    vec<int32_t> row_node_;      // per block
+    vec<int32_t> column_start_;  // 3 per node and the end: the system's column starts
+};
+
+}  // namespace sh

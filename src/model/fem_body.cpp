@@ -1,6 +1,7 @@
 #include "model/fem_body.hpp"
 
 #include "core/error.hpp"
+#include "core/morton.hpp"
 #include "core/vec3.hpp"
 #include "material/material_params.hpp"
 #include "material/material_table.hpp"
@@ -16,17 +17,6 @@ namespace sh {
 
 namespace {
 
-// Spreads the low 21 bits of v to every third bit (Morton interleaving).
-uint64_t spread_bits(uint64_t v) {
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffULL;
-    v = (v | v << 16) & 0x1f0000ff0000ffULL;
-    v = (v | v << 8) & 0x100f00f00f00f00fULL;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-    v = (v | v << 2) & 0x1249249249249249ULL;
-    return v;
-}
-
 // Tets ordered along a Z-order (Morton) curve through their centroids at positions p, so that
 // consecutive tets, and the kLanes tets of a block, share nodes and cache lines: the kernels'
 // gathers and scatters then mostly hit L1. Node numbering is public and stays as it is; only
@@ -34,27 +24,17 @@ uint64_t spread_bits(uint64_t v) {
 vec<uint32_t> locality_order(const vec<int32_t>& tets, const vec<double>& p) {
     const size_t tet_count = tets.size() / 4;
     vec<double> centroid(3 * tet_count);
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t t = 0; t < tet_count; ++t)
+    MortonBox box;
+    for (size_t t = 0; t < tet_count; ++t) {
         for (int i = 0; i < 3; ++i) {
             double c = 0.0;
             for (int a = 0; a < 4; ++a) c += p[3 * static_cast<size_t>(tets[4 * t + a]) + i];
-            c *= 0.25;
-            centroid[3 * t + i] = c;
-            lo[i] = std::min(lo[i], c);
-            hi[i] = std::max(hi[i], c);
+            centroid[3 * t + i] = 0.25 * c;
         }
-    vec<std::pair<uint64_t, uint32_t>> keyed(tet_count);
-    for (size_t t = 0; t < tet_count; ++t) {
-        uint64_t key = 0;
-        for (int i = 0; i < 3; ++i) {
-            const double extent = hi[i] - lo[i];
-            const double u = extent > 0.0 ? (centroid[3 * t + i] - lo[i]) / extent : 0.0;  // NaN-safe below
-            const uint64_t q = u >= 0.0 ? static_cast<uint64_t>(std::min(u, 1.0) * 2097151.0) : 0;
-            key |= spread_bits(q) << i;
-        }
-        keyed[t] = {key, static_cast<uint32_t>(t)};
+        box.include(&centroid[3 * t]);
     }
+    vec<std::pair<uint64_t, uint32_t>> keyed(tet_count);
+    for (size_t t = 0; t < tet_count; ++t) keyed[t] = {box.key(&centroid[3 * t]), static_cast<uint32_t>(t)};
     std::sort(keyed.begin(), keyed.end());
     vec<uint32_t> order(tet_count);
     for (size_t k = 0; k < tet_count; ++k) order[k] = keyed[k].second;

@@ -1,6 +1,7 @@
 #include "solver/newton_body_state.hpp"
 
 #include "model/external_field.hpp"
+#include "solver/free_node_order.hpp"
 #include "solver/node_links.hpp"
 
 #include <utility>
@@ -65,9 +66,8 @@ int32_t NewtonBodyState::prepare(const Body& body, const sh_implicit_settings& s
         return 3 * free_count;
     }
 
-    vec<int32_t> index(static_cast<size_t>(n), -1);
-    for (int32_t i = 0; i < n; ++i)
-        if (body.is_free(i)) index[static_cast<size_t>(i)] = count++;
+    vec<int32_t> index;
+    count = number_free_nodes(body, index);
     link_key_pairs(grown, link_pairs);
     SparseSystem pattern;
     pattern.build_pattern(body.element_nodes(), static_cast<size_t>(body.element_count()), body.nodes_per_element(),

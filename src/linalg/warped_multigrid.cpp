@@ -206,7 +206,8 @@ void WarpedMultigrid::build(const SparseSystem& a0, const double* rest) {
     build_prolongation(rest, nodes);
     build_coarse(a0.values().data());
     inverse_diagonal_.assign(3 * static_cast<size_t>(nodes), Node4{});
-    rotation_.assign(9 * static_cast<size_t>(nodes), 0.0);
+    turn_.assign(6 * static_cast<size_t>(nodes), Node4{});
+    coarse_lanes_.assign(static_cast<size_t>(coarse_count_), Node4{});
     z_.assign(static_cast<size_t>(nodes), Node4{});
     pushed_.assign(static_cast<size_t>(nodes), Node4{});
     product_lanes_.assign(2 * static_cast<size_t>(nodes), Node4{});
@@ -218,7 +219,14 @@ void WarpedMultigrid::build(const SparseSystem& a0, const double* rest) {
 void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
     SH_REQUIRE(built_for(a), SH_ERR_INTERNAL, "multigrid: prepared with another pattern than it was built for");
     values_ = a.values().data();
-    std::copy(rotations, rotations + rotation_.size(), rotation_.begin());
+    for (int32_t i = 0; i < blocks_.node_count(); ++i) {
+        const double* R = rotations + 9 * static_cast<size_t>(i);  // row-major
+        Node4* turn = &turn_[6 * static_cast<size_t>(i)];
+        for (int c = 0; c < 3; ++c) {
+            turn[c] = Node4{R[c], R[3 + c], R[6 + c], 0.0};                  // R's columns
+            turn[3 + c] = Node4{R[3 * c], R[3 * c + 1], R[3 * c + 2], 0.0};  // R^T's
+        }
+    }
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
         Eigen::Matrix3d d;
         for (int r = 0; r < 3; ++r)
@@ -260,31 +268,27 @@ void WarpedMultigrid::first_sweep(const double* r) {
 
 void WarpedMultigrid::coarse_correction() {
     const int32_t n = blocks_.node_count();
-    coarse_rhs_.setZero();
+    std::fill(coarse_lanes_.begin(), coarse_lanes_.end(), Node4{});
     for (int32_t i = 0; i < n; ++i) {
-        const double* R = &rotation_[9 * static_cast<size_t>(i)];
-        const Node4 e = residual_[static_cast<size_t>(i)];
-        double local[3];
-        for (int c = 0; c < 3; ++c) local[c] = R[c] * e[0] + R[3 + c] * e[1] + R[6 + c] * e[2];  // R^T e
+        const size_t node = static_cast<size_t>(i);
+        const Node4 local = block_times(&turn_[6 * node + 3], residual_[node]);  // R^T e
         for (int p = 0; p < 8; ++p) {
-            const int32_t I = corner_[8 * static_cast<size_t>(i) + p];
-            if (I < 0) continue;
-            const double w = weight_[8 * static_cast<size_t>(i) + p];
-            for (int c = 0; c < 3; ++c) coarse_rhs_[3 * I + c] += w * local[c];
+            const int32_t I = corner_[8 * node + static_cast<size_t>(p)];
+            if (I >= 0) coarse_lanes_[static_cast<size_t>(I)] += weight_[8 * node + static_cast<size_t>(p)] * local;
         }
     }
+    for (int32_t I = 0; I < coarse_count_; ++I)
+        for (int c = 0; c < 3; ++c) coarse_rhs_[3 * I + c] = coarse_lanes_[static_cast<size_t>(I)][c];
     coarse_.solveInPlace(coarse_rhs_);
+    for (int32_t I = 0; I < coarse_count_; ++I) coarse_lanes_[static_cast<size_t>(I)] = load_node(&coarse_rhs_[3 * I]);
     for (int32_t i = 0; i < n; ++i) {
-        double local[3] = {0.0, 0.0, 0.0};
+        const size_t node = static_cast<size_t>(i);
+        Node4 local{};
         for (int p = 0; p < 8; ++p) {
-            const int32_t I = corner_[8 * static_cast<size_t>(i) + p];
-            if (I < 0) continue;
-            const double w = weight_[8 * static_cast<size_t>(i) + p];
-            for (int c = 0; c < 3; ++c) local[c] += w * coarse_rhs_[3 * I + c];
+            const int32_t I = corner_[8 * node + static_cast<size_t>(p)];
+            if (I >= 0) local += weight_[8 * node + static_cast<size_t>(p)] * coarse_lanes_[static_cast<size_t>(I)];
         }
-        const double* R = &rotation_[9 * static_cast<size_t>(i)];
-        Node4& zi = z_[static_cast<size_t>(i)];
-        for (int c = 0; c < 3; ++c) zi[c] += R[3 * c] * local[0] + R[3 * c + 1] * local[1] + R[3 * c + 2] * local[2];
+        z_[node] += block_times(&turn_[6 * node], local);  // R P u
     }
 }
 

@@ -80,12 +80,13 @@ private:
     UpperBlocks blocks_;           // the system's block structure
     const double* values_ = nullptr;  // the prepared system's values
     vec<Node4> inverse_diagonal_;  // 3 columns per node: the current diagonal blocks' inverses
-    vec<double> rotation_;         // 9 per node
+    vec<Node4> turn_;              // 6 per node: the columns of its rotation R, then of R^T
     vec<int32_t> corner_;          // 8 per node: the coarse nodes of its grid cell (-1: weight 0)
     vec<double> weight_;           // 8 per node: their trilinear weights
     int32_t coarse_count_ = 0;
     Eigen::LLT<Eigen::MatrixXd> coarse_;  // factor of P^T A0 P (3 per coarse node)
     Eigen::VectorXd coarse_rhs_;          // restricted residual, then the coarse solution
+    vec<Node4> coarse_lanes_;             // the same per coarse node, in node lanes
     vec<Node4> z_;                        // the cycle's iterate
     vec<Node4> residual_;                 // r - A z_ after the first sweep
     vec<Node4> change_;                   // the backward sweep's change of z_

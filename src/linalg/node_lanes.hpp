@@ -2,7 +2,8 @@
 // as three such columns: a block times a node is then three vector multiply-adds where the
 // row-major form takes nine scalar ones and three sums (GCC vector extensions: AVX2 or AVX-512
 // where the target has them, SSE2 pairs elsewhere). The block sweeps of the multigrid run
-// about twice as fast in this form (raptorTetra_19409's matrix: 0.11 against 0.23 ms).
+// about twice as fast in this form (a sweep over raptorTetra_19409's blocks in a
+// microbenchmark: 0.11 against 0.23 ms).
 #pragma once
 
 namespace sh {

@@ -422,9 +422,13 @@ void NewtonStep::evaluate() {
         evaluated_energy_ += elastic.value + field_energy;
         phi.value += elastic.value + field;
         phi.scale += elastic.scale + std::fabs(field);  // what its round-off is relative to
-        const vec<int32_t>& global = state.matrix.system.dof_to_global();
-        for (size_t d = 0; d < global.size(); ++d) {
-            const size_t j = static_cast<size_t>(global[d]), node = j / 3;
+        // In the nodes' order: the free order (solver/free_node_order.hpp) would scatter the
+        // reads of every node array; only the residual's writes jump.
+        const vec<int32_t>& free_index = state.free_index;
+        for (size_t j = 0; j < body.x.size(); ++j) {
+            const size_t node = j / 3;
+            if (free_index[node] < 0) continue;
+            const size_t d = 3 * static_cast<size_t>(free_index[node]) + j % 3;
             const double m = body.mass[node], v = body.v[j], dv = v - stepped.workspace.v0[j];
             const double c = body.mass_damping(node);
             const double load = body.applied_load(j, g_), fd = damping ? damping[j] : 0.0;

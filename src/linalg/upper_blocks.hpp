@@ -39,7 +39,8 @@ public:
     /// Entry (row, col) of node J's diagonal block.
     double diagonal_entry(const double* values, int32_t node, int row, int col) const;
 
-    /// The sum over node J's blocks of A_JI x_I (x in node lanes, fourth lanes 0).
+    /// The sum over node J's blocks of A_JI x_I (x in node lanes; their fourth lanes are not
+    /// read), its fourth lane 0.
     Node4 pull(const double* values, int32_t node, const Node4* x) const {
         Node4 dot[3] = {};
         const int32_t begin = first_block_[static_cast<size_t>(node)], end = first_block_[static_cast<size_t>(node) + 1];
@@ -52,7 +53,8 @@ public:
         }
         return Node4{lane_sum3(dot[0]), lane_sum3(dot[1]), lane_sum3(dot[2]), 0.0};
     }
-    /// out_I += A_IJ u over node J's blocks.
+    /// out_I += A_IJ u over node J's blocks (the fourth lanes of out take what the columns'
+    /// next entries give: read them as three values).
     void push(const double* values, int32_t node, Node4 u, Node4* out) const {
         const int32_t begin = first_block_[static_cast<size_t>(node)], end = first_block_[static_cast<size_t>(node) + 1];
         const double* column[3];
@@ -79,12 +81,14 @@ private:
     void columns(const double* values, int32_t node, const double* (&out)[3]) const {
         for (int c = 0; c < 3; ++c) out[c] = values + column_start_[3 * static_cast<size_t>(node) + static_cast<size_t>(c)];
     }
-    // Three values from p, the fourth lane 0 whatever p[3] is (the next entry of the column).
+    // The three values from p in lanes 0-2; lane 3 holds p[3], the column's next entry. That
+    // lane never reaches lanes 0-2 of a result: pull sums lanes 0-2 of its products only, and
+    // push adds it into the output's lane 3, which every reader of the output ignores
+    // (block_times and store_node read lanes 0-2); so nothing masks it.
     static Node4 load_column(const double* p) {
         Node4 v;
         __builtin_memcpy(&v, p, sizeof v);
-        typedef long long Bits __attribute__((vector_size(4 * sizeof(long long))));
-        return reinterpret_cast<Node4>(reinterpret_cast<Bits>(v) & Bits{-1, -1, -1, 0});
+        return v;
     }
     static double lane_sum3(Node4 v) { return v[0] + v[1] + v[2]; }
 

@@ -162,6 +162,7 @@ void SparseSystem::build_scatter_map(const int32_t* elements, size_t element_cou
             BlockRecord& rec = records[i++];
             for (size_t c = 0; c < 3; ++c) rec.slot[c] = column_starts[3 * j + c] + static_cast<int32_t>(3 * pos);
             rec.local = static_cast<uint16_t>(3 * a * n3 + 3 * b);
+            rec.pair = static_cast<uint16_t>(a * k + b) & 0x7fffu;
             rec.diagonal = fi == fj ? 1 : 0;
         });
     }
@@ -206,31 +207,37 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
 
 void SparseSystem::clear_values() { std::fill(values_.begin(), values_.end(), 0.0); }
 
-void SparseSystem::add_element(size_t element, const double* Ke, double scale) {
+template <class Entry>
+void SparseSystem::scatter_element(size_t element, double scale, const Entry& entry) {
     SH_REQUIRE(element < element_count_, SH_ERR_INTERNAL, "sparse system: element %zu of %zu", element,
                element_count_);
     double* v = values_.data();
-    const size_t m = static_cast<size_t>(local_size_);
     const BlockRecord* rec = block_records_.data() + block_record_start_[element];
     const BlockRecord* end = block_records_.data() + block_record_start_[element + 1];
     for (; rec != end; ++rec) {
-        const double* k = Ke + rec->local;
         if (!rec->diagonal) {
             for (int s = 0; s < 3; ++s) {
                 double* col = v + rec->slot[s];
-                col[0] += scale * k[s];
-                col[1] += scale * k[m + s];
-                col[2] += scale * k[2 * m + s];
+                for (int r = 0; r < 3; ++r) col[r] += scale * entry(*rec, r, s);
             }
         } else {
-            v[rec->slot[0]] += scale * k[0];
-            v[rec->slot[1]] += scale * k[1];
-            v[rec->slot[1] + 1] += scale * k[m + 1];
-            v[rec->slot[2]] += scale * k[2];
-            v[rec->slot[2] + 1] += scale * k[m + 2];
-            v[rec->slot[2] + 2] += scale * k[2 * m + 2];
+            for (int s = 0; s < 3; ++s)
+                for (int r = 0; r <= s; ++r) v[rec->slot[s] + r] += scale * entry(*rec, r, s);
         }
     }
+}
+
+void SparseSystem::add_element(size_t element, const double* Ke, double scale) {
+    const size_t m = static_cast<size_t>(local_size_);
+    scatter_element(element, scale, [&](const BlockRecord& rec, int r, int s) {
+        return Ke[rec.local + static_cast<size_t>(r) * m + static_cast<size_t>(s)];
+    });
+}
+
+void SparseSystem::add_element_lane(size_t element, const double* blocks, size_t stride, double scale) {
+    scatter_element(element, scale, [&](const BlockRecord& rec, int r, int s) {
+        return blocks[(9 * static_cast<size_t>(rec.pair) + static_cast<size_t>(3 * r + s)) * stride];
+    });
 }
 
 void SparseSystem::add_block(int32_t free_i, int32_t free_j, const double* B, double scale) {

@@ -42,6 +42,10 @@ public:
     /// Precisely: local entry (p, q) is added to global entry (g(p), g(q)) when both are free
     /// DOFs and g(p) <= g(q), so a full symmetric Ke gives the exact global sum.
     void add_element(size_t element, const double* Ke, double scale);
+    /// add_element for Ke given by node blocks, one element's lane of a batch: local entry
+    /// (3a + r, 3b + s) at blocks[((a k + b) 9 + 3r + s) stride] (k nodes per element), as the
+    /// element kernels hold a batch's tangents. Saves copying each lane out into a Ke.
+    void add_element_lane(size_t element, const double* blocks, size_t stride, double scale);
     /// Adds scale * B (3x3, row-major) to the block of free nodes (I, J) and, for I != J, its
     /// transpose to (J, I): only the stored upper triangle is touched. The nodes must share an
     /// element or a link (or be equal); otherwise throws SH_ERR_INTERNAL.
@@ -82,10 +86,15 @@ private:
     // Element scatter map: records [block_record_start_[e], block_record_start_[e+1]) of element
     // e, one per local node pair (a, b) whose global block (I, J) has I <= J.
     struct BlockRecord {
-        int32_t slot[3];   // value slot of global entry (3I, 3J + s); rows 3I+1, 3I+2 follow it
-        uint16_t local;    // Ke offset of the block: 3a * 3k + 3b
-        uint16_t diagonal; // 1 if I == J (only its upper part r <= s is added)
+        int32_t slot[3];        // value slot of global entry (3I, 3J + s); rows 3I+1, 3I+2 follow it
+        uint16_t local;         // Ke offset of the block: 3a * 3k + 3b
+        uint16_t pair : 15;     // its local node pair a k + b
+        uint16_t diagonal : 1;  // 1 if I == J (only its upper part r <= s is added)
     };
+    /// Adds scale * entry(record, r, s) for every stored entry of element's blocks: the one
+    /// scatter of add_element and add_element_lane.
+    template <class Entry>
+    void scatter_element(size_t element, double scale, const Entry& entry);
     int32_t local_size_ = 0;  // 3k
     vec<size_t> block_record_start_;
     vec<BlockRecord> block_records_;

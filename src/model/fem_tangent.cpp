@@ -77,14 +77,6 @@ void element_stiffness(const StressDerivativeLanes& C, const Lanes (&g)[3][3], L
             K.block[0][0][k][l] = -(K.block[0][1][k][l] + K.block[0][2][k][l] + K.block[0][3][k][l]);
 }
 
-// Lane l's stiffness as the row-major 12x12 matrix SparseSystem::add_element takes.
-void lane_stiffness(const StiffnessLanes& K, int l, double (&ke)[144]) {
-    for (int a = 0; a < 4; ++a)
-        for (int k = 0; k < 3; ++k)
-            for (int b = 0; b < 4; ++b)
-                for (int c = 0; c < 3; ++c) ke[12 * (3 * a + k) + 3 * b + c] = K.block[a][b][k][c][l];
-}
-
 }  // namespace
 
 void FemBody::add_tangent(const double* xs, double stiffness_scale, double damping_scale, SparseSystem& system) const {
@@ -123,11 +115,8 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
         });
         StiffnessLanes K;
         element_stiffness(C, g, volume, K);
-        for (int l = 0; l < count; ++l) {
-            double ke[144];
-            lane_stiffness(K, l, ke);
-            system.add_element(static_cast<size_t>(members[l]), ke, scale);
-        }
+        const double* blocks = reinterpret_cast<const double*>(&K.block[0][0][0][0]);  // a vector aliases a double
+        for (int l = 0; l < count; ++l) system.add_element_lane(static_cast<size_t>(members[l]), blocks + l, kLanes, scale);
     };
 
     int32_t batch[SH_MATERIAL_COUNT][kLanes];

@@ -44,20 +44,9 @@ public:
         known_[model] = true;
         return KeptRotations{warm ? kept.data() : nullptr, kept.data()};
     }
-    /// The last pass's rotations of the count tets of model whose lanes (block * kLanes +
-    /// lane) lane_of gives for members, into near's lanes; false (near untouched) if there was
-    /// no pass.
-    bool gather(int model, const int32_t* members, int count, const int32_t* lane_of, Mat3L& near) const {
-        if (!known_[model]) return false;
-        const Mat3L* last = rotations_[model].data();
-        for (int l = 0; l < count; ++l) {
-            const int32_t lane = lane_of[members[l]];
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) near.m[i][j][l] = last[lane / kLanes].m[i][j][lane % kLanes];
-        }
-        return true;
-    }
-
+    /// The last pass's rotations of model's blocks (one Mat3L per block), or null if there was
+    /// no pass since fit or its law keeps none.
+    const Mat3L* last(int model) const { return known_[model] && !rotations_[model].empty() ? rotations_[model].data() : nullptr; }
 private:
     vec<Mat3L> rotations_[SH_MATERIAL_COUNT];
     bool known_[SH_MATERIAL_COUNT] = {};

@@ -134,6 +134,12 @@ private:
     /// Writes one lane from a tet's Bm, rest volume, material and nodes.
     static void fill_lane_from(const double* bm, double v0, const sh_material& m, const int32_t nodes[4], bool used,
                                TetBlock& b, int lane);
+    /// lane_tets_, rebuilt first if the elements changed since (allocates only then).
+    const vec<int32_t>& tets_by_lane() const;
+    /// The tangent of one block of model's law at positions xs (near: its kept rotations, or
+    /// null), each used lane's (tets: the block's lanes' tets, -1 for none) into system.
+    void add_block_tangent(int model, const TetBlock& b, const Mat3L* near, const int32_t* tets, const double* xs,
+                           double scale, SparseSystem& system) const;
     /// element_omega2_[t], computed first if unknown.
     double frequency_squared_of(size_t t) const;
     /// 2/omega with the stiffness damping, for omega^2 = omega2 (1/s^2).
@@ -154,6 +160,11 @@ private:
     mutable vec<double> element_omega2_;
     mutable int32_t inverted_elements_ = 0;  ///< most elements with det F <= 0 at one evaluation
     vec<int32_t> lane_of_;       ///< per tet: block * kLanes + lane in its model's blocks
+    /// per lane slot of every model's blocks in turn: the tet in it, -1 for none (lane_of_'s
+    /// inverse, for the tangent's scatter), as of matrix_version lane_tets_version_
+    mutable vec<int32_t> lane_tets_;
+    mutable uint64_t lane_tets_version_ = 0;
+    mutable bool lane_tets_known_ = false;
     size_t vacant_lanes_ = 0;    ///< lanes emptied by local changes since blocks were last built
     SurfaceIndex surface_index_; ///< surface_triangles by their nodes
 };

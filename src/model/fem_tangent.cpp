@@ -79,58 +79,58 @@ void element_stiffness(const StressDerivativeLanes& C, const Lanes (&g)[3][3], L
 
 }  // namespace
 
+const vec<int32_t>& FemBody::tets_by_lane() const {
+    if (lane_tets_known_ && lane_tets_version_ == matrix_version) return lane_tets_;
+    size_t slots = 0;
+    size_t first[SH_MATERIAL_COUNT];
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
+        first[model] = slots;
+        slots += blocks_[model].size() * kLanes;
+    }
+    lane_tets_.assign(slots, -1);
+    for (size_t t = 0; t < volume_.size(); ++t)
+        lane_tets_[first[materials_[t].model] + static_cast<size_t>(lane_of_[t])] = static_cast<int32_t>(t);
+    lane_tets_version_ = matrix_version;
+    lane_tets_known_ = true;
+    return lane_tets_;
+}
+
+void FemBody::add_block_tangent(int model, const TetBlock& b, const Mat3L* near, const int32_t* tets, const double* xs,
+                                double scale, SparseSystem& system) const {
+    // The block's weights are -V0 lambda and -V0 mu, and every law's dP/dF is linear in
+    // (lambda, mu) (projected or not: the projection commutes with a positive scale), so the
+    // tangent is formed with them as the Lame parameters and a unit volume.
+    const Mat3L F = mul(gather_edges(b, xs), b.Bm);
+    const Lanes lambda = -b.lambda_w, mu = -b.mu_w;
+    StressDerivativeLanes C;
+    visit_material(model, [&](auto law) {
+        using Law = decltype(law);
+        if constexpr (Law::kProjectTangent)
+            law_projected_derivatives<Law>(F, lambda, mu, near, C);
+        else
+            stress_derivatives<Law>(F, lambda, mu, C);
+    });
+    StiffnessLanes K;
+    element_stiffness(C, b.Bm.m, splat(1.0), K);
+    const double* blocks = reinterpret_cast<const double*>(&K.block[0][0][0][0]);  // a vector aliases a double
+    for (int l = 0; l < kLanes; ++l)
+        if (tets[l] >= 0) system.add_element_lane(static_cast<size_t>(tets[l]), blocks + l, kLanes, scale);
+}
+
 void FemBody::add_tangent(const double* xs, double stiffness_scale, double damping_scale, SparseSystem& system) const {
     const double scale = stiffness_scale + damping_scale * damping_stiffness_;  // D = beta K
     if (scale == 0.0) return;
-    const size_t tet_count = volume_.size();
-
-    auto process = [&](int model, const int32_t* members, int count) {
-        Mat3L F = identity_lanes();
-        Lanes lambda = splat(1.0), mu = splat(1.0), volume = Lanes{};
-        Lanes g[3][3] = {};
-        Mat3L near = identity_lanes();
-        const bool warm = rotations_.gather(model, members, count, lane_of_.data(), near);
-        for (int l = 0; l < count; ++l) {
-            const size_t t = static_cast<size_t>(members[l]);
-            const int32_t* tet = &tets_[4 * t];
-            const double* bm = &inverse_rest_[9 * t];
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) {
-                    double f = 0.0;
-                    for (int a = 0; a < 3; ++a) f += (xs[3 * tet[a + 1] + i] - xs[3 * tet[0] + i]) * bm[3 * a + j];
-                    F.m[i][j][l] = f;
-                    g[i][j][l] = bm[3 * i + j];
-                }
-            lambda[l] = lame_lambda(materials_[t]);
-            mu[l] = lame_mu(materials_[t]);
-            volume[l] = volume_[t];
-        }
-        StressDerivativeLanes C;
-        visit_material(model, [&](auto law) {
-            using Law = decltype(law);
-            if constexpr (Law::kProjectTangent)
-                law_projected_derivatives<Law>(F, lambda, mu, warm ? &near : nullptr, C);
-            else
-                stress_derivatives<Law>(F, lambda, mu, C);
-        });
-        StiffnessLanes K;
-        element_stiffness(C, g, volume, K);
-        const double* blocks = reinterpret_cast<const double*>(&K.block[0][0][0][0]);  // a vector aliases a double
-        for (int l = 0; l < count; ++l) system.add_element_lane(static_cast<size_t>(members[l]), blocks + l, kLanes, scale);
-    };
-
-    int32_t batch[SH_MATERIAL_COUNT][kLanes];
-    int filled[SH_MATERIAL_COUNT] = {};
-    for (size_t t = 0; t < tet_count; ++t) {
-        const int model = materials_[t].model;
-        batch[model][filled[model]++] = static_cast<int32_t>(t);
-        if (filled[model] == kLanes) {
-            process(model, batch[model], kLanes);
-            filled[model] = 0;
-        }
+    // Block by block, as the force passes run: a block's data lie together, the blocks follow
+    // each lane's stretch of the elements' locality order, and the scatter then writes near
+    // where the last block wrote (the free nodes are numbered by position too:
+    // solver/free_node_order.hpp). The file's order of the tets would jump across the matrix.
+    const vec<int32_t>& lane_tets = tets_by_lane();
+    size_t slot = 0;
+    for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
+        const Mat3L* near = rotations_.last(model);
+        for (size_t k = 0; k < blocks_[model].size(); ++k, slot += kLanes)
+            add_block_tangent(model, blocks_[model][k], near ? &near[k] : nullptr, &lane_tets[slot], xs, scale, system);
     }
-    for (int model = 0; model < SH_MATERIAL_COUNT; ++model)
-        if (filled[model] > 0) process(model, batch[model], filled[model]);
 }
 
 }  // namespace sh

@@ -23,33 +23,16 @@ void UpperBlocks::build(const SparseSystem& system) {
         for (int32_t b = first[static_cast<size_t>(j)]; b < first[static_cast<size_t>(j) + 1]; ++b)
             row_node[static_cast<size_t>(b)] = rows[static_cast<size_t>(column + 3 * (b - first[static_cast<size_t>(j)]))] / 3;
     }
-    vec<int32_t> column_start(starts.begin(), starts.end());
-    first_block_.swap(first), row_node_.swap(row_node), column_start_.swap(column_start);
+    first_block_.swap(first), row_node_.swap(row_node);
     node_count_ = n;
     pattern_id_ = system.pattern_id();
 }
 
-double UpperBlocks::diagonal_entry(const double* values, int32_t node, int row, int col) const {
+double UpperBlocks::diagonal_entry(const SparseSystem& a, int32_t node, int row, int col) const {
     // Column 3J + c ends with the diagonal block's rows 0..c.
     const int upper = std::max(row, col), lower = std::min(row, col);
     const size_t column = 3 * static_cast<size_t>(node) + static_cast<size_t>(upper);
-    return values[static_cast<size_t>(column_start_[column + 1] - 1 - upper + lower)];
-}
-
-void UpperBlocks::multiply(const double* values, const double* x, double* y, Node4* lanes) const {
-    Node4* in = lanes;
-    Node4* out = lanes + node_count_;
-    for (int32_t j = 0; j < node_count_; ++j) {
-        in[j] = load_node(x + 3 * static_cast<size_t>(j));
-        out[j] = Node4{};
-    }
-    // Row J gets its diagonal and left blocks here and its right blocks from the later columns'
-    // pushes.
-    for (int32_t j = 0; j < node_count_; ++j) {
-        out[j] += diagonal_times(values, j, in[j]) + pull(values, j, in);
-        push(values, j, in[j], out);
-    }
-    for (int32_t j = 0; j < node_count_; ++j) store_node(out[j], y + 3 * static_cast<size_t>(j));
+    return a.values()[static_cast<size_t>(a.column_starts()[column + 1] - 1 - upper + lower)];
 }
 
 }  // namespace sh

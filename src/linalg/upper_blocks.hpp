@@ -17,8 +17,8 @@
 
 namespace sh {
 
-/// The node blocks of a SparseSystem's pattern (see the file comment); the values are read
-/// from the system given to each call, which must have the pattern built from.
+/// The node blocks of a SparseSystem's pattern (see the file comment); each call reads the
+/// values and column starts of the system it is given, which must have the pattern built from.
 class UpperBlocks {
 public:
     /// The block structure of system's pattern (allocates; on failure it is as it was).
@@ -31,21 +31,21 @@ public:
     const int32_t* first_block() const { return first_block_.data(); }                 ///< per column node J, node_count() + 1
     const int32_t* row_node() const { return row_node_.data(); }                       ///< I of each block
 
-    /// Entry (row, col) of block b of column node J (each 0..2) in values (the system's).
-    double entry(const double* values, int32_t node, int32_t b, int row, int col) const {
-        return values[column_start_[3 * static_cast<size_t>(node) + static_cast<size_t>(col)] +
-                      3 * static_cast<size_t>(b - first_block_[static_cast<size_t>(node)]) + static_cast<size_t>(row)];
+    /// Entry (row, col) of block b of column node J (each 0..2).
+    double entry(const SparseSystem& a, int32_t node, int32_t b, int row, int col) const {
+        return a.values()[static_cast<size_t>(a.column_starts()[3 * static_cast<size_t>(node) + static_cast<size_t>(col)]) +
+                          3 * static_cast<size_t>(b - first_block_[static_cast<size_t>(node)]) + static_cast<size_t>(row)];
     }
     /// Entry (row, col) of node J's diagonal block.
-    double diagonal_entry(const double* values, int32_t node, int row, int col) const;
+    double diagonal_entry(const SparseSystem& a, int32_t node, int row, int col) const;
 
     /// The sum over node J's blocks of A_JI x_I (x in node lanes; their fourth lanes are not
     /// read), its fourth lane 0.
-    Node4 pull(const double* values, int32_t node, const Node4* x) const {
+    Node4 pull(const SparseSystem& a, int32_t node, const Node4* x) const {
         Node4 dot[3] = {};
         const int32_t begin = first_block_[static_cast<size_t>(node)], end = first_block_[static_cast<size_t>(node) + 1];
         const double* column[3];
-        columns(values, node, column);
+        columns(a, node, column);
         for (int32_t b = begin; b < end; ++b) {
             const Node4 xi = x[row_node_[static_cast<size_t>(b)]];
             const size_t at = 3 * static_cast<size_t>(b - begin);
@@ -55,31 +55,29 @@ public:
     }
     /// out_I += A_IJ u over node J's blocks (the fourth lanes of out take what the columns'
     /// next entries give: read them as three values).
-    void push(const double* values, int32_t node, Node4 u, Node4* out) const {
+    void push(const SparseSystem& a, int32_t node, Node4 u, Node4* out) const {
         const int32_t begin = first_block_[static_cast<size_t>(node)], end = first_block_[static_cast<size_t>(node) + 1];
         const double* column[3];
-        columns(values, node, column);
+        columns(a, node, column);
         for (int32_t b = begin; b < end; ++b) {
             const size_t at = 3 * static_cast<size_t>(b - begin);
             out[row_node_[static_cast<size_t>(b)]] +=
                 load_column(column[0] + at) * u[0] + load_column(column[1] + at) * u[1] + load_column(column[2] + at) * u[2];
         }
     }
-    /// y = A x for the full symmetric matrix (3 per node each; x and y must not overlap);
-    /// lanes: 2 node_count() node lanes of scratch.
-    void multiply(const double* values, const double* x, double* y, Node4* lanes) const;
     /// Node J's diagonal block times x (node lanes).
-    Node4 diagonal_times(const double* values, int32_t node, Node4 x) const {
+    Node4 diagonal_times(const SparseSystem& a, int32_t node, Node4 x) const {
         Node4 out{};
         for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) out[r] += diagonal_entry(values, node, r, c) * x[c];
+            for (int c = 0; c < 3; ++c) out[r] += diagonal_entry(a, node, r, c) * x[c];
         return out;
     }
 
 private:
     // Where node J's DOF columns start in the values (the first block's column c).
-    void columns(const double* values, int32_t node, const double* (&out)[3]) const {
-        for (int c = 0; c < 3; ++c) out[c] = values + column_start_[3 * static_cast<size_t>(node) + static_cast<size_t>(c)];
+    static void columns(const SparseSystem& a, int32_t node, const double* (&out)[3]) {
+        for (int c = 0; c < 3; ++c)
+            out[c] = a.values().data() + a.column_starts()[3 * static_cast<size_t>(node) + static_cast<size_t>(c)];
     }
     // The three values from p in lanes 0-2; lane 3 holds p[3], the column's next entry. That
     // lane never reaches lanes 0-2 of a result: pull sums lanes 0-2 of its products only, and
@@ -96,7 +94,6 @@ private:
     uint64_t pattern_id_ = 0;
     vec<int32_t> first_block_;   // node_count_ + 1
     vec<int32_t> row_node_;      // per block
-    vec<int32_t> column_start_;  // 3 per node and the end: the system's column starts
 };
 
 }  // namespace sh

@@ -176,17 +176,17 @@ void WarpedMultigrid::add_coarse_block(int32_t a, int32_t b, const Eigen::Matrix
     }
 }
 
-void WarpedMultigrid::build_coarse(const double* values) {
+void WarpedMultigrid::build_coarse(const SparseSystem& a0) {
     const Eigen::Index n = 3 * static_cast<Eigen::Index>(coarse_count_);
     Eigen::MatrixXd coarse = Eigen::MatrixXd::Zero(n, n);
     for (int32_t j = 0; j < blocks_.node_count(); ++j) {
         Eigen::Matrix3d block;
         for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) block(r, c) = blocks_.diagonal_entry(values, j, r, c);
+            for (int c = 0; c < 3; ++c) block(r, c) = blocks_.diagonal_entry(a0, j, r, c);
         add_coarse_block(j, j, block, coarse);
         for (int32_t b = blocks_.first_block()[j]; b < blocks_.first_block()[j + 1]; ++b) {
             for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c) block(r, c) = blocks_.entry(values, j, b, r, c);
+                for (int c = 0; c < 3; ++c) block(r, c) = blocks_.entry(a0, j, b, r, c);
             const int32_t i = blocks_.row_node()[b];
             add_coarse_block(i, j, block, coarse);
             add_coarse_block(j, i, block.transpose(), coarse);
@@ -204,13 +204,12 @@ void WarpedMultigrid::build(const SparseSystem& a0, const double* rest) {
     blocks_.build(a0);
     const int32_t nodes = blocks_.node_count();
     build_prolongation(rest, nodes);
-    build_coarse(a0.values().data());
+    build_coarse(a0);
     inverse_diagonal_.assign(3 * static_cast<size_t>(nodes), Node4{});
     turn_.assign(6 * static_cast<size_t>(nodes), Node4{});
     coarse_lanes_.assign(static_cast<size_t>(coarse_count_), Node4{});
     z_.assign(static_cast<size_t>(nodes), Node4{});
     pushed_.assign(static_cast<size_t>(nodes), Node4{});
-    product_lanes_.assign(2 * static_cast<size_t>(nodes), Node4{});
     residual_.assign(static_cast<size_t>(nodes), Node4{});
     change_.assign(static_cast<size_t>(nodes), Node4{});
     built_ = true;
@@ -218,7 +217,7 @@ void WarpedMultigrid::build(const SparseSystem& a0, const double* rest) {
 
 void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
     SH_REQUIRE(built_for(a), SH_ERR_INTERNAL, "multigrid: prepared with another pattern than it was built for");
-    values_ = a.values().data();
+    system_ = &a;
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
         const double* R = rotations + 9 * static_cast<size_t>(i);  // row-major
         Node4* turn = &turn_[6 * static_cast<size_t>(i)];
@@ -230,7 +229,7 @@ void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
         Eigen::Matrix3d d;
         for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) d(r, c) = blocks_.diagonal_entry(values_, i, r, c);
+            for (int c = 0; c < 3; ++c) d(r, c) = blocks_.diagonal_entry(*system_, i, r, c);
         const Eigen::LLT<Eigen::Matrix3d> cholesky(d);
         const Eigen::Matrix3d inverse = cholesky.solve(Eigen::Matrix3d::Identity());
         SH_REQUIRE(cholesky.info() == Eigen::Success && inverse.allFinite(), SH_ERR_SOLVER,
@@ -247,9 +246,9 @@ void WarpedMultigrid::backward_sweep(const double* r, double* z) {
     std::fill(pushed_.begin(), pushed_.end(), Node4{});
     for (int32_t j = blocks_.node_count() - 1; j >= 0; --j) {
         const size_t n = static_cast<size_t>(j);
-        const Node4 s = load_node(r + 3 * n) - pushed_[n] - blocks_.pull(values_, j, z_.data());
+        const Node4 s = load_node(r + 3 * n) - pushed_[n] - blocks_.pull(*system_, j, z_.data());
         const Node4 updated = block_times(&inverse_diagonal_[3 * n], s);
-        blocks_.push(values_, j, updated, pushed_.data());
+        blocks_.push(*system_, j, updated, pushed_.data());
         change_[n] = updated - z_[n];
         z_[n] = updated;
         store_node(updated, z + 3 * n);
@@ -261,8 +260,8 @@ void WarpedMultigrid::first_sweep(const double* r) {
     std::fill(residual_.begin(), residual_.end(), Node4{});
     for (int32_t j = 0; j < blocks_.node_count(); ++j) {
         const size_t n = static_cast<size_t>(j);
-        z_[n] = block_times(&inverse_diagonal_[3 * n], load_node(r + 3 * n) - blocks_.pull(values_, j, z_.data()));
-        blocks_.push(values_, j, -z_[n], residual_.data());
+        z_[n] = block_times(&inverse_diagonal_[3 * n], load_node(r + 3 * n) - blocks_.pull(*system_, j, z_.data()));
+        blocks_.push(*system_, j, -z_[n], residual_.data());
     }
 }
 
@@ -304,7 +303,7 @@ bool WarpedMultigrid::apply_with_product(const double* r, double* z, double* az)
     // (A z)_j = r_j + sum over i < j of A_ji change_i.
     for (int32_t j = 0; j < blocks_.node_count(); ++j) {
         const size_t n = static_cast<size_t>(j);
-        store_node(load_node(r + 3 * n) + blocks_.pull(values_, j, change_.data()), az + 3 * n);
+        store_node(load_node(r + 3 * n) + blocks_.pull(*system_, j, change_.data()), az + 3 * n);
     }
     return true;
 }

@@ -5,8 +5,9 @@
 // by each node's rotation R, so the coarse correction is warped by them (restricted by
 // P^T R^T, prolonged by R P) instead of rebuilt. The smoother is block Gauss-Seidel on the
 // current matrix (3x3 node blocks, forward before and backward after the coarse correction,
-// so the cycle is symmetric). Its setup per step is loading the matrix and the rotations; no
-// factorisation of the fine matrix, which at 20 k tets costs 20-26 solves.
+// so the cycle is symmetric), reading the system's stored triangle in place (UpperBlocks). Its
+// setup per step is the diagonal blocks' inverses and the rotations; no factorisation of the
+// fine matrix, which at 20 k tets costs 20-26 solves.
 #pragma once
 
 #include "core/memory.hpp"
@@ -43,8 +44,6 @@ public:
     /// row of A z equal to r but for the blocks left of its diagonal times the changes the
     /// sweep made after it (Eisenstat's observation), so only those blocks are read again.
     bool apply_with_product(const double* r, double* z, double* az) override;
-    /// y = A x with the prepared matrix (the product CG needs, from the same blocks).
-    void multiply(const double* x, double* y) { blocks_.multiply(values_, x, y, product_lanes_.data()); }
     /// One apply's work plus CG's product (half a product, apply_with_product), in a sparse
     /// solve's operations (FactorWork).
     double iteration_work() const;
@@ -61,8 +60,8 @@ private:
     /// holds (parts joined by elements: blocks_'s pattern), so that a cut, or legs that share
     /// grid cells but no element, are not tied together; renumbers corner_, returns the count.
     int32_t split_by_connection(int32_t nodes);
-    /// coarse_ := P^T A0 P (A0's values) and its Cholesky factor.
-    void build_coarse(const double* values);
+    /// coarse_ := P^T A0 P and its Cholesky factor.
+    void build_coarse(const SparseSystem& a0);
     /// coarse += P_a^T block P_b (the coarse image of the matrix's block (a, b)).
     void add_coarse_block(int32_t a, int32_t b, const Eigen::Matrix3d& block, Eigen::MatrixXd& coarse) const;
     /// One block Gauss-Seidel sweep over the nodes backward, on z_ towards r; change_ := what
@@ -78,7 +77,7 @@ private:
 
     bool built_ = false;
     UpperBlocks blocks_;           // the system's block structure
-    const double* values_ = nullptr;  // the prepared system's values
+    const SparseSystem* system_ = nullptr;  // the prepared system, read in place
     vec<Node4> inverse_diagonal_;  // 3 columns per node: the current diagonal blocks' inverses
     vec<Node4> turn_;              // 6 per node: the columns of its rotation R, then of R^T
     vec<int32_t> corner_;          // 8 per node: the coarse nodes of its grid cell (-1: weight 0)
@@ -91,7 +90,6 @@ private:
     vec<Node4> residual_;                 // r - A z_ after the first sweep
     vec<Node4> change_;                   // the backward sweep's change of z_
     vec<Node4> pushed_;                   // the backward sweep's sums from the nodes after each
-    vec<Node4> product_lanes_;            // multiply's scratch
     vec<int32_t> scratch_;                // the grid's node numbers, then the union-find's parents
 };
 

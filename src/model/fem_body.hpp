@@ -161,10 +161,10 @@ private:
     mutable int32_t inverted_elements_ = 0;  ///< most elements with det F <= 0 at one evaluation
     vec<int32_t> lane_of_;       ///< per tet: block * kLanes + lane in its model's blocks
     /// per lane slot of every model's blocks in turn: the tet in it, -1 for none (lane_of_'s
-    /// inverse, for the tangent's scatter), as of matrix_version lane_tets_version_
+    /// inverse, for the tangent's scatter), as of matrix_version lane_tets_version_ (0: never;
+    /// building the elements bumps matrix_version past it)
     mutable vec<int32_t> lane_tets_;
     mutable uint64_t lane_tets_version_ = 0;
-    mutable bool lane_tets_known_ = false;
     size_t vacant_lanes_ = 0;    ///< lanes emptied by local changes since blocks were last built
     SurfaceIndex surface_index_; ///< surface_triangles by their nodes
 };

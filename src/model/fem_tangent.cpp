@@ -80,7 +80,7 @@ void element_stiffness(const StressDerivativeLanes& C, const Lanes (&g)[3][3], L
 }  // namespace
 
 const vec<int32_t>& FemBody::tets_by_lane() const {
-    if (lane_tets_known_ && lane_tets_version_ == matrix_version) return lane_tets_;
+    if (lane_tets_version_ == matrix_version) return lane_tets_;  // every element change bumps it
     size_t slots = 0;
     size_t first[SH_MATERIAL_COUNT];
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
@@ -91,7 +91,6 @@ const vec<int32_t>& FemBody::tets_by_lane() const {
     for (size_t t = 0; t < volume_.size(); ++t)
         lane_tets_[first[materials_[t].model] + static_cast<size_t>(lane_of_[t])] = static_cast<int32_t>(t);
     lane_tets_version_ = matrix_version;
-    lane_tets_known_ = true;
     return lane_tets_;
 }
 

@@ -56,6 +56,24 @@ vec<int32_t> free_dofs(const int32_t* free_index, int32_t node_count, int32_t fr
     return dof_to_global;
 }
 
+// The elements in assembly order (element_order, or 0, 1, ... for nullptr) and each element's
+// position in it, checking that element_order is a permutation of [0, element_count).
+void assembly_order(const int32_t* element_order, size_t element_count, vec<int32_t>& order, vec<int32_t>& position) {
+    SH_REQUIRE(element_count <= static_cast<size_t>(INT32_MAX), SH_ERR_CAPACITY,
+               "sparse system: %zu elements exceed 2^31 - 1", element_count);
+    order.resize(element_count);
+    position.assign(element_count, -1);
+    for (size_t p = 0; p < element_count; ++p) {
+        const int32_t e = element_order ? element_order[p] : static_cast<int32_t>(p);
+        SH_REQUIRE(e >= 0 && static_cast<size_t>(e) < element_count && position[static_cast<size_t>(e)] < 0,
+                   SH_ERR_INVALID_ARGUMENT,
+                   "sparse system: element_order[%zu] = %d is out of [0, %zu) or repeats an earlier entry", p, e,
+                   element_count);
+        order[p] = e;
+        position[static_cast<size_t>(e)] = static_cast<int32_t>(p);
+    }
+}
+
 // The node-block pattern of the strict upper triangle: for free column node J, the sorted,
 // distinct free row nodes I < J sharing an element with it, rows[start[J], start[J + 1]).
 struct NodeBlocks {
@@ -128,11 +146,11 @@ void expand_columns(const NodeBlocks& blocks, size_t nfree, vec<int32_t>& column
 // the diagonal block (I == J) coming after all block rows and keeping only r <= s. Pairs with
 // I > J are left out: their entries lie in the lower triangle (the pair (b, a) supplies them).
 // That is exactly "local (p, q) is added when g(p) <= g(q)", also for a repeated node.
-void SparseSystem::build_scatter_map(const int32_t* elements, size_t element_count, size_t k,
+void SparseSystem::build_scatter_map(const int32_t* elements, const vec<int32_t>& order, size_t k,
                                      const int32_t* free_index, const vec<size_t>& block_start,
                                      const vec<int32_t>& block_rows, const vec<int32_t>& column_starts,
                                      vec<size_t>& record_start, vec<BlockRecord>& records) {
-    const size_t n3 = 3 * k;
+    const size_t n3 = 3 * k, element_count = order.size();
     record_start.assign(element_count + 1, 0);
     auto element_blocks = [&](size_t e, auto&& visit) {
         const int32_t* en = elements + e * k;
@@ -146,15 +164,15 @@ void SparseSystem::build_scatter_map(const int32_t* elements, size_t element_cou
             }
         }
     };
-    for (size_t e = 0; e < element_count; ++e) {
+    for (size_t p = 0; p < element_count; ++p) {
         size_t count = 0;
-        element_blocks(e, [&](size_t, size_t, int32_t, int32_t) { ++count; });
-        record_start[e + 1] = record_start[e] + count;
+        element_blocks(static_cast<size_t>(order[p]), [&](size_t, size_t, int32_t, int32_t) { ++count; });
+        record_start[p + 1] = record_start[p] + count;
     }
     records.resize(record_start[element_count]);
-    for (size_t e = 0; e < element_count; ++e) {
-        size_t i = record_start[e];
-        element_blocks(e, [&](size_t a, size_t b, int32_t fi, int32_t fj) {
+    for (size_t p = 0; p < element_count; ++p) {
+        size_t i = record_start[p];
+        element_blocks(static_cast<size_t>(order[p]), [&](size_t a, size_t b, int32_t fi, int32_t fj) {
             const size_t j = static_cast<size_t>(fj);
             const int32_t* rows = block_rows.data() + block_start[j];
             const size_t count = block_start[j + 1] - block_start[j];
@@ -170,7 +188,7 @@ void SparseSystem::build_scatter_map(const int32_t* elements, size_t element_cou
 
 void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, int nodes_per_element,
                                  const int32_t* free_index, int32_t node_count, int32_t free_count,
-                                 const int32_t* links, size_t link_count) {
+                                 const int32_t* links, size_t link_count, const int32_t* element_order) {
     // Start empty, so a failure below (bad input, std::bad_alloc) leaves an empty system.
     {
         SparseSystem empty;
@@ -187,10 +205,11 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
     vec<int32_t> column_starts(3 * nfree + 1);
     vec<int32_t> row_indices(static_cast<size_t>(nnz));
     expand_columns(blocks, nfree, column_starts, row_indices);
+    vec<int32_t> order, position;
+    assembly_order(element_order, element_count, order, position);
     vec<size_t> record_start;
     vec<BlockRecord> records;
-    build_scatter_map(elements, element_count, k, free_index, blocks.start, blocks.rows, column_starts, record_start,
-                      records);
+    build_scatter_map(elements, order, k, free_index, blocks.start, blocks.rows, column_starts, record_start, records);
     vec<double> values(static_cast<size_t>(nnz), 0.0);
 
     dof_count_ = 3 * free_count;
@@ -200,6 +219,7 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
     values_.swap(values);
     dof_to_global_.swap(dof_to_global);
     local_size_ = static_cast<int32_t>(3 * k);
+    element_position_.swap(position);
     block_record_start_.swap(record_start);
     block_records_.swap(records);
     pattern_id_ = g_next_pattern_id.fetch_add(1);
@@ -212,8 +232,9 @@ void SparseSystem::scatter_element(size_t element, double scale, const Entry& en
     SH_REQUIRE(element < element_count_, SH_ERR_INTERNAL, "sparse system: element %zu of %zu", element,
                element_count_);
     double* v = values_.data();
-    const BlockRecord* rec = block_records_.data() + block_record_start_[element];
-    const BlockRecord* end = block_records_.data() + block_record_start_[element + 1];
+    const size_t position = static_cast<size_t>(element_position_[element]);
+    const BlockRecord* rec = block_records_.data() + block_record_start_[position];
+    const BlockRecord* end = block_records_.data() + block_record_start_[position + 1];
     for (; rec != end; ++rec) {
         if (!rec->diagonal) {
             for (int s = 0; s < 3; ++s) {

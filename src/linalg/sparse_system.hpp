@@ -31,9 +31,14 @@ public:
     /// links: link_count node pairs (links[2l], links[2l + 1]) whose blocks the pattern holds
     /// too, though they may share no element (a field's coupling, e.g. a contact that spans
     /// several faces); add_block reaches them, add_element does not.
+    /// element_order: the order the elements will be added in, a permutation of
+    /// [0, element_count) (nullptr: 0, 1, ...). The scatter map is laid out in it, so that an
+    /// assembly in that order reads the map in sequence; only speed depends on it. Throws
+    /// SH_ERR_INVALID_ARGUMENT if it is not a permutation.
     void build_pattern(const int32_t* elements, size_t element_count, int nodes_per_element,
                        const int32_t* free_index, int32_t node_count, int32_t free_count,
-                       const int32_t* links = nullptr, size_t link_count = 0);
+                       const int32_t* links = nullptr, size_t link_count = 0,
+                       const int32_t* element_order = nullptr);
     int32_t dof_count() const { return dof_count_; }  ///< 3 * free_count
     int64_t nonzero_count() const { return static_cast<int64_t>(row_indices_.size()); }  ///< stored (upper) entries
     void clear_values();                 ///< all values to 0
@@ -83,8 +88,9 @@ private:
     vec<int32_t> row_indices_;
     vec<double> values_;
     vec<int32_t> dof_to_global_;
-    // Element scatter map: records [block_record_start_[e], block_record_start_[e+1]) of element
-    // e, one per local node pair (a, b) whose global block (I, J) has I <= J.
+    // Element scatter map: element e's records, one per local node pair (a, b) whose global
+    // block (I, J) has I <= J, are [block_record_start_[p], block_record_start_[p + 1]) for its
+    // position p = element_position_[e] in the assembly order.
     struct BlockRecord {
         int32_t slot[3];        // value slot of global entry (3I, 3J + s); rows 3I+1, 3I+2 follow it
         uint16_t local;         // Ke offset of the block: 3a * 3k + 3b
@@ -96,15 +102,17 @@ private:
     template <class Entry>
     void scatter_element(size_t element, double scale, const Entry& entry);
     int32_t local_size_ = 0;  // 3k
+    vec<int32_t> element_position_;
     vec<size_t> block_record_start_;
     vec<BlockRecord> block_records_;
 
     /// The element scatter map (records per element, see sparse_system.cpp) over the node
     /// blocks (block_start, block_rows) and DOF columns (column_starts) of the pattern.
-    static void build_scatter_map(const int32_t* elements, size_t element_count, size_t k, const int32_t* free_index,
-                                  const vec<size_t>& block_start, const vec<int32_t>& block_rows,
-                                  const vec<int32_t>& column_starts, vec<size_t>& record_start,
-                                  vec<BlockRecord>& records);
+    /// order: the elements in assembly order (element_position_'s inverse).
+    static void build_scatter_map(const int32_t* elements, const vec<int32_t>& order, size_t k,
+                                  const int32_t* free_index, const vec<size_t>& block_start,
+                                  const vec<int32_t>& block_rows, const vec<int32_t>& column_starts,
+                                  vec<size_t>& record_start, vec<BlockRecord>& records);
 };
 
 }  // namespace sh

@@ -95,6 +95,11 @@ public:
     /// Element connectivity: element_count() x nodes_per_element() node indices.
     virtual const int32_t* element_nodes() const = 0;
 
+    /// The order add_tangent adds its elements in, a permutation of [0, element_count()), or
+    /// nullptr for 0, 1, ...: the sparse system lays its scatter map out in it (see
+    /// SparseSystem::build_pattern). Valid until the elements change.
+    virtual const int32_t* tangent_order() const { return nullptr; }
+
     /// 4 for tets, 2 for springs.
     virtual int nodes_per_element() const = 0;
 

@@ -65,6 +65,8 @@ public:
     void add_tangent(const double* x, double stiffness_scale, double damping_scale,
                      SparseSystem& system) const override;
     const int32_t* element_nodes() const override { return tets_.data(); }
+    /// The tets in their blocks' lane order (the kernel blocks' locality order).
+    const int32_t* tangent_order() const override;
     int nodes_per_element() const override { return 4; }
     int32_t element_count() const override { return static_cast<int32_t>(volume_.size()); }
     bool is_fem() const override { return true; }
@@ -134,7 +136,8 @@ private:
     /// Writes one lane from a tet's Bm, rest volume, material and nodes.
     static void fill_lane_from(const double* bm, double v0, const sh_material& m, const int32_t nodes[4], bool used,
                                TetBlock& b, int lane);
-    /// lane_tets_, rebuilt first if the elements changed since (allocates only then).
+    /// lane_tets_, rebuilt first (with tangent_order_) if the elements changed since
+    /// (allocates only then).
     const vec<int32_t>& tets_by_lane() const;
     /// The tangent of one block of model's law at positions xs (near: its kept rotations, or
     /// null), each used lane's (tets: the block's lanes' tets, -1 for none) into system.
@@ -164,6 +167,7 @@ private:
     /// inverse, for the tangent's scatter), as of matrix_version lane_tets_version_ (0: never;
     /// building the elements bumps matrix_version past it)
     mutable vec<int32_t> lane_tets_;
+    mutable vec<int32_t> tangent_order_;  ///< lane_tets_ without its empty lanes
     mutable uint64_t lane_tets_version_ = 0;
     size_t vacant_lanes_ = 0;    ///< lanes emptied by local changes since blocks were last built
     SurfaceIndex surface_index_; ///< surface_triangles by their nodes

@@ -90,9 +90,15 @@ const vec<int32_t>& FemBody::tets_by_lane() const {
     lane_tets_.assign(slots, -1);
     for (size_t t = 0; t < volume_.size(); ++t)
         lane_tets_[first[materials_[t].model] + static_cast<size_t>(lane_of_[t])] = static_cast<int32_t>(t);
+    tangent_order_.clear();
+    tangent_order_.reserve(volume_.size());
+    for (const int32_t t : lane_tets_)
+        if (t >= 0) tangent_order_.push_back(t);
     lane_tets_version_ = matrix_version;
     return lane_tets_;
 }
+
+const int32_t* FemBody::tangent_order() const { return tets_by_lane().size() ? tangent_order_.data() : nullptr; }
 
 void FemBody::add_block_tangent(int model, const TetBlock& b, const Mat3L* near, const int32_t* tets, const double* xs,
                                 double scale, SparseSystem& system) const {

@@ -71,7 +71,7 @@ int32_t NewtonBodyState::prepare(const Body& body, const sh_implicit_settings& s
     link_key_pairs(grown, link_pairs);
     SparseSystem pattern;
     pattern.build_pattern(body.element_nodes(), static_cast<size_t>(body.element_count()), body.nodes_per_element(),
-                          index.data(), n, count, link_pairs.data(), link_pairs.size() / 2);
+                          index.data(), n, count, link_pairs.data(), link_pairs.size() / 2, body.tangent_order());
     EliminationOrder suggested;
     const bool suggest = own_solver && carried_order(body, elimination, index, count, suggested);
     LinearSolverPtr solver = own_solver ? make_analysed_solver(pattern, s, suggest ? &suggested : nullptr) : nullptr;

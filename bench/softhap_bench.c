@@ -3,8 +3,9 @@
  *
  *   softhap_bench [FILTER] [--steps N] [--meshes DIR]      FEM materials and springs
  *   softhap_bench integrators [FILTER] [--steps N]          forward/symplectic Euler, RK2, RK4
- *   softhap_bench implicit [FILTER] [--steps N]             implicit Euler step, direct vs CG;
- *                                                           and on a 20 k-tet cube (stand, droop)
+ *   softhap_bench implicit [FILTER] [--steps N] [--trace]   implicit Euler step, direct vs CG;
+ *                                                           and on a 20 k-tet cube (stand, droop);
+ *                                                           --trace: each step's line on stderr
  *   softhap_bench contact [FILTER] [--steps N]              collision and contact time per step
  *   softhap_bench accuracy [--quick] [--jobs N]             error against run time (accuracy.c)
  *   softhap_bench haptic [FILTER] [--steps N]               haptic step cost vs buffer size (haptic.c)
@@ -61,6 +62,7 @@ static const char* const kMeshes[] = {"Armadillo_Tetra_4406", "raptorTetra_8418"
 static const char* g_mesh_dir = NULL;
 static int g_steps = 0; /* --steps N; 0 = adaptive */
 static double g_factor_reuse = -1.0; /* implicit: --factor-reuse X; < 0 = the default */
+static int g_trace = 0; /* implicit: --trace, one JSON line per timed step on stderr */
 
 /* ------------------------------------------------------------------------------------------ */
 /* Scenes                                                                                       */
@@ -353,6 +355,9 @@ static void step_implicit(sh_world* world, int ramp, int steps, const char* name
             continue;
         }
         r->wall[s] = ns;
+        if (g_trace)
+            fprintf(stderr, "{\"case\":\"%s\",\"step\":%d,\"ms\":%.3f,\"factorizations\":%d,\"linear_iterations\":%d}\n",
+                    name, s, ns * 1e-6, report.factorizations, report.linear_iterations);
         r->factorize += report.factorize_seconds;
         r->solve += report.solve_seconds;
         r->factorizations += report.factorize_seconds > 0.0;
@@ -665,6 +670,7 @@ static void usage(void) {
             "       softhap_bench accuracy|haptic|haptic-error|haptic-force|palpation|cut ... (see their --help)\n"
             "  FILTER  keep the cases whose name contains it (e.g. stvk/raptorTetra_19409)\n"
             "  --steps N  timed steps per case (default: adaptive, %d..%d; implicit 100, contact 200)\n"
+            "  --trace  implicit: each timed step's time, factorisations and iterations on stderr\n"
             "  --meshes DIR  mesh folder (default $SOFTHAP_MESHES, " SOFTHAP_BENCH_MESH_DIR
             ", ../shared/meshes)\n",
             kMinSteps, kMaxSteps);
@@ -684,6 +690,8 @@ int main(int argc, char** argv) {
                 usage();
                 return 2;
             }
+        } else if (strcmp(argv[i], "--trace") == 0) {
+            g_trace = 1;
         } else if (strcmp(argv[i], "--factor-reuse") == 0 && i + 1 < argc) {
             g_factor_reuse = atof(argv[++i]);
         } else if (strcmp(argv[i], "--meshes") == 0 && i + 1 < argc) {

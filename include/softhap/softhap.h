@@ -387,8 +387,9 @@ typedef struct sh_implicit_settings {
                                          max(20, this)): contacts that switch on within the
                                          step would make a linearised step oscillate. A
                                          linearised step that would raise the mechanical
-                                         energy with no work done on the body goes on up to 20
-                                         iterations towards the step's minimiser */
+                                         energy with no work done on the body goes on towards
+                                         the step's minimiser (up to 20 iterations) until an
+                                         iterate no longer raises it */
     double newton_tolerance;        /**< (dimensionless) stop when the residual |g| <= tol max(|g_0|, dt |f|)
                                          (f: f_ext + m g and the push of tools and other
                                          bodies at its first iterate) or the velocity correction
@@ -419,9 +420,11 @@ typedef struct sh_implicit_settings {
                                          its rest shape, warped by its nodes' rotations) where
                                          that costs less per step than new factorisations, and
                                          keeps it across steps until its nodes settle or it
-                                         fails to converge within two factorisations' work;
-                                         changing dt by more than 25 % or the matrix rebuilds
-                                         it. These choices weigh work estimated from counts,
+                                         fails to cut the residual by factor_reuse within two
+                                         factorisations' work (then it sits out 1, 2, 4 ... 64
+                                         steps, doubling with each failure in a row, before it
+                                         may serve again); changing dt by more than 25 % or the
+                                         matrix rebuilds it. These choices weigh work estimated from counts,
                                          never measured time, so that identical runs repeat bit
                                          for bit. Changing dt,
                                          the fixed nodes, a material or node

@@ -43,9 +43,10 @@ constexpr int kMaxStaleSolves = 4;
 // factorisation wherever krylov_pays finds it cheaper per step than new factorisations: under
 // large rotation a factorisation (20-26 solves at 20 k tets) goes stale within a step or two,
 // where 5-7 multigrid iterations cost about one solve and never go stale. Once chosen, steps
-// start with it; once it fails to converge within kMultigridBudget factorisations' work, the
-// body keeps factorisations until its matrix version or the step size changes. Smaller bodies
-// factorise in a few ms and keep the direct path.
+// start with it; once a solve fails to cut the residual by factor_reuse within
+// kMultigridBudget factorisations' work, the body factorises and the multigrid sits out a
+// pause of steps (NewtonMatrix::multigrid_pause) before krylov_pays may weigh it again. Smaller
+// bodies factorise in a few ms and keep the direct path.
 constexpr int32_t kMultigridMinDofs = 9000;
 // The multigrid built for one step size serves steps within this fraction of it (it only
 // preconditions; a host alternating 1/60 and 1/61 s would rebuild it every step).
@@ -55,6 +56,9 @@ constexpr double kMultigridStepTolerance = 0.25;
 // times in 30 steps, a few steps many times), one step's factorisation and the solves after it
 // cost about that much (the raptor's solves need 27-30 iterations).
 constexpr double kMultigridBudget = 2.0;
+// The most steps the multigrid sits out after a solve it could not bring to a usable residual
+// (the pause doubles with each such failure in a row, from 1).
+constexpr int kMaxMultigridPause = 64;
 // Nodes that turn by less than this (rad) per update for NewtonMatrix::multigrid_calm_needed
 // multigrid updates in a row (10 at first) have settled: the body goes back to factorisations,
 // which then last many steps with one solve each, where the multigrid keeps costing an assembly
@@ -172,8 +176,8 @@ private:
     bool build_multigrid();
     /// The multigrid does not serve this body until its matrix version or step size changes.
     void drop_multigrid();
-    /// The update by CG preconditioned by the multigrid on the assembled tangent; false (the
-    /// multigrid dropped) if it did not converge within a factorisation's work.
+    /// The update by CG preconditioned by the multigrid on the assembled tangent; false (out of
+    /// multigrid mode) if it did not reach a usable residual within two factorisations' work.
     bool solve_by_multigrid();
     /// After a multigrid update: leaves multigrid mode once the nodes have turned by less than
     /// kCalmTurn per update for multigrid_calm_needed updates (a new factorisation would then
@@ -241,6 +245,7 @@ private:
     bool krylov_update_ = false;   // the last update came from such CG (it counts as fresh_)
     bool krylov_failed_ = false;   // CG failed this step: no more of it
     bool multigrid_ = false;       // CG is preconditioned by the multigrid, not the kept factorisation
+    bool multigrid_resting_ = false;  // this step is one of a pause of the multigrid's
     bool assembled_ = false;       // matrix_.system holds the tangent at the current iterate
     bool in_contact_ = false;      // a body has contact candidates (a field) this step
     uint64_t matrix_version_ = 0;  // the bodies' matrix version at the step's start
@@ -333,6 +338,8 @@ void NewtonStep::begin() {
     factor_current_ = reuse_ && allow_stale_ && matrix_.kept.valid && matrix_.kept.dt == dt_ &&
                       matrix_.kept.matrix_version == matrix_version_;
     if (factor_current_) ++matrix_.kept.steps_served;
+    multigrid_resting_ = matrix_.multigrid_pause > 0;
+    if (multigrid_resting_) --matrix_.multigrid_pause;
 }
 
 bool NewtonStep::use_multigrid() {
@@ -341,7 +348,7 @@ bool NewtonStep::use_multigrid() {
         return false;
     const bool current = std::fabs(matrix_.multigrid_dt / dt_ - 1.0) <= kMultigridStepTolerance &&
                          matrix_.multigrid_version == matrix_version_;
-    if (current && matrix_.multigrid_failed) return false;
+    if (current && (matrix_.multigrid_failed || multigrid_resting_)) return false;
     if (current && matrix_.multigrid.built_for(matrix_.system)) return true;
     return build_multigrid();
 }
@@ -359,6 +366,8 @@ bool NewtonStep::build_multigrid() {
     matrix_.multigrid_dt = dt_;
     matrix_.multigrid_version = matrix_version_;
     matrix_.multigrid_calm_steps = 0;
+    matrix_.multigrid_pause = 0;
+    matrix_.multigrid_pause_length = 1;
     const vec<int32_t>& global = matrix_.system.dof_to_global();
     vec<double> rest(global.size());
     for (size_t d = 0; d < global.size(); ++d) rest[d] = body.rest[static_cast<size_t>(global[d])];
@@ -526,14 +535,22 @@ bool NewtonStep::solve_by_multigrid() {
     result_.linear_iterations += cg.iterations;
     result_.solve_seconds += cg.seconds;
     used_stale = true;  // an inexact update: a failed step retries with factorisations
-    // A body it fails on (a thin body turning fast, such as the raptor's corotational swing:
-    // 10-44 iterations, then over 50) keeps factorisations until its matrix changes.
-    if (!cg.converged) {
-        drop_multigrid();
+    double& mean = matrix_.multigrid_iterations;
+    // At the cap, an update that cuts the linearised residual by factor_reuse is as good as a
+    // linearised step asks (see iterate()): the line search judges it as any other. One that
+    // does not (a thin body whipping round: the raptor's swing needs 40-50 iterations at its
+    // fastest) is solved by a factorisation, and the multigrid sits out the next steps
+    // (NewtonMatrix::multigrid_pause) before krylov_pays may weigh it again.
+    const bool acceptable = cg.converged || cg.relative_residual <= s_.factor_reuse;
+    mean = kKeepLife * mean + (1.0 - kKeepLife) * cg.iterations;
+    int& pause = matrix_.multigrid_pause_length;
+    if (!acceptable) {
+        matrix_.multigrid_mode = multigrid_ = false;
+        matrix_.multigrid_pause = pause;
+        pause = std::min(2 * pause, kMaxMultigridPause);
         return false;
     }
-    double& mean = matrix_.multigrid_iterations;
-    mean = kKeepLife * mean + (1.0 - kKeepLife) * cg.iterations;
+    pause = 1;
     note_multigrid_motion(matrix_.rotations.last_turn());
     return true;
 }
@@ -819,6 +836,10 @@ bool NewtonStep::iterate(bool& solver_failed) {
             max_iterations = kContactNewtonIterations;
             continue;
         }
+        // On the way there, the first iterate that no longer gains energy is the linearised
+        // step's answer: converging further (to newton_tolerance) would cost a dozen updates.
+        if (towards_minimiser && !energy_rose(kLinearisedEnergyGain, EnergyAt::kLastEvaluation))
+            return energy_checked_ = true;
         ++iteration;
         // Near equilibrium of a stiff body the residual is cancellation noise of large
         // element forces, so a negligible whole velocity correction also ends the loop.

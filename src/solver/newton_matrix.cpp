@@ -37,6 +37,8 @@ void NewtonMatrix::reset(SparseSystem&& pattern, LinearSolverPtr new_solver) {
     kept.valid = false;
     multigrid.clear();
     multigrid_failed = multigrid_mode = false;
+    multigrid_pause = 0;
+    multigrid_pause_length = 1;
 }
 
 LinearSolverPtr make_analysed_solver(const SparseSystem& system, const sh_implicit_settings& s,

@@ -63,6 +63,8 @@ struct NewtonMatrix {
     int multigrid_calm_steps = 0;      ///< its updates in a row whose nodes barely turned
     int multigrid_calm_needed = 10;    ///< how many of them leave it (doubles when leaving did not pay)
     bool multigrid_left_calm = false;  ///< it was left for being calm, and not chosen again since
+    int multigrid_pause = 0;           ///< steps it still sits out after a solve it could not use
+    int multigrid_pause_length = 1;    ///< the next such pause (doubles with failures in a row)
 
     /// Takes pattern as the matrix and solver (analysed for it, or null) as its solver, sizes
     /// the scratch vectors for its DOFs (delta zeroed) and forgets any kept factorisation.

@@ -220,6 +220,7 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
     dof_to_global_.swap(dof_to_global);
     local_size_ = static_cast<int32_t>(3 * k);
     element_position_.swap(position);
+    element_order_.swap(order);
     block_record_start_.swap(record_start);
     block_records_.swap(records);
     pattern_id_ = g_next_pattern_id.fetch_add(1);
@@ -228,11 +229,12 @@ void SparseSystem::build_pattern(const int32_t* elements, size_t element_count, 
 void SparseSystem::clear_values() { std::fill(values_.begin(), values_.end(), 0.0); }
 
 template <class Entry>
-void SparseSystem::scatter_element(size_t element, double scale, const Entry& entry) {
+void SparseSystem::scatter_element(size_t element, size_t position, double scale, const Entry& entry) {
     SH_REQUIRE(element < element_count_, SH_ERR_INTERNAL, "sparse system: element %zu of %zu", element,
                element_count_);
     double* v = values_.data();
-    const size_t position = static_cast<size_t>(element_position_[element]);
+    if (position >= element_order_.size() || static_cast<size_t>(element_order_[position]) != element)
+        position = static_cast<size_t>(element_position_[element]);
     const BlockRecord* rec = block_records_.data() + block_record_start_[position];
     const BlockRecord* end = block_records_.data() + block_record_start_[position + 1];
     for (; rec != end; ++rec) {
@@ -250,13 +252,14 @@ void SparseSystem::scatter_element(size_t element, double scale, const Entry& en
 
 void SparseSystem::add_element(size_t element, const double* Ke, double scale) {
     const size_t m = static_cast<size_t>(local_size_);
-    scatter_element(element, scale, [&](const BlockRecord& rec, int r, int s) {
+    scatter_element(element, SIZE_MAX, scale, [&](const BlockRecord& rec, int r, int s) {
         return Ke[rec.local + static_cast<size_t>(r) * m + static_cast<size_t>(s)];
     });
 }
 
-void SparseSystem::add_element_lane(size_t element, const double* blocks, size_t stride, double scale) {
-    scatter_element(element, scale, [&](const BlockRecord& rec, int r, int s) {
+void SparseSystem::add_element_lane(size_t element, size_t position, const double* blocks, size_t stride,
+                                    double scale) {
+    scatter_element(element, position, scale, [&](const BlockRecord& rec, int r, int s) {
         return blocks[(9 * static_cast<size_t>(rec.pair) + static_cast<size_t>(3 * r + s)) * stride];
     });
 }

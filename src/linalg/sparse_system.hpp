@@ -50,7 +50,10 @@ public:
     /// add_element for Ke given by node blocks, one element's lane of a batch: local entry
     /// (3a + r, 3b + s) at blocks[((a k + b) 9 + 3r + s) stride] (k nodes per element), as the
     /// element kernels hold a batch's tangents. Saves copying each lane out into a Ke.
-    void add_element_lane(size_t element, const double* blocks, size_t stride, double scale);
+    /// position: where the element is expected in the assembly order (build_pattern's
+    /// element_order), as an assembly in that order counts; the map is then read without a
+    /// lookup by element. Any other value costs only that lookup.
+    void add_element_lane(size_t element, size_t position, const double* blocks, size_t stride, double scale);
     /// Adds scale * B (3x3, row-major) to the block of free nodes (I, J) and, for I != J, its
     /// transpose to (J, I): only the stored upper triangle is touched. The nodes must share an
     /// element or a link (or be equal); otherwise throws SH_ERR_INTERNAL.
@@ -90,19 +93,21 @@ private:
     vec<int32_t> dof_to_global_;
     // Element scatter map: element e's records, one per local node pair (a, b) whose global
     // block (I, J) has I <= J, are [block_record_start_[p], block_record_start_[p + 1]) for its
-    // position p = element_position_[e] in the assembly order.
+    // position p = element_position_[e] in the assembly order (element_order_[p] = e).
     struct BlockRecord {
         int32_t slot[3];        // value slot of global entry (3I, 3J + s); rows 3I+1, 3I+2 follow it
         uint16_t local;         // Ke offset of the block: 3a * 3k + 3b
         uint16_t pair : 15;     // its local node pair a k + b
         uint16_t diagonal : 1;  // 1 if I == J (only its upper part r <= s is added)
     };
-    /// Adds scale * entry(record, r, s) for every stored entry of element's blocks: the one
-    /// scatter of add_element and add_element_lane.
+    /// Adds scale * entry(record, r, s) for every stored entry of element's blocks (position:
+    /// its expected place in the assembly order, see add_element_lane): the one scatter of
+    /// add_element and add_element_lane.
     template <class Entry>
-    void scatter_element(size_t element, double scale, const Entry& entry);
+    void scatter_element(size_t element, size_t position, double scale, const Entry& entry);
     int32_t local_size_ = 0;  // 3k
     vec<int32_t> element_position_;
+    vec<int32_t> element_order_;
     vec<size_t> block_record_start_;
     vec<BlockRecord> block_records_;
 

@@ -101,7 +101,7 @@ const vec<int32_t>& FemBody::tets_by_lane() const {
 const int32_t* FemBody::tangent_order() const { return tets_by_lane().size() ? tangent_order_.data() : nullptr; }
 
 void FemBody::add_block_tangent(int model, const TetBlock& b, const Mat3L* near, const int32_t* tets, const double* xs,
-                                double scale, SparseSystem& system) const {
+                                double scale, size_t& position, SparseSystem& system) const {
     // The block's weights are -V0 lambda and -V0 mu, and every law's dP/dF is linear in
     // (lambda, mu) (projected or not: the projection commutes with a positive scale), so the
     // tangent is formed with them as the Lame parameters and a unit volume.
@@ -119,7 +119,7 @@ void FemBody::add_block_tangent(int model, const TetBlock& b, const Mat3L* near,
     element_stiffness(C, b.Bm.m, splat(1.0), K);
     const double* blocks = reinterpret_cast<const double*>(&K.block[0][0][0][0]);  // a vector aliases a double
     for (int l = 0; l < kLanes; ++l)
-        if (tets[l] >= 0) system.add_element_lane(static_cast<size_t>(tets[l]), blocks + l, kLanes, scale);
+        if (tets[l] >= 0) system.add_element_lane(static_cast<size_t>(tets[l]), position++, blocks + l, kLanes, scale);
 }
 
 void FemBody::add_tangent(const double* xs, double stiffness_scale, double damping_scale, SparseSystem& system) const {
@@ -130,11 +130,12 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
     // where the last block wrote (the free nodes are numbered by position too:
     // solver/free_node_order.hpp). The file's order of the tets would jump across the matrix.
     const vec<int32_t>& lane_tets = tets_by_lane();
-    size_t slot = 0;
+    size_t slot = 0, position = 0;  // position: in tangent_order(), as the pattern expects it
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         const Mat3L* near = rotations_.last(model);
         for (size_t k = 0; k < blocks_[model].size(); ++k, slot += kLanes)
-            add_block_tangent(model, blocks_[model][k], near ? &near[k] : nullptr, &lane_tets[slot], xs, scale, system);
+            add_block_tangent(model, blocks_[model][k], near ? &near[k] : nullptr, &lane_tets[slot], xs, scale,
+                              position, system);
     }
 }
 

@@ -2,8 +2,9 @@
 // scatter map is laid out in it, and the matrix must not depend on it. A Kuhn block of 48 tets,
 // with two nodes fixed and the free nodes numbered out of the file's order, each tet adding a
 // different element matrix: assembled in the elements' order and in a shuffled one, the
-// system's product is the dense sum of the element matrices written out by hand. An order that
-// is not a permutation is refused, naming its entry, and leaves the system empty.
+// system's product is the dense sum of the element matrices written out by hand, also when
+// each is added from its node blocks told a wrong place in the order. An order that is not a
+// permutation is refused, naming its entry, and leaves the system empty.
 #include "linalg/sparse_system.hpp"
 
 #include "core/error.hpp"
@@ -110,6 +111,43 @@ void test_the_matrix_does_not_depend_on_the_assembly_order(void**) {
     }
 }
 
+// Ke in node blocks, as add_element_lane reads a lane (stride 1): entry (3a + r, 3b + s) at
+// ((4a + b) 9 + 3r + s).
+std::array<double, 144> node_blocks(const std::array<double, 144>& ke) {
+    std::array<double, 144> blocks{};
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+            for (int r = 0; r < 3; ++r)
+                for (int s = 0; s < 3; ++s)
+                    blocks[static_cast<size_t>((4 * a + b) * 9 + 3 * r + s)] =
+                        ke[static_cast<size_t>(12 * (3 * a + r) + 3 * b + s)];
+    return blocks;
+}
+
+void test_lanes_added_at_any_expected_place_give_the_same_matrix(void**) {
+    // Each element added from its node blocks, told its true place in the order, or a wrong
+    // one (always 0, or past the end): the matrix is the same.
+    const std::vector<int32_t> tets = kuhn::block_tets(kCells);
+    int32_t count = 0;
+    const std::vector<int32_t> index = free_index(count);
+    const Eigen::MatrixXd reference = dense_reference(tets, index, count);
+    std::vector<int32_t> order(tets.size() / 4);
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), std::mt19937(11));
+    for (int told = 0; told < 3; ++told) {
+        sh::SparseSystem a;
+        a.build_pattern(tets.data(), order.size(), 4, index.data(), kuhn::node_count(kCells), count, nullptr, 0,
+                        order.data());
+        for (size_t p = 0; p < order.size(); ++p) {
+            const size_t e = static_cast<size_t>(order[p]);
+            const size_t place = told == 0 ? p : told == 1 ? 0 : order.size() + p;
+            a.add_element_lane(e, place, node_blocks(element_matrix(e)).data(), 1, 1.0);
+        }
+        const double worst = (product_columns(a) - reference).cwiseAbs().maxCoeff();
+        assert_true(worst <= 1e-12 * reference.cwiseAbs().maxCoeff());
+    }
+}
+
 // build_pattern with order must refuse it with a message holding `names`, leaving a empty.
 void expect_refused(const std::vector<int32_t>& order, const char* names) {
     const std::vector<int32_t> tets = kuhn::block_tets(kCells);
@@ -148,6 +186,7 @@ void test_an_order_that_is_not_a_permutation_is_refused_by_entry(void**) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_the_matrix_does_not_depend_on_the_assembly_order),
+        cmocka_unit_test(test_lanes_added_at_any_expected_place_give_the_same_matrix),
         cmocka_unit_test(test_an_order_that_is_not_a_permutation_is_refused_by_entry),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);

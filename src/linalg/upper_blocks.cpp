@@ -2,7 +2,6 @@
 
 #include "core/error.hpp"
 
-#include <algorithm>
 
 namespace sh {
 
@@ -28,11 +27,13 @@ void UpperBlocks::build(const SparseSystem& system) {
     pattern_id_ = system.pattern_id();
 }
 
-double UpperBlocks::diagonal_entry(const SparseSystem& a, int32_t node, int row, int col) const {
+void UpperBlocks::diagonal_block(const SparseSystem& a, int32_t node, double (&out)[3][3]) const {
     // Column 3J + c ends with the diagonal block's rows 0..c.
-    const int upper = std::max(row, col), lower = std::min(row, col);
-    const size_t column = 3 * static_cast<size_t>(node) + static_cast<size_t>(upper);
-    return a.values()[static_cast<size_t>(a.column_starts()[column + 1] - 1 - upper + lower)];
+    for (int c = 0; c < 3; ++c) {
+        const size_t column = 3 * static_cast<size_t>(node) + static_cast<size_t>(c);
+        const double* last = a.values().data() + a.column_starts()[column + 1] - 1;
+        for (int r = 0; r <= c; ++r) out[r][c] = out[c][r] = last[r - c];
+    }
 }
 
 }  // namespace sh

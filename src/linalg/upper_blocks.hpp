@@ -36,8 +36,8 @@ public:
         return a.values()[static_cast<size_t>(a.column_starts()[3 * static_cast<size_t>(node) + static_cast<size_t>(col)]) +
                           3 * static_cast<size_t>(b - first_block_[static_cast<size_t>(node)]) + static_cast<size_t>(row)];
     }
-    /// Entry (row, col) of node J's diagonal block.
-    double diagonal_entry(const SparseSystem& a, int32_t node, int row, int col) const;
+    /// Node J's diagonal block (both triangles), read from its three columns' last entries.
+    void diagonal_block(const SparseSystem& a, int32_t node, double (&out)[3][3]) const;
 
     /// The sum over node J's blocks of A_JI x_I (x in node lanes; their fourth lanes are not
     /// read), its fourth lane 0.
@@ -67,9 +67,11 @@ public:
     }
     /// Node J's diagonal block times x (node lanes).
     Node4 diagonal_times(const SparseSystem& a, int32_t node, Node4 x) const {
+        double d[3][3];
+        diagonal_block(a, node, d);
         Node4 out{};
         for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) out[r] += diagonal_entry(a, node, r, c) * x[c];
+            for (int c = 0; c < 3; ++c) out[r] += d[r][c] * x[c];
         return out;
     }
 

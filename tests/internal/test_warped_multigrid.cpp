@@ -6,6 +6,7 @@
 // flat as the mesh is refined (what a multigrid buys over the condition number's growth); and
 // a matrix rotated rigidly as a whole is preconditioned exactly as well as the unrotated one
 // when the cycle is given the rotation, and worse without it.
+#include "core/error.hpp"
 #include "linalg/preconditioned_cg.hpp"
 #include "linalg/sparse_system.hpp"
 #include "linalg/upper_blocks.hpp"
@@ -16,6 +17,8 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <cstdint>
 #include <vector>
 
@@ -223,11 +226,41 @@ void parts_that_share_no_element_get_coarse_nodes_of_their_own(void**) {
     assert_true(pair <= single + 2);
 }
 
+// prepare must refuse a with SH_ERR_SOLVER, naming free node `node`.
+void expect_refused(const sh::SparseSystem& a, sh::WarpedMultigrid& multigrid, int32_t node) {
+    bool refused = false;
+    char expected[64];
+    std::snprintf(expected, sizeof expected, "free node %d is not positive definite", node);
+    try {
+        multigrid.prepare(a, rotations_of(static_cast<size_t>(a.dof_count() / 3), 0.0).data());
+    } catch (const sh::Error& e) {
+        refused = e.status() == SH_ERR_SOLVER && std::strstr(e.message().c_str(), expected);
+    }
+    assert_true(refused);
+}
+
+void diagonal_block_not_positive_definite_is_refused_by_node(void**) {
+    // Positive diagonal entries, but a coupling that makes the block indefinite: in its
+    // leading 2x2 minor (node 5: x-y) or only in its determinant (node 7: y-z).
+    for (const int32_t node : {5, 7}) {
+        Block block;
+        build_block(3, 0.0, block);
+        sh::WarpedMultigrid multigrid;
+        multigrid.build(block.a, block.rest.data());
+        double coupling[9] = {};
+        const int r = node == 5 ? 0 : 1;
+        coupling[3 * r + r + 1] = coupling[3 * (r + 1) + r] = 1e6;  // the diagonal entries are about 1e4
+        block.a.add_block(node, node, coupling, 1.0);
+        expect_refused(block.a, multigrid, node);
+    }
+}
+
 }  // namespace
 
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(node_blocks_give_the_sparse_product),
+        cmocka_unit_test(diagonal_block_not_positive_definite_is_refused_by_node),
         cmocka_unit_test(cycle_is_symmetric_positive_definite),
         cmocka_unit_test(product_beside_the_cycle_is_the_matrix_times_its_output),
         cmocka_unit_test(iterations_stay_flat_as_the_mesh_is_refined),

@@ -44,6 +44,14 @@ vec<NodeRotations::Edge> unique_edges(const Body& body, const vec<int32_t>& free
         edge.weight = 1.0;
         edges.push_back(edge);
     }
+    // In the free nodes' order (a Z-order through the rest shape: solver/free_node_order.hpp),
+    // so that each edge's sums land near the last one's; the file's numbers may jump anywhere.
+    const auto key = [](const NodeRotations::Edge& edge) {
+        const int32_t low = edge.free_a < 0 ? edge.free_b : edge.free_b < 0 ? edge.free_a : std::min(edge.free_a, edge.free_b);
+        return std::make_pair(low, std::max(edge.free_a, edge.free_b));
+    };
+    std::sort(edges.begin(), edges.end(),
+              [&](const NodeRotations::Edge& p, const NodeRotations::Edge& q) { return key(p) < key(q); });
     return edges;
 }
 

@@ -91,23 +91,34 @@ void assemble(sh::SparseSystem& a, const std::vector<int32_t>& tets, const std::
     }
 }
 
-void test_the_matrix_does_not_depend_on_the_assembly_order(void**) {
-    const std::vector<int32_t> tets = kuhn::block_tets(kCells);
+// The block, its free numbering, the dense reference and the elements in a shuffled order.
+struct Scene {
+    std::vector<int32_t> tets = kuhn::block_tets(kCells);
     int32_t count = 0;
-    const std::vector<int32_t> index = free_index(count);
-    const Eigen::MatrixXd reference = dense_reference(tets, index, count);
-    std::vector<int32_t> shuffled(tets.size() / 4);
-    std::iota(shuffled.begin(), shuffled.end(), 0);
-    std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(7));
-    assert_true(shuffled[0] != 0 || shuffled[1] != 1);
-    const std::vector<int32_t>* orders[2] = {nullptr, &shuffled};
-    for (const std::vector<int32_t>* order : orders) {
-        sh::SparseSystem a;
-        assemble(a, tets, index, count, order);
+    std::vector<int32_t> index = free_index(count);
+    Eigen::MatrixXd reference = dense_reference(tets, index, count);
+    std::vector<int32_t> shuffled;
+    explicit Scene(unsigned seed) : shuffled(tets.size() / 4) {
+        std::iota(shuffled.begin(), shuffled.end(), 0);
+        std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(seed));
+        assert_true(shuffled[0] != 0 || shuffled[1] != 1);
+    }
+    // a's matrix is the reference to round-off.
+    void check(const sh::SparseSystem& a) const {
         assert_int_equal(a.dof_count(), 3 * count);
         const double worst = (product_columns(a) - reference).cwiseAbs().maxCoeff();
         assert_true(reference.cwiseAbs().maxCoeff() > 10.0);
         assert_true(worst <= 1e-12 * reference.cwiseAbs().maxCoeff());
+    }
+};
+
+void test_the_matrix_does_not_depend_on_the_assembly_order(void**) {
+    const Scene scene(7);
+    const std::vector<int32_t>* orders[2] = {nullptr, &scene.shuffled};
+    for (const std::vector<int32_t>* order : orders) {
+        sh::SparseSystem a;
+        assemble(a, scene.tets, scene.index, scene.count, order);
+        scene.check(a);
     }
 }
 
@@ -127,24 +138,18 @@ std::array<double, 144> node_blocks(const std::array<double, 144>& ke) {
 void test_lanes_added_at_any_expected_place_give_the_same_matrix(void**) {
     // Each element added from its node blocks, told its true place in the order, or a wrong
     // one (always 0, or past the end): the matrix is the same.
-    const std::vector<int32_t> tets = kuhn::block_tets(kCells);
-    int32_t count = 0;
-    const std::vector<int32_t> index = free_index(count);
-    const Eigen::MatrixXd reference = dense_reference(tets, index, count);
-    std::vector<int32_t> order(tets.size() / 4);
-    std::iota(order.begin(), order.end(), 0);
-    std::shuffle(order.begin(), order.end(), std::mt19937(11));
+    const Scene scene(11);
+    const std::vector<int32_t>& order = scene.shuffled;
     for (int told = 0; told < 3; ++told) {
         sh::SparseSystem a;
-        a.build_pattern(tets.data(), order.size(), 4, index.data(), kuhn::node_count(kCells), count, nullptr, 0,
-                        order.data());
+        a.build_pattern(scene.tets.data(), order.size(), 4, scene.index.data(), kuhn::node_count(kCells), scene.count,
+                        nullptr, 0, order.data());
         for (size_t p = 0; p < order.size(); ++p) {
             const size_t e = static_cast<size_t>(order[p]);
             const size_t place = told == 0 ? p : told == 1 ? 0 : order.size() + p;
             a.add_element_lane(e, place, node_blocks(element_matrix(e)).data(), 1, 1.0);
         }
-        const double worst = (product_columns(a) - reference).cwiseAbs().maxCoeff();
-        assert_true(worst <= 1e-12 * reference.cwiseAbs().maxCoeff());
+        scene.check(a);
     }
 }
 

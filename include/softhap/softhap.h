@@ -420,8 +420,9 @@ typedef struct sh_implicit_settings {
                                          its rest shape, warped by its nodes' rotations) where
                                          that costs less per step than new factorisations, and
                                          keeps it across steps until its nodes settle or it
-                                         fails to cut the residual by factor_reuse within two
-                                         factorisations' work (then it sits out 1, 2, 4 ... 64
+                                         fails to cut the residual by factor_reuse within 30
+                                         iterations or two factorisations' work, whichever is
+                                         less (then it sits out 1, 2, 4 ... 64
                                          steps, doubling with each failure in a row, before it
                                          may serve again); changing dt by more than 25 % or the
                                          matrix rebuilds it. These choices weigh work estimated from counts,

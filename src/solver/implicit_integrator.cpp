@@ -56,6 +56,12 @@ constexpr double kMultigridStepTolerance = 0.25;
 // times in 30 steps, a few steps many times), one step's factorisation and the solves after it
 // cost about that much (the raptor's solves need 27-30 iterations).
 constexpr double kMultigridBudget = 2.0;
+// And at most this many iterations: the bound of a real-time step. Where the multigrid serves
+// poorly (the raptor's tail and legs whipping round), CG contracts the residual by about 0.93
+// per iteration, so that iterations 30-50 take it from about 0.1 to the tolerance's 0.025 at
+// 0.4-0.5 ms each: over 100 steps, 7-9 solves end at this cap with relative residuals of
+// 0.025-0.15 (taken, see solve_by_multigrid), and the swing's p99 falls from 26-36 ms to 24-26.
+constexpr int kMultigridMaxIterations = 30;
 // The most steps the multigrid sits out after a solve it could not bring to a usable residual
 // (the pause doubles with each such failure in a row, from 1).
 constexpr int kMaxMultigridPause = 64;
@@ -177,7 +183,8 @@ private:
     /// The multigrid does not serve this body until its matrix version or step size changes.
     void drop_multigrid();
     /// The update by CG preconditioned by the multigrid on the assembled tangent; false (out of
-    /// multigrid mode) if it did not reach a usable residual within two factorisations' work.
+    /// multigrid mode) if it did not reach a usable residual within its cap (two
+    /// factorisations' work, at most kMultigridMaxIterations).
     bool solve_by_multigrid();
     /// After a multigrid update: leaves multigrid mode once the nodes have turned by less than
     /// kCalmTurn per update for multigrid_calm_needed updates (a new factorisation would then
@@ -521,12 +528,13 @@ bool NewtonStep::solve_by_multigrid() {
         drop_multigrid();
         return false;  // a diagonal block not positive definite: the factorisation will say where
     }
-    // At most as many iterations as kMultigridBudget factorisations cost, once that is known.
+    // At most as many iterations as kMultigridBudget factorisations cost, once that is known,
+    // and kMultigridMaxIterations.
     const double factorisation = matrix_.kept.factorize_work;
     const int cap = factorisation > 0.0
                         ? std::clamp(static_cast<int>(kMultigridBudget * factorisation / multigrid.iteration_work()),
-                                     kKrylovMinIterations, kKrylovMaxIterations)
-                        : kKrylovMaxIterations;
+                                     kKrylovMinIterations, kMultigridMaxIterations)
+                        : kMultigridMaxIterations;
     const PreconditionedCgResult cg = solve_for_update([&](const double* minus_g, double* delta) {
         return solve_preconditioned_cg(
             matrix_.system.dof_count(), [&](const double* x, double* y) { matrix_.system.multiply(x, y); }, multigrid,
@@ -538,8 +546,8 @@ bool NewtonStep::solve_by_multigrid() {
     double& mean = matrix_.multigrid_iterations;
     // At the cap, an update that cuts the linearised residual by factor_reuse is as good as a
     // linearised step asks (see iterate()): the line search judges it as any other. One that
-    // does not (a thin body whipping round: the raptor's swing needs 40-50 iterations at its
-    // fastest) is solved by a factorisation, and the multigrid sits out the next steps
+    // does not (a thin body whipping round: the raptor's swing would need 40-50 iterations at
+    // its fastest) is solved by a factorisation, and the multigrid sits out the next steps
     // (NewtonMatrix::multigrid_pause) before krylov_pays may weigh it again.
     const bool acceptable = cg.converged || cg.relative_residual <= s_.factor_reuse;
     mean = kKeepLife * mean + (1.0 - kKeepLife) * cg.iterations;

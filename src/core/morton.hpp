@@ -3,9 +3,12 @@
 // for the Newton matrix's columns) whatever order a file listed them in.
 #pragma once
 
+#include "core/memory.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 
 namespace sh {
 
@@ -43,5 +46,19 @@ private:
         return v;
     }
 };
+
+/// 0 .. count - 1 sorted along the Z-order curve through the box of the points point(k) (each
+/// 3 values), ties by k. Allocates.
+template <class Point>
+vec<uint32_t> morton_order(size_t count, const Point& point) {
+    MortonBox box;
+    for (size_t k = 0; k < count; ++k) box.include(point(k));
+    vec<std::pair<uint64_t, uint32_t>> keyed(count);
+    for (size_t k = 0; k < count; ++k) keyed[k] = {box.key(point(k)), static_cast<uint32_t>(k)};
+    std::sort(keyed.begin(), keyed.end());
+    vec<uint32_t> order(count);
+    for (size_t k = 0; k < count; ++k) order[k] = keyed[k].second;
+    return order;
+}
 
 }  // namespace sh

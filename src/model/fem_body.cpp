@@ -24,21 +24,13 @@ namespace {
 vec<uint32_t> locality_order(const vec<int32_t>& tets, const vec<double>& p) {
     const size_t tet_count = tets.size() / 4;
     vec<double> centroid(3 * tet_count);
-    MortonBox box;
-    for (size_t t = 0; t < tet_count; ++t) {
+    for (size_t t = 0; t < tet_count; ++t)
         for (int i = 0; i < 3; ++i) {
             double c = 0.0;
             for (int a = 0; a < 4; ++a) c += p[3 * static_cast<size_t>(tets[4 * t + a]) + i];
             centroid[3 * t + i] = 0.25 * c;
         }
-        box.include(&centroid[3 * t]);
-    }
-    vec<std::pair<uint64_t, uint32_t>> keyed(tet_count);
-    for (size_t t = 0; t < tet_count; ++t) keyed[t] = {box.key(&centroid[3 * t]), static_cast<uint32_t>(t)};
-    std::sort(keyed.begin(), keyed.end());
-    vec<uint32_t> order(tet_count);
-    for (size_t k = 0; k < tet_count; ++k) order[k] = keyed[k].second;
-    return order;
+    return morton_order(tet_count, [&](size_t t) { return &centroid[3 * t]; });
 }
 
 }  // namespace

@@ -46,9 +46,10 @@ vec<NodeRotations::Edge> unique_edges(const Body& body, const vec<int32_t>& free
     }
     // In the free nodes' order (a Z-order through the rest shape: solver/free_node_order.hpp),
     // so that each edge's sums land near the last one's; the file's numbers may jump anywhere.
+    // As unsigned numbers a fixed end (-1) comes last, so the lower key is the first free end.
     const auto key = [](const NodeRotations::Edge& edge) {
-        const int32_t low = edge.free_a < 0 ? edge.free_b : edge.free_b < 0 ? edge.free_a : std::min(edge.free_a, edge.free_b);
-        return std::make_pair(low, std::max(edge.free_a, edge.free_b));
+        const uint32_t a = static_cast<uint32_t>(edge.free_a), b = static_cast<uint32_t>(edge.free_b);
+        return std::make_pair(std::min(a, b), std::max(a, b));
     };
     std::sort(edges.begin(), edges.end(),
               [&](const NodeRotations::Edge& p, const NodeRotations::Edge& q) { return key(p) < key(q); });

@@ -356,8 +356,10 @@ static void step_implicit(sh_world* world, int ramp, int steps, const char* name
         }
         r->wall[s] = ns;
         if (g_trace)
-            fprintf(stderr, "{\"case\":\"%s\",\"step\":%d,\"ms\":%.3f,\"factorizations\":%d,\"linear_iterations\":%d}\n",
-                    name, s, ns * 1e-6, report.factorizations, report.linear_iterations);
+            fprintf(stderr, "{\"case\":\"%s\",\"step\":%d,\"ms\":%.3f,\"factorizations\":%d,\"newton_iterations\":%d,"
+                    "\"linear_iterations\":%d,\"solve_ms\":%.3f}\n",
+                    name, s, ns * 1e-6, report.factorizations, report.newton_iterations, report.linear_iterations,
+                    report.solve_seconds * 1e3);
         r->factorize += report.factorize_seconds;
         r->solve += report.solve_seconds;
         r->factorizations += report.factorize_seconds > 0.0;

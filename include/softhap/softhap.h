@@ -416,8 +416,9 @@ typedef struct sh_implicit_settings {
                                          residual of 0.1 factor_reuse, and factorises afresh once
                                          that has cost as much as a factorisation. A body solved
                                          alone with 9,000 free DOF or more and no contact
-                                         candidates uses a multigrid cycle instead (a grid over
-                                         its rest shape, warped by its nodes' rotations) where
+                                         candidates uses a multigrid cycle instead (the rigid
+                                         motions of aggregates of its nodes at rest, warped by
+                                         the nodes' rotations) where
                                          that costs less per step than new factorisations, and
                                          keeps it across steps until its nodes settle or it
                                          fails to cut the residual by factor_reuse within 30

@@ -125,6 +125,14 @@ LinearSolverPtr make_linear_solver(LinearSolverKind kind, double cg_tolerance, i
     throw Error(SH_ERR_INVALID_ARGUMENT, format("linear solver: unknown kind %d", static_cast<int>(kind)));
 }
 
+LinearSolverKind default_direct_solver() {
+#if SOFTHAP_WITH_CHOLMOD
+    return LinearSolverKind::Cholmod;
+#else
+    return LinearSolverKind::Ldlt;
+#endif
+}
+
 #if !SOFTHAP_WITH_CHOLMOD
 LinearSolverPtr make_cholmod_solver() {
     throw Error(SH_ERR_UNSUPPORTED, "linear solver: CHOLMOD is not built in (SOFTHAP_WITH_CHOLMOD=OFF); "

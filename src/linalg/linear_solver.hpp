@@ -113,6 +113,9 @@ using LinearSolverPtr = std::unique_ptr<LinearSolver, LinearSolverDelete>;
 /// (SH_ERR_INVALID_ARGUMENT); the other kinds ignore both.
 LinearSolverPtr make_linear_solver(LinearSolverKind kind, double cg_tolerance, int cg_max_iterations);
 
+/// The direct backend the library is built with: CHOLMOD where SOFTHAP_WITH_CHOLMOD, else LDL^T.
+LinearSolverKind default_direct_solver();
+
 /// The backends (make_linear_solver picks one of them).
 LinearSolverPtr make_cholmod_solver();
 LinearSolverPtr make_ldlt_solver();

@@ -1,9 +1,10 @@
 // A two-level multigrid cycle for the implicit step's matrix A = M + h D + h^2 K(x) under large
-// rotation, used as conjugate gradients' preconditioner. The coarse level is a regular grid
-// embedding the free nodes' rest shape (trilinear prolongation P, Galerkin coarse matrix
-// P^T A0 P of the matrix at rest, factorised once); the current matrix differs from A0 mostly
-// by each node's rotation R, so the coarse correction is warped by them (restricted by
-// P^T R^T, prolonged by R P) instead of rebuilt. The smoother is block Gauss-Seidel on the
+// rotation, used as conjugate gradients' preconditioner. The coarse level is the rigid motions
+// of aggregates of nodes at the rest shape, smoothed (linalg/rigid_prolongation.hpp: P), with
+// the Galerkin coarse matrix P^T A0 P of the matrix at rest, factorised once by the library's
+// direct solver; the current matrix differs from A0 mostly by each node's rotation R, so the
+// coarse correction is warped by them (restricted by P^T R^T, prolonged by R P) instead of
+// rebuilt. The smoother is block Gauss-Seidel on the
 // current matrix (3x3 node blocks, forward before and backward after the coarse correction,
 // so the cycle is symmetric), reading the system's stored triangle in place (UpperBlocks). Its
 // setup per step is the diagonal blocks' inverses and the rotations; no factorisation of the
@@ -11,12 +12,12 @@
 #pragma once
 
 #include "core/memory.hpp"
+#include "linalg/linear_solver.hpp"
 #include "linalg/node_lanes.hpp"
 #include "linalg/preconditioned_cg.hpp"
+#include "linalg/rigid_prolongation.hpp"
 #include "linalg/sparse_system.hpp"
 #include "linalg/upper_blocks.hpp"
-
-#include <Eigen/Dense>
 
 #include <cstdint>
 
@@ -47,23 +48,14 @@ public:
     /// One apply's work plus CG's product (half a product, apply_with_product), in a sparse
     /// solve's operations (FactorWork).
     double iteration_work() const;
-    /// Coarse nodes (grid nodes some free node's cell has), for reports and tests.
+    /// Coarse nodes (aggregates: 6 coarse DOFs each), for reports and tests.
     int32_t coarse_nodes() const { return coarse_count_; }
+    /// The aggregate of each free node (coarse_nodes() of them), for tests.
+    const vec<int32_t>& aggregates() const { return aggregate_; }
 
 private:
-    /// Picks the grid and fills corner_ and weight_ from the rest positions.
-    void build_prolongation(const double* rest, int32_t nodes);
-    /// corner_ and weight_ for the grid of `cells` cells along the longest side of the box
-    /// [lo, hi]; returns the coarse nodes' count (split_by_connection).
-    int32_t fill_prolongation(const double lo[3], const double hi[3], int32_t cells, const double* rest, int32_t nodes);
-    /// Splits each grid node into one coarse node per connected part of the fine nodes it
-    /// holds (parts joined by elements: blocks_'s pattern), so that a cut, or legs that share
-    /// grid cells but no element, are not tied together; renumbers corner_, returns the count.
-    int32_t split_by_connection(int32_t nodes);
-    /// coarse_ := P^T A0 P and its Cholesky factor.
-    void build_coarse(const SparseSystem& a0);
-    /// coarse += P_a^T block P_b (the coarse image of the matrix's block (a, b)).
-    void add_coarse_block(int32_t a, int32_t b, const Eigen::Matrix3d& block, Eigen::MatrixXd& coarse) const;
+    /// The aggregates, P and the factorised coarse matrix from a0 and the rest positions.
+    void build_coarse(const SparseSystem& a0, const double* rest);
     /// One block Gauss-Seidel sweep over the nodes backward, on z_ towards r; change_ := what
     /// it added to z_, and z := z_ (3 per node).
     void backward_sweep(const double* r, double* z);
@@ -80,17 +72,18 @@ private:
     const SparseSystem* system_ = nullptr;  // the prepared system, read in place
     vec<Node4> inverse_diagonal_;  // 3 columns per node: the current diagonal blocks' inverses
     vec<Node4> turn_;              // 6 per node: the columns of its rotation R, then of R^T
-    vec<int32_t> corner_;          // 8 per node: the coarse nodes of its grid cell (-1: weight 0)
-    vec<double> weight_;           // 8 per node: their trilinear weights
+    vec<int32_t> aggregate_;       // per node, its aggregate
     int32_t coarse_count_ = 0;
-    Eigen::LLT<Eigen::MatrixXd> coarse_;  // factor of P^T A0 P (3 per coarse node)
-    Eigen::VectorXd coarse_rhs_;          // restricted residual, then the coarse solution
-    vec<Node4> coarse_lanes_;             // the same per coarse node, in node lanes
+    RigidProlongation prolongation_;
+    SparseSystem coarse_;                 // P^T A0 P
+    LinearSolverPtr coarse_solver_;       // its factorisation
+    vec<double> coarse_rhs_;              // the restricted residual (6 per aggregate)
+    vec<double> coarse_solution_;         // the coarse correction
+    vec<Node4> coarse_local_;             // R^T of the residual, then P of the coarse correction (rest frames)
     vec<Node4> z_;                        // the cycle's iterate
     vec<Node4> residual_;                 // r - A z_ after the first sweep
     vec<Node4> change_;                   // the backward sweep's change of z_
     vec<Node4> pushed_;                   // the backward sweep's sums from the nodes after each
-    vec<int32_t> scratch_;                // the grid's node numbers, then the union-find's parents
 };
 
 }  // namespace sh

@@ -16,7 +16,7 @@ LinearSolverKind solver_kind(sh_linear_solver kind) {
         case SH_LINEAR_SOLVER_CHOLMOD: return LinearSolverKind::Cholmod;
         case SH_LINEAR_SOLVER_LDLT: return LinearSolverKind::Ldlt;
         case SH_LINEAR_SOLVER_CG: return LinearSolverKind::ConjugateGradient;
-        default: return (sh_build_features() & SH_FEATURE_CHOLMOD) ? LinearSolverKind::Cholmod : LinearSolverKind::Ldlt;
+        default: return default_direct_solver();
     }
 }
 

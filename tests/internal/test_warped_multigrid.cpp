@@ -195,9 +195,11 @@ void product_beside_the_cycle_is_the_matrix_times_its_output(void**) {
 
 void iterations_stay_flat_as_the_mesh_is_refined(void**) {
     // The condition number grows 4x per halving of h (kStiffness / mass dominates): plain CG's
-    // iterations would double per refinement. Measured: 11 at 8, 16 and 24 cells.
+    // iterations would double per refinement. Measured: 16, 14 and 16 at 8, 16 and 24 cells (a
+    // trilinear grid took 11 each: this Laplacian's low modes are translations only, where the
+    // aggregates' rotation modes that serve elasticity add nothing).
     const int coarse = iterations(8, 0.0, 0.0), middle = iterations(16, 0.0, 0.0), fine = iterations(24, 0.0, 0.0);
-    assert_true(coarse <= 16 && middle <= 16 && fine <= 16);
+    assert_true(coarse <= 18 && middle <= 18 && fine <= 18);
     assert_true(fine <= coarse + 3);
 }
 
@@ -206,13 +208,13 @@ void rotation_given_restores_the_unrotated_convergence(void**) {
     const int warped = iterations(12, 2.0, 2.0);
     const int unwarped = iterations(12, 2.0, 0.0);
     assert_int_equal(warped, plain);  // the cycle for Q A0 Q^T given Q is Q (the cycle for A0) Q^T
-    assert_true(unwarped > plain + 5);  // measured: 10 and 22
+    assert_true(unwarped > plain + 5);  // measured: 13 and 23
 }
 
 void parts_that_share_no_element_get_coarse_nodes_of_their_own(void**) {
-    // Two blocks 0.3 cells apart share grid cells but no element (a cut, legs side by side):
-    // a coarse node tying both would pull one by the other. Each keeps the convergence it has
-    // alone (measured: 11 alone, 11 side by side; 38 when their grid nodes were shared).
+    // Two blocks 0.3 cells apart share no element (a cut, legs side by side): a coarse node
+    // tying both would pull one by the other (a grid's nodes did: 38 iterations against 11
+    // alone). Each keeps the convergence it has alone.
     Block alone, apart;
     build_block(8, 0.0, alone);
     build_block(8, 0.0, apart, 2, 0.3);

@@ -26,6 +26,29 @@ inline std::vector<int32_t> block_tets(int cells) {
     return tets;
 }
 
+/// The tets of `copies` blocks of cells^3 cubes, copy c's nodes numbered after copy c - 1's:
+/// blocks that share no element.
+inline std::vector<int32_t> copies_tets(int cells, int copies) {
+    const std::vector<int32_t> one = block_tets(cells);
+    std::vector<int32_t> tets;
+    for (int copy = 0; copy < copies; ++copy)
+        for (const int32_t node : one) tets.push_back(node + copy * node_count(cells));
+    return tets;
+}
+
+/// Their nodes' positions (3 per node): unit cells, copy c shifted by c * pitch along x.
+inline std::vector<double> copies_rest(int cells, int copies, double pitch) {
+    std::vector<double> rest(3 * static_cast<size_t>(copies * node_count(cells)));
+    for (int copy = 0; copy < copies; ++copy)
+        for (int k = 0; k <= cells; ++k)
+            for (int j = 0; j <= cells; ++j)
+                for (int i = 0; i <= cells; ++i) {
+                    const size_t n = static_cast<size_t>(grid_node(cells, i, j, k) + copy * node_count(cells));
+                    rest[3 * n] = i + copy * pitch, rest[3 * n + 1] = j, rest[3 * n + 2] = k;
+                }
+    return rest;
+}
+
 /// A tet's graph Laplacian per component, 4 I - ones (row-major 12x12 over its 4 nodes' x y z),
 /// with an x-y coupling `shear` in each block (symmetric positive semi-definite for |shear| < 1;
 /// anisotropic, so that a rotation changes it).

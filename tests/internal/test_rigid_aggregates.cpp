@@ -39,11 +39,9 @@ struct Scene {
 };
 
 void build_scene(int cells, int copies, Scene& out) {
-    const std::vector<int32_t> one = kuhn::block_tets(cells);
-    const int32_t per_copy = kuhn::node_count(cells), nodes = copies * per_copy;
-    std::vector<int32_t> tets, identity(static_cast<size_t>(nodes));
-    for (int copy = 0; copy < copies; ++copy)
-        for (const int32_t node : one) tets.push_back(node + copy * per_copy);
+    const std::vector<int32_t> tets = kuhn::copies_tets(cells, copies);
+    const int32_t nodes = copies * kuhn::node_count(cells);
+    std::vector<int32_t> identity(static_cast<size_t>(nodes));
     for (int32_t i = 0; i < nodes; ++i) identity[static_cast<size_t>(i)] = i;
     out.a.build_pattern(tets.data(), tets.size() / 4, 4, identity.data(), nodes, nodes);
     const std::array<double, 144> ke = kuhn::laplacian_element(0.6);
@@ -52,14 +50,7 @@ void build_scene(int cells, int copies, Scene& out) {
     out.a.add_diagonal(mass.data(), 1.0);
     out.blocks.build(out.a);
     out.rows.build(out.a, out.blocks);
-    out.rest.resize(3 * static_cast<size_t>(nodes));
-    for (int copy = 0; copy < copies; ++copy)
-        for (int k = 0; k <= cells; ++k)
-            for (int j = 0; j <= cells; ++j)
-                for (int i = 0; i <= cells; ++i) {
-                    const size_t n = static_cast<size_t>(kuhn::grid_node(cells, i, j, k) + copy * per_copy);
-                    out.rest[3 * n] = i + copy * (cells + 1.0), out.rest[3 * n + 1] = j, out.rest[3 * n + 2] = k;
-                }
+    out.rest = kuhn::copies_rest(cells, copies, cells + 1.0);
 }
 
 // True if nodes i and j share a block of rows (an element).
@@ -154,61 +145,68 @@ Eigen::MatrixXd dense_prolongation(sh::RigidProlongation& p, int32_t nodes) {
     return out;
 }
 
-void prolongation_is_orthonormal_and_holds_the_rigid_motions(void**) {
+// A scene's aggregates, their prolongation and P as a dense matrix.
+struct Coarse {
     Scene scene;
-    build_scene(5, 1, scene);
     sh::vec<int32_t> aggregate;
-    const int32_t count = sh::aggregate_nodes(scene.rows, aggregate), nodes = scene.rows.node_count();
+    int32_t count = 0;
     sh::RigidProlongation p;
-    p.build(aggregate, count, scene.rest.data());
-    const Eigen::MatrixXd dense = dense_prolongation(p, nodes);
+    Eigen::MatrixXd dense;
+};
+
+void build_coarse(int cells, Coarse& out) {
+    build_scene(cells, 1, out.scene);
+    out.count = sh::aggregate_nodes(out.scene.rows, out.aggregate);
+    out.p.build(out.aggregate, out.count, out.scene.rest.data());
+    out.dense = dense_prolongation(out.p, out.scene.rows.node_count());
+}
+
+// a as a dense matrix, from its products with the unit vectors.
+Eigen::MatrixXd dense_matrix(const sh::SparseSystem& a) {
+    const int32_t n = a.dof_count();
+    Eigen::MatrixXd out(n, n);
+    std::vector<double> unit(static_cast<size_t>(n)), column(unit.size());
+    for (int32_t c = 0; c < n; ++c) {
+        unit.assign(unit.size(), 0.0);
+        unit[static_cast<size_t>(c)] = 1.0;
+        a.multiply(unit.data(), column.data());
+        for (int32_t r = 0; r < n; ++r) out(r, c) = column[static_cast<size_t>(r)];
+    }
+    return out;
+}
+
+void prolongation_is_orthonormal_and_holds_the_rigid_motions(void**) {
+    Coarse coarse;
+    build_coarse(5, coarse);
+    const Eigen::MatrixXd& dense = coarse.dense;
+    const int32_t nodes = coarse.scene.rows.node_count(), dofs = coarse.p.coarse_dofs();
     // P^T P = I: restricting the prolongation of any u gives u back.
-    assert_true((dense.transpose() * dense - Eigen::MatrixXd::Identity(6 * count, 6 * count)).cwiseAbs().maxCoeff() < 1e-12);
+    assert_true((dense.transpose() * dense - Eigen::MatrixXd::Identity(dofs, dofs)).cwiseAbs().maxCoeff() < 1e-12);
     // restrict_to is P^T.
     std::vector<sh::Node4> s(static_cast<size_t>(nodes));
     Eigen::VectorXd sv(3 * nodes);
     for (int32_t d = 0; d < 3 * nodes; ++d) sv[d] = std::sin(0.3 * d) + 0.2, s[static_cast<size_t>(d / 3)][d % 3] = sv[d];
-    std::vector<double> coarse(static_cast<size_t>(p.coarse_dofs()));
-    p.restrict_to(s.data(), coarse.data());
+    std::vector<double> restricted(static_cast<size_t>(dofs));
+    coarse.p.restrict_to(s.data(), restricted.data());
     const Eigen::VectorXd expected = dense.transpose() * sv;
-    for (int32_t c = 0; c < p.coarse_dofs(); ++c) assert_true(std::fabs(coarse[static_cast<size_t>(c)] - expected[c]) < 1e-12);
+    for (int32_t c = 0; c < dofs; ++c) assert_true(std::fabs(restricted[static_cast<size_t>(c)] - expected[c]) < 1e-12);
     // A rigid motion of the whole block, v_i = t + w x x_i, is in P's range: P P^T v = v.
     const Eigen::Vector3d t(0.3, -1.1, 0.7), w(0.4, 0.9, -0.5);
     Eigen::VectorXd v(3 * nodes);
     for (int32_t i = 0; i < nodes; ++i)
-        v.segment<3>(3 * i) = t + w.cross(Eigen::Vector3d(&scene.rest[3 * static_cast<size_t>(i)]));
+        v.segment<3>(3 * i) = t + w.cross(Eigen::Vector3d(&coarse.scene.rest[3 * static_cast<size_t>(i)]));
     assert_true((dense * (dense.transpose() * v) - v).cwiseAbs().maxCoeff() < 1e-10 * v.cwiseAbs().maxCoeff());
 }
 
 void galerkin_matrix_is_the_dense_triple_product(void**) {
-    Scene scene;
-    build_scene(4, 1, scene);
-    sh::vec<int32_t> aggregate;
-    const int32_t count = sh::aggregate_nodes(scene.rows, aggregate), nodes = scene.rows.node_count();
-    sh::RigidProlongation p;
-    p.build(aggregate, count, scene.rest.data());
-    const Eigen::MatrixXd dense = dense_prolongation(p, nodes);
-    Eigen::MatrixXd a(3 * nodes, 3 * nodes);
-    std::vector<double> unit(3 * static_cast<size_t>(nodes)), column(unit.size());
-    for (int32_t c = 0; c < 3 * nodes; ++c) {
-        unit.assign(unit.size(), 0.0);
-        unit[static_cast<size_t>(c)] = 1.0;
-        scene.a.multiply(unit.data(), column.data());
-        for (int32_t r = 0; r < 3 * nodes; ++r) a(r, c) = column[static_cast<size_t>(r)];
-    }
-    const Eigen::MatrixXd expected = dense.transpose() * a * dense;
-    sh::SparseSystem coarse;
-    p.galerkin(scene.rows, coarse);
-    assert_int_equal(coarse.dof_count(), 6 * count);
-    std::vector<double> got(static_cast<size_t>(6 * count));
-    unit.assign(static_cast<size_t>(6 * count), 0.0);
-    for (int32_t c = 0; c < 6 * count; ++c) {
-        unit.assign(unit.size(), 0.0);
-        unit[static_cast<size_t>(c)] = 1.0;
-        coarse.multiply(unit.data(), got.data());
-        for (int32_t r = 0; r < 6 * count; ++r)
-            assert_true(std::fabs(got[static_cast<size_t>(r)] - expected(r, c)) <= 1e-9 * expected.cwiseAbs().maxCoeff());
-    }
+    Coarse coarse;
+    build_coarse(4, coarse);
+    const Eigen::MatrixXd expected = coarse.dense.transpose() * dense_matrix(coarse.scene.a) * coarse.dense;
+    sh::SparseSystem galerkin;
+    coarse.p.galerkin(coarse.scene.rows, galerkin);
+    assert_int_equal(galerkin.dof_count(), 6 * coarse.count);
+    const double largest = expected.cwiseAbs().maxCoeff();
+    assert_true((dense_matrix(galerkin) - expected).cwiseAbs().maxCoeff() <= 1e-9 * largest);
 }
 
 void flat_aggregates_have_inert_rotations_and_a_definite_coarse_matrix(void**) {

@@ -43,11 +43,8 @@ struct Block {
 };
 
 void build_block(int cells, double angle, Block& out, int copies = 1, double gap = 0.0) {
-    const std::vector<int32_t> one = kuhn::block_tets(cells);
-    const int32_t per_copy = kuhn::node_count(cells), nodes = copies * per_copy;
-    std::vector<int32_t> tets;
-    for (int copy = 0; copy < copies; ++copy)
-        for (const int32_t node : one) tets.push_back(node + copy * per_copy);
+    const std::vector<int32_t> tets = kuhn::copies_tets(cells, copies);
+    const int32_t nodes = copies * kuhn::node_count(cells);
     std::vector<int32_t> identity(static_cast<size_t>(nodes));
     for (int32_t i = 0; i < nodes; ++i) identity[static_cast<size_t>(i)] = i;
     out.a.build_pattern(tets.data(), tets.size() / 4, 4, identity.data(), nodes, nodes);
@@ -60,14 +57,7 @@ void build_block(int cells, double angle, Block& out, int copies = 1, double gap
     std::vector<double> mass(3 * static_cast<size_t>(nodes));
     for (size_t d = 0; d < mass.size(); ++d) mass[d] = 1.0 + static_cast<double>((d / 3) % 5) / 4.0;
     out.a.add_diagonal(mass.data(), 1.0);
-    out.rest.resize(3 * static_cast<size_t>(nodes));
-    for (int copy = 0; copy < copies; ++copy)
-        for (int k = 0; k <= cells; ++k)
-            for (int j = 0; j <= cells; ++j)
-                for (int i = 0; i <= cells; ++i) {
-                    const size_t n = static_cast<size_t>(kuhn::grid_node(cells, i, j, k) + copy * per_copy);
-                    out.rest[3 * n] = i + copy * (cells + gap), out.rest[3 * n + 1] = j, out.rest[3 * n + 2] = k;
-                }
+    out.rest = kuhn::copies_rest(cells, copies, cells + gap);
 }
 
 std::vector<double> rotations_of(size_t nodes, double angle) {

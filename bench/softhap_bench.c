@@ -329,6 +329,16 @@ static sh_implicit_settings implicit_settings(sh_linear_solver solver) {
     return implicit;
 }
 
+/* With --trace: step s's wall time (ns) and report as one JSON line on stderr. */
+static void trace_step(const char* name, int s, double ns, const sh_step_report* report) {
+    if (!g_trace) return;
+    fprintf(stderr,
+            "{\"case\":\"%s\",\"step\":%d,\"ms\":%.3f,\"factorizations\":%d,\"newton_iterations\":%d,"
+            "\"linear_iterations\":%d,\"solve_ms\":%.3f}\n",
+            name, s, ns * 1e-6, report->factorizations, report->newton_iterations, report->linear_iterations,
+            report->solve_seconds * 1e3);
+}
+
 /* Per-step samples of one implicit case. */
 typedef struct {
     double* wall; /* ns per step, after the first */
@@ -355,11 +365,7 @@ static void step_implicit(sh_world* world, int ramp, int steps, const char* name
             continue;
         }
         r->wall[s] = ns;
-        if (g_trace)
-            fprintf(stderr, "{\"case\":\"%s\",\"step\":%d,\"ms\":%.3f,\"factorizations\":%d,\"newton_iterations\":%d,"
-                    "\"linear_iterations\":%d,\"solve_ms\":%.3f}\n",
-                    name, s, ns * 1e-6, report.factorizations, report.newton_iterations, report.linear_iterations,
-                    report.solve_seconds * 1e3);
+        trace_step(name, s, ns, &report);
         r->factorize += report.factorize_seconds;
         r->solve += report.solve_seconds;
         r->factorizations += report.factorize_seconds > 0.0;
@@ -474,6 +480,7 @@ static void cube_case(const char* scene, const body_kind* kind, double dt, const
         failed += sh_world_step(world, dt, &report) != SH_OK;
         if (s < 0) continue;
         wall[s] = now_ns() - t0;
+        trace_step(name, s, wall[s], &report);
         factorizations += report.factorizations;
         newton += report.newton_iterations;
         linear += report.linear_iterations;

@@ -37,13 +37,4 @@ void BlockRows::build(const SparseSystem& system, const UpperBlocks& blocks) {
     first.swap(starts), column.swap(columns), block.swap(values);
 }
 
-void BlockRows::multiply(const double* x, double* y) const {
-    for (int32_t i = 0; i < node_count(); ++i) {
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        for (int32_t e = first[static_cast<size_t>(i)]; e < first[static_cast<size_t>(i) + 1]; ++e)
-            sum += block[static_cast<size_t>(e)] * Eigen::Map<const Eigen::Vector3d>(x + 3 * column[static_cast<size_t>(e)]);
-        Eigen::Map<Eigen::Vector3d>(y + 3 * static_cast<size_t>(i)) = sum;
-    }
-}
-
 }  // namespace sh

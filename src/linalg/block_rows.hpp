@@ -1,6 +1,6 @@
 // A symmetric SparseSystem's 3x3 node blocks row by row, both triangles: the form the
-// multigrid's setup reads (a node's neighbours, the prolongation's smoothing, the coarse
-// matrix). The stored upper triangle (UpperBlocks) gives each block once; a row's walk over
+// multigrid's setup reads (a node's neighbours for the aggregates, a row's blocks for the
+// coarse matrix). The stored upper triangle (UpperBlocks) gives each block once; a row's walk over
 // its neighbours needs the lower ones too, so this copies them out once per setup.
 #pragma once
 
@@ -20,12 +20,11 @@ struct BlockRows {
     vec<int32_t> column;            ///< per entry, its column node; each row's diagonal entry first
     vec<Eigen::Matrix3d> block;     ///< per entry, the 3x3 block A_IJ
 
-    /// Copies system's blocks (blocks built from its pattern). Allocates.
+    /// Copies system's blocks (blocks built from its pattern). Allocates; on failure it is as
+    /// it was.
     void build(const SparseSystem& system, const UpperBlocks& blocks);
-    /// Free nodes.
-    int32_t node_count() const { return static_cast<int32_t>(first.size()) - 1; }
-    /// y = A x (3 per node each; they must not overlap).
-    void multiply(const double* x, double* y) const;
+    /// Free nodes (0 before build).
+    int32_t node_count() const { return first.empty() ? 0 : static_cast<int32_t>(first.size()) - 1; }
 };
 
 }  // namespace sh

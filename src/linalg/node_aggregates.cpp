@@ -12,7 +12,7 @@ void for_each_neighbour(const BlockRows& rows, int32_t i, Visit visit) {
         visit(rows.column[static_cast<size_t>(e)]);
 }
 
-// Founds an aggregate of node i and its neighbours still free; returns the new count.
+// Founds an aggregate of node i and its neighbours (all free); returns the new count.
 int32_t found(const BlockRows& rows, int32_t i, int32_t count, vec<int32_t>& aggregate) {
     aggregate[static_cast<size_t>(i)] = count;
     for_each_neighbour(rows, i, [&](int32_t j) {
@@ -40,8 +40,6 @@ int32_t aggregate_nodes(const BlockRows& rows, vec<int32_t>& aggregate) {
             if (aggregate[static_cast<size_t>(i)] == kFree) aggregate[static_cast<size_t>(i)] = founded[static_cast<size_t>(j)];
         });
     }
-    for (int32_t i = 0; i < n; ++i)
-        if (aggregate[static_cast<size_t>(i)] == kFree) count = found(rows, i, count, aggregate);
     return count;
 }
 

@@ -1,5 +1,7 @@
 #include "linalg/rigid_prolongation.hpp"
 
+#include "core/error.hpp"
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -42,14 +44,20 @@ Matrix3 rotation_gauge(const Matrix3& moment, uint8_t* inert) {
 }  // namespace
 
 void RigidProlongation::build(const vec<int32_t>& aggregate, int32_t aggregates, const double* rest) {
+    SH_REQUIRE(aggregates >= 0, SH_ERR_INTERNAL, "rigid prolongation: %d aggregates", aggregates);
     const size_t m = static_cast<size_t>(aggregates), n = aggregate.size();
     vec<Vector3> centroid(m, Vector3::Zero());
     vec<int32_t> size(m, 0);
     for (size_t i = 0; i < n; ++i) {
+        SH_REQUIRE(aggregate[i] >= 0 && aggregate[i] < aggregates, SH_ERR_INTERNAL,
+                   "rigid prolongation: node %zu in aggregate %d of %d", i, aggregate[i], aggregates);
         centroid[static_cast<size_t>(aggregate[i])] += rest_of(rest, i);
         ++size[static_cast<size_t>(aggregate[i])];
     }
-    for (size_t a = 0; a < m; ++a) centroid[a] /= size[a];
+    for (size_t a = 0; a < m; ++a) {
+        SH_REQUIRE(size[a] > 0, SH_ERR_INTERNAL, "rigid prolongation: aggregate %zu has no node", a);
+        centroid[a] /= size[a];
+    }
     vec<Node4> offset(n);
     vec<Matrix3> moment(m, Matrix3::Zero());
     for (size_t i = 0; i < n; ++i) {

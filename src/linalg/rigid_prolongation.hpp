@@ -29,15 +29,19 @@ namespace sh {
 /// a's translation along axis c (c < 3) or its rotation mode c - 3.
 class RigidProlongation {
 public:
-    /// Builds P for the nodes' aggregates (aggregate_nodes: aggregates of them) and rest
-    /// positions (3 per node). An aggregate whose nodes lie on a line or a point has rotation
-    /// modes of no motion: their columns of P are zero and they are marked inert. Allocates.
+    /// Builds P for the nodes' aggregates (aggregate_nodes: aggregates of them, each in [0,
+    /// aggregates) and each aggregate non-empty, else SH_ERR_INTERNAL) and rest positions (3 per
+    /// node). An aggregate whose nodes lie on a line or a point has rotation modes of no motion:
+    /// their columns of P are zero and they are marked inert. Allocates; on failure it is as
+    /// it was.
     void build(const vec<int32_t>& aggregate, int32_t aggregates, const double* rest);
     /// The coarse DOFs (6 per aggregate).
     int32_t coarse_dofs() const { return 6 * aggregates_; }
-    /// coarse = P^T s (s: 1 per node, in node lanes; coarse: coarse_dofs()).
+    /// coarse = P^T s (s: 1 per node, in node lanes; coarse: coarse_dofs()). Uses the object's
+    /// scratch: one transfer at a time.
     void restrict_to(const Node4* s, double* coarse);
-    /// out += P u (out: 1 per node, in node lanes; u: coarse_dofs()).
+    /// out += P u (out: 1 per node, in node lanes; u: coarse_dofs()). Uses the object's
+    /// scratch, as restrict_to.
     void prolong_add(const double* u, Node4* out);
     /// out := P^T A P for the matrix rows, over two pseudo-nodes of 3 DOFs per aggregate
     /// (translations, rotations), pattern and values; an inert DOF gets 1 on the diagonal, so

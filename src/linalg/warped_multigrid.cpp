@@ -31,11 +31,15 @@ void WarpedMultigrid::build_coarse(const SparseSystem& a0, const double* rest) {
     try {
         coarse_solver_->factorize(coarse_);
     } catch (const Error& e) {
+        if (e.status() != SH_ERR_SOLVER) throw;
         throw Error(SH_ERR_SOLVER, format("multigrid: the coarse matrix of %d aggregates: %s", coarse_count_,
                                           e.message().c_str()));
     }
     coarse_rhs_.assign(static_cast<size_t>(prolongation_.coarse_dofs()), 0.0);
     coarse_solution_.assign(coarse_rhs_.size(), 0.0);
+    // One solve here, so that the backend's solve workspace is allocated by the build and not
+    // by the first cycle.
+    coarse_solver_->solve(coarse_, coarse_rhs_.data(), coarse_solution_.data());
 }
 
 void WarpedMultigrid::build(const SparseSystem& a0, const double* rest) {
@@ -135,11 +139,14 @@ bool WarpedMultigrid::apply_with_product(const double* r, double* z, double* az)
 double WarpedMultigrid::iteration_work() const {
     // Per stored block, 36 operations for each sweep (its pull and its push: the first sweep
     // with its residual, the backward sweep) and 18 for the half product CG's A p takes from
-    // the cycle; the transfers (per node a rotation and a cross product each way); the coarse
-    // solve. They count kCachedOperationWeight of a sparse solve's operation each.
+    // the cycle; the transfers (per node a rotation and a cross product each way): they count
+    // kCachedOperationWeight of a sparse solve's operation each. The coarse solve is a sparse
+    // solve, whose factor the sweeps' passes push out of cache: its own work, at full weight.
+    // Measured on the raptor's 17,793 DOF: 0.39 ms per cycle against 0.35 for the trilinear
+    // grid's, which this puts at 1.22e6 against 1.01e6 operations.
     const double stored = static_cast<double>(blocks_.block_count()) + blocks_.node_count();
     const double transfers = 60.0 * blocks_.node_count();
-    return kCachedOperationWeight * ((2.0 * 36.0 + 18.0) * stored + transfers + coarse_solver_->work().solve);
+    return kCachedOperationWeight * ((2.0 * 36.0 + 18.0) * stored + transfers) + coarse_solver_->work().solve;
 }
 
 }  // namespace sh

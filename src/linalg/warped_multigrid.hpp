@@ -1,6 +1,6 @@
 // A two-level multigrid cycle for the implicit step's matrix A = M + h D + h^2 K(x) under large
 // rotation, used as conjugate gradients' preconditioner. The coarse level is the rigid motions
-// of aggregates of nodes at the rest shape, smoothed (linalg/rigid_prolongation.hpp: P), with
+// of aggregates of nodes at the rest shape (linalg/rigid_prolongation.hpp: P), with
 // the Galerkin coarse matrix P^T A0 P of the matrix at rest, factorised once by the library's
 // direct solver; the current matrix differs from A0 mostly by each node's rotation R, so the
 // coarse correction is warped by them (restricted by P^T R^T, prolonged by R P) instead of
@@ -39,19 +39,18 @@ public:
     /// current). Throws SH_ERR_SOLVER naming the
     /// node whose diagonal block is not positive definite.
     void prepare(const SparseSystem& a, const double* rotations);
-    /// z = one V-cycle applied to r.
+    /// z = one V-cycle applied to r. Throws SH_ERR_SOLVER if the coarse solve comes out
+    /// non-finite (a non-finite r or rotation).
     void apply(const double* r, double* z) override;
     /// The V-cycle, and az = A z for half a product: the backward sweep leaves each node's
     /// row of A z equal to r but for the blocks left of its diagonal times the changes the
     /// sweep made after it (Eisenstat's observation), so only those blocks are read again.
     bool apply_with_product(const double* r, double* z, double* az) override;
     /// One apply's work plus CG's product (half a product, apply_with_product), in a sparse
-    /// solve's operations (FactorWork).
+    /// solve's operations (FactorWork). Once built.
     double iteration_work() const;
     /// Coarse nodes (aggregates: 6 coarse DOFs each), for reports and tests.
     int32_t coarse_nodes() const { return coarse_count_; }
-    /// The aggregate of each free node (coarse_nodes() of them), for tests.
-    const vec<int32_t>& aggregates() const { return aggregate_; }
 
 private:
     /// The aggregates, P and the factorised coarse matrix from a0 and the rest positions.

@@ -535,11 +535,17 @@ bool NewtonStep::solve_by_multigrid() {
                         ? std::clamp(static_cast<int>(kMultigridBudget * factorisation / multigrid.iteration_work()),
                                      kKrylovMinIterations, kMultigridMaxIterations)
                         : kMultigridMaxIterations;
-    const PreconditionedCgResult cg = solve_for_update([&](const double* minus_g, double* delta) {
-        return solve_preconditioned_cg(
-            matrix_.system.dof_count(), [&](const double* x, double* y) { matrix_.system.multiply(x, y); }, multigrid,
-            minus_g, delta, true, kKrylovForcing * s_.factor_reuse, cap, matrix_.cg);
-    });
+    PreconditionedCgResult cg;
+    try {
+        cg = solve_for_update([&](const double* minus_g, double* delta) {
+            return solve_preconditioned_cg(
+                matrix_.system.dof_count(), [&](const double* x, double* y) { matrix_.system.multiply(x, y); },
+                multigrid, minus_g, delta, true, kKrylovForcing * s_.factor_reuse, cap, matrix_.cg);
+        });
+    } catch (const Error& e) {
+        if (e.status() != SH_ERR_SOLVER) throw;
+        cg = PreconditionedCgResult{};  // a non-finite coarse solve: not usable, as below
+    }
     result_.linear_iterations += cg.iterations;
     result_.solve_seconds += cg.seconds;
     used_stale = true;  // an inexact update: a failed step retries with factorisations

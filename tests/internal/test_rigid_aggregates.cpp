@@ -88,8 +88,8 @@ void every_aggregate_is_one_connected_part_of_one_block(void**) {
     sh::vec<int32_t> aggregate;
     const int32_t count = sh::aggregate_nodes(scene.rows, aggregate);
     const int32_t nodes = scene.rows.node_count(), per_copy = nodes / 2;
-    // Interior nodes of a Kuhn mesh have 14 neighbours: aggregates of 4-15 nodes, about 9 on
-    // a 7^3-node block whose surface is a third of its nodes.
+    // A founder's aggregate holds it and its neighbours: 14 in a Kuhn mesh's interior, 3 to 13
+    // on its surface (218 of a 7^3-node block's 343 nodes), so aggregates average 4 to 15.
     assert_true(count >= nodes / 15 && count <= nodes / 4);
     std::vector<int> size(static_cast<size_t>(count), 0);
     std::vector<int> copy_of(static_cast<size_t>(count), -1);
@@ -226,8 +226,13 @@ void flat_aggregates_have_inert_rotations_and_a_definite_coarse_matrix(void**) {
         const bool inert = (c >= 3 && c < 6) || c == 6 + 3;  // node 0's rotations; the pair's about x (its line)
         assert_true(inert ? norms[c] == 0.0 : std::fabs(norms[c] - 1.0) < 1e-12);
     }
+    // The coarse matrix is P^T A P with 1 on the inert DOFs' diagonal (their rows are zero).
     sh::SparseSystem coarse;
     p.galerkin(scene.rows, coarse);
+    Eigen::MatrixXd expected = dense.transpose() * dense_matrix(scene.a) * dense;
+    for (int c = 0; c < 18; ++c)
+        if (norms[c] == 0.0) expected(c, c) += 1.0;
+    assert_true((dense_matrix(coarse) - expected).cwiseAbs().maxCoeff() <= 1e-9 * expected.cwiseAbs().maxCoeff());
     sh::LinearSolverPtr solver = sh::make_linear_solver(sh::default_direct_solver(), 0.0, 1);
     solver->analyze(coarse);
     solver->factorize(coarse);  // throws if not positive definite

@@ -43,7 +43,7 @@ Matrix3 rotation_gauge(const Matrix3& moment, uint8_t* inert) {
 
 }  // namespace
 
-void RigidProlongation::build(const vec<int32_t>& aggregate, int32_t aggregates, const double* rest) {
+void RigidProlongation::build(vec<int32_t> aggregate, int32_t aggregates, const double* rest) {
     SH_REQUIRE(aggregates >= 0, SH_ERR_INTERNAL, "rigid prolongation: %d aggregates", aggregates);
     const size_t m = static_cast<size_t>(aggregates), n = aggregate.size();
     vec<Vector3> centroid(m, Vector3::Zero());
@@ -74,8 +74,7 @@ void RigidProlongation::build(const vec<int32_t>& aggregate, int32_t aggregates,
         for (int k = 0; k < 3; ++k) gauge[3 * a + static_cast<size_t>(k)] = Node4{g(0, k), g(1, k), g(2, k), 0.0};
     }
     vec<Node4> lanes(2 * m);
-    vec<int32_t> copy = aggregate;
-    aggregate_.swap(copy), offset_.swap(offset), scale_.swap(scale), gauge_.swap(gauge), inert_.swap(inert),
+    aggregate_.swap(aggregate), offset_.swap(offset), scale_.swap(scale), gauge_.swap(gauge), inert_.swap(inert),
         lanes_.swap(lanes);
     aggregates_ = aggregates;
 }

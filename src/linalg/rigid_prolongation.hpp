@@ -34,7 +34,9 @@ public:
     /// node). An aggregate whose nodes lie on a line or a point has rotation modes of no motion:
     /// their columns of P are zero and they are marked inert. Allocates; on failure it is as
     /// it was.
-    void build(const vec<int32_t>& aggregate, int32_t aggregates, const double* rest);
+    void build(vec<int32_t> aggregate, int32_t aggregates, const double* rest);
+    /// The aggregates (coarse nodes).
+    int32_t aggregates() const { return aggregates_; }
     /// The coarse DOFs (6 per aggregate).
     int32_t coarse_dofs() const { return 6 * aggregates_; }
     /// coarse = P^T s (s: 1 per node, in node lanes; coarse: coarse_dofs()). Uses the object's

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace sh {
 namespace {
@@ -23,8 +24,9 @@ constexpr double kCachedOperationWeight = 0.22;
 void WarpedMultigrid::build_coarse(const SparseSystem& a0, const double* rest) {
     BlockRows rows;
     rows.build(a0, blocks_);
-    coarse_count_ = aggregate_nodes(rows, aggregate_);
-    prolongation_.build(aggregate_, coarse_count_, rest);
+    vec<int32_t> aggregate;
+    const int32_t aggregates = aggregate_nodes(rows, aggregate);
+    prolongation_.build(std::move(aggregate), aggregates, rest);
     prolongation_.galerkin(rows, coarse_);
     coarse_solver_ = make_linear_solver(default_direct_solver(), 0.0, 1);
     coarse_solver_->analyze(coarse_);
@@ -32,7 +34,7 @@ void WarpedMultigrid::build_coarse(const SparseSystem& a0, const double* rest) {
         coarse_solver_->factorize(coarse_);
     } catch (const Error& e) {
         if (e.status() != SH_ERR_SOLVER) throw;
-        throw Error(SH_ERR_SOLVER, format("multigrid: the coarse matrix of %d aggregates: %s", coarse_count_,
+        throw Error(SH_ERR_SOLVER, format("multigrid: the coarse matrix of %d aggregates: %s", aggregates,
                                           e.message().c_str()));
     }
     coarse_rhs_.assign(static_cast<size_t>(prolongation_.coarse_dofs()), 0.0);

@@ -50,7 +50,7 @@ public:
     /// solve's operations (FactorWork). Once built.
     double iteration_work() const;
     /// Coarse nodes (aggregates: 6 coarse DOFs each), for reports and tests.
-    int32_t coarse_nodes() const { return coarse_count_; }
+    int32_t coarse_nodes() const { return prolongation_.aggregates(); }
 
 private:
     /// The aggregates, P and the factorised coarse matrix from a0 and the rest positions.
@@ -71,8 +71,6 @@ private:
     const SparseSystem* system_ = nullptr;  // the prepared system, read in place
     vec<Node4> inverse_diagonal_;  // 3 columns per node: the current diagonal blocks' inverses
     vec<Node4> turn_;              // 6 per node: the columns of its rotation R, then of R^T
-    vec<int32_t> aggregate_;       // per node, its aggregate
-    int32_t coarse_count_ = 0;
     RigidProlongation prolongation_;
     SparseSystem coarse_;                 // P^T A0 P
     LinearSolverPtr coarse_solver_;       // its factorisation

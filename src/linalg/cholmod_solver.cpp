@@ -2,9 +2,10 @@
 // of the system per step). One cholmod_common per solver; the symbolic analysis (ordering,
 // elimination tree, supernodes) is kept in the cholmod_factor and reused by every factorize until
 // the pattern changes; solves reuse CHOLMOD's solution and workspace (cholmod_solve2).
-// CHOLMOD picks supernodal LL^T for 3D tet meshes of a few thousand nodes and up; it uses the
-// system BLAS (OpenBLAS is about 2.5x faster there than the reference BLAS). Its OpenMP loops
-// run on the calling thread (CallingThreadOnly below).
+// CHOLMOD picks supernodal LL^T for 3D tet meshes of a few thousand nodes and up (unless told
+// to stay simplicial: CholmodLayout); it uses the system BLAS (OpenBLAS is about 2.5x faster
+// there than the reference BLAS). Its OpenMP loops run on the calling thread (CallingThreadOnly
+// below).
 #if SOFTHAP_WITH_CHOLMOD
 
 #include "linalg/linear_solver.hpp"
@@ -85,8 +86,9 @@ private:
 
 class CholmodSolver final : public LinearSolver {
 public:
-    CholmodSolver() {
+    explicit CholmodSolver(CholmodLayout layout) {
         cholmod_start(&common_);
+        if (layout == CholmodLayout::Simplicial) common_.supernodal = CHOLMOD_SIMPLICIAL;
         common_.print = 0;  // never print (errors come back as sh::Error)
         common_.error_handler = nullptr;
         // Keep the factor as computed (supernodal LL^T or simplicial LDL^T): no conversion pass.
@@ -120,7 +122,7 @@ protected:
             flops_per_node_ = common_.fl / nodes;
         }
         // common_ holds the analysis of the order kept (cholmod_analyze_p sets both).
-        estimated_work_ = factor_work(common_.fl, common_.lnz, kSupernodalSpeed);
+        estimated_work_ = factor_work(common_.fl, common_.lnz, common_.supernodal == CHOLMOD_SIMPLICIAL ? 1.0 : kSupernodalSpeed);
     }
 
     bool do_elimination_order(EliminationOrder& out) const override {
@@ -201,7 +203,8 @@ protected:
 
 private:
     // How many times a solve's operations per second a supernodal factorisation does (BLAS-3
-    // over supernodes, OpenBLAS): 4.3 to 7.4 measured on 17,800 and 11,500 DOF systems.
+    // over supernodes, OpenBLAS): 4.3 to 7.4 measured on 17,800 and 11,500 DOF systems. A
+    // simplicial factorisation runs the same scalar loops as a solve: counted at its speed.
     static constexpr double kSupernodalSpeed = 6.0;
 
     // The symbolic analysis of matrix in the suggested node order (each node's DOFs together),
@@ -275,7 +278,7 @@ private:
 
 }  // namespace
 
-LinearSolverPtr make_cholmod_solver() { return LinearSolverPtr(create<CholmodSolver>()); }
+LinearSolverPtr make_cholmod_solver(CholmodLayout layout) { return LinearSolverPtr(create<CholmodSolver>(layout)); }
 
 }  // namespace sh
 

@@ -133,8 +133,16 @@ LinearSolverKind default_direct_solver() {
 #endif
 }
 
+LinearSolverPtr make_solve_often_solver() {
+#if SOFTHAP_WITH_CHOLMOD
+    return make_cholmod_solver(CholmodLayout::Simplicial);
+#else
+    return make_ldlt_solver();
+#endif
+}
+
 #if !SOFTHAP_WITH_CHOLMOD
-LinearSolverPtr make_cholmod_solver() {
+LinearSolverPtr make_cholmod_solver(CholmodLayout) {
     throw Error(SH_ERR_UNSUPPORTED, "linear solver: CHOLMOD is not built in (SOFTHAP_WITH_CHOLMOD=OFF); "
                                     "use the LDL^T or conjugate-gradient solver");
 }

@@ -28,7 +28,7 @@ void WarpedMultigrid::build_coarse(const SparseSystem& a0, const double* rest) {
     const int32_t aggregates = aggregate_nodes(rows, aggregate);
     prolongation_.build(std::move(aggregate), aggregates, rest);
     prolongation_.galerkin(rows, coarse_);
-    coarse_solver_ = make_linear_solver(default_direct_solver(), 0.0, 1);
+    coarse_solver_ = make_solve_often_solver();
     coarse_solver_->analyze(coarse_);
     try {
         coarse_solver_->factorize(coarse_);

@@ -105,7 +105,9 @@ void test_every_solver_solves_the_linked_system(void**) {
     solvers.push_back(sh::make_cg_solver(1e-14, 500));
 #if SOFTHAP_WITH_CHOLMOD
     solvers.push_back(sh::make_cholmod_solver());
+    solvers.push_back(sh::make_cholmod_solver(sh::CholmodLayout::Simplicial));
 #endif
+    solvers.push_back(sh::make_solve_often_solver());
     for (sh::LinearSolverPtr& solver : solvers) {
         std::vector<double> x(3 * kNodes, 0.0);
         solver->analyze(a);

@@ -22,4 +22,11 @@ inline Node4 block_times(const Node4* columns, Node4 x) {
     return columns[0] * x[0] + columns[1] * x[1] + columns[2] * x[2];
 }
 
+/// B^T x for the 3x3 block B given as its three columns: their dot products with x (lanes
+/// 0-2 of each product summed; the fourth lane 0).
+inline Node4 block_transpose_times(const Node4* columns, Node4 x) {
+    const Node4 a = columns[0] * x, b = columns[1] * x, c = columns[2] * x;
+    return Node4{a[0] + a[1] + a[2], b[0] + b[1] + b[2], c[0] + c[1] + c[2], 0.0};
+}
+
 }  // namespace sh

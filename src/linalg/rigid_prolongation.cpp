@@ -20,10 +20,6 @@ using Matrix3 = Eigen::Matrix3d;
 
 Vector3 rest_of(const double* rest, size_t node) { return Vector3(rest[3 * node], rest[3 * node + 1], rest[3 * node + 2]); }
 
-Node4 cross(Node4 a, Node4 b) {
-    return Node4{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0], 0.0};
-}
-
 // The rotations' scaling G of an aggregate whose second moment (the sum of |d|^2 I - d d^T
 // over its nodes) is moment: rotations about its eigenvectors u_k, scaled by 1 / sqrt(lambda_k),
 // are orthonormal over the aggregate (and orthogonal to its translations: d sums to 0). A
@@ -73,43 +69,13 @@ void RigidProlongation::build(vec<int32_t> aggregate, int32_t aggregates, const 
         const Matrix3 g = rotation_gauge(moment[a], &inert[6 * a + 3]);
         for (int k = 0; k < 3; ++k) gauge[3 * a + static_cast<size_t>(k)] = Node4{g(0, k), g(1, k), g(2, k), 0.0};
     }
-    vec<Node4> lanes(2 * m);
-    aggregate_.swap(aggregate), offset_.swap(offset), scale_.swap(scale), gauge_.swap(gauge), inert_.swap(inert),
-        lanes_.swap(lanes);
+    vec<int32_t> member_start(m + 1, 0), members(n);
+    for (size_t a = 0; a < m; ++a) member_start[a + 1] = member_start[a] + size[a];
+    vec<int32_t> next(member_start.begin(), member_start.end() - 1);
+    for (size_t i = 0; i < n; ++i) members[static_cast<size_t>(next[static_cast<size_t>(aggregate[i])]++)] = static_cast<int32_t>(i);
+    aggregate_.swap(aggregate), member_start_.swap(member_start), members_.swap(members), offset_.swap(offset),
+        scale_.swap(scale), gauge_.swap(gauge), inert_.swap(inert);
     aggregates_ = aggregates;
-}
-
-void RigidProlongation::restrict_to(const Node4* s, double* coarse) {
-    // P_i^T s_i: the translations take s_i / sqrt(n_a); rotation k takes (g_k x d_i) . s_i =
-    // g_k . (d_i x s_i).
-    std::fill(lanes_.begin(), lanes_.end(), Node4{});
-    for (size_t i = 0; i < aggregate_.size(); ++i) {
-        const size_t a = static_cast<size_t>(aggregate_[i]);
-        lanes_[2 * a] += s[i];
-        lanes_[2 * a + 1] += cross(offset_[i], s[i]);
-    }
-    for (size_t a = 0; a < static_cast<size_t>(aggregates_); ++a) {
-        const Node4 t = scale_[a] * lanes_[2 * a], moment = lanes_[2 * a + 1];
-        for (int k = 0; k < 3; ++k) {
-            const Node4 g = gauge_[3 * a + static_cast<size_t>(k)] * moment;
-            coarse[6 * a + static_cast<size_t>(k)] = t[k];
-            coarse[6 * a + 3 + static_cast<size_t>(k)] = g[0] + g[1] + g[2];
-        }
-    }
-}
-
-void RigidProlongation::prolong_add(const double* u, Node4* out) {
-    // P_i u = t_a / sqrt(n_a) + w_a x d_i, w_a = G_a r_a for aggregate a's translation t_a and
-    // rotation modes r_a.
-    for (size_t a = 0; a < static_cast<size_t>(aggregates_); ++a) {
-        const double* ua = u + 6 * a;
-        lanes_[2 * a] = scale_[a] * load_node(ua);
-        lanes_[2 * a + 1] = block_times(&gauge_[3 * a], load_node(ua + 3));
-    }
-    for (size_t i = 0; i < aggregate_.size(); ++i) {
-        const size_t a = static_cast<size_t>(aggregate_[i]);
-        out[i] += lanes_[2 * a] + cross(lanes_[2 * a + 1], offset_[i]);
-    }
 }
 
 Eigen::Matrix<double, 3, 6> RigidProlongation::block(size_t node) const {
@@ -117,18 +83,17 @@ Eigen::Matrix<double, 3, 6> RigidProlongation::block(size_t node) const {
     Eigen::Matrix<double, 3, 6> p;
     p.leftCols<3>() = scale_[a] * Matrix3::Identity();
     for (int k = 0; k < 3; ++k) {
-        const Node4 column = cross(gauge_[3 * a + static_cast<size_t>(k)], offset_[node]);  // g_k x d_i
+        const Node4 column = node_cross(gauge_[3 * a + static_cast<size_t>(k)], offset_[node]);  // g_k x d_i
         p.col(3 + k) = Vector3(column[0], column[1], column[2]);
     }
     return p;
 }
 
-void RigidProlongation::galerkin_row(const BlockRows& rows, int32_t a, const vec<int32_t>& member_start,
-                                     const vec<int32_t>& members, vec<int32_t>& slot, vec<int32_t>& columns,
+void RigidProlongation::galerkin_row(const BlockRows& rows, int32_t a, vec<int32_t>& slot, vec<int32_t>& columns,
                                      vec<Eigen::Matrix<double, 6, 6>>& blocks) const {
     const size_t begin = columns.size();
-    for (int32_t k = member_start[static_cast<size_t>(a)]; k < member_start[static_cast<size_t>(a) + 1]; ++k) {
-        const size_t i = static_cast<size_t>(members[static_cast<size_t>(k)]);
+    for (int32_t k = member_start_[static_cast<size_t>(a)]; k < member_start_[static_cast<size_t>(a) + 1]; ++k) {
+        const size_t i = static_cast<size_t>(members_[static_cast<size_t>(k)]);
         const Eigen::Matrix<double, 6, 3> left = block(i).transpose();
         for (int32_t e = rows.first[i]; e < rows.first[i + 1]; ++e) {
             const size_t j = static_cast<size_t>(rows.column[static_cast<size_t>(e)]);
@@ -148,16 +113,10 @@ void RigidProlongation::galerkin_row(const BlockRows& rows, int32_t a, const vec
 
 void RigidProlongation::galerkin(const BlockRows& rows, SparseSystem& out) const {
     const int32_t m = aggregates_;
-    vec<int32_t> member_start(static_cast<size_t>(m) + 1, 0), members(aggregate_.size());
-    for (const int32_t a : aggregate_) ++member_start[static_cast<size_t>(a) + 1];
-    for (size_t a = 0; a < static_cast<size_t>(m); ++a) member_start[a + 1] += member_start[a];
-    vec<int32_t> next(member_start.begin(), member_start.end() - 1);
-    for (size_t i = 0; i < aggregate_.size(); ++i)
-        members[static_cast<size_t>(next[static_cast<size_t>(aggregate_[i])]++)] = static_cast<int32_t>(i);
     vec<int32_t> slot(static_cast<size_t>(m), -1), row_start(static_cast<size_t>(m) + 1, 0), columns;
     vec<Eigen::Matrix<double, 6, 6>> blocks;
     for (int32_t a = 0; a < m; ++a) {
-        galerkin_row(rows, a, member_start, members, slot, columns, blocks);
+        galerkin_row(rows, a, slot, columns, blocks);
         row_start[static_cast<size_t>(a) + 1] = static_cast<int32_t>(columns.size());
     }
     // Pseudo-node 2a holds aggregate a's translations, 2a + 1 its rotations; each pair of

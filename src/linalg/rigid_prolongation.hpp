@@ -21,6 +21,8 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 
 namespace sh {
@@ -39,32 +41,83 @@ public:
     int32_t aggregates() const { return aggregates_; }
     /// The coarse DOFs (6 per aggregate).
     int32_t coarse_dofs() const { return 6 * aggregates_; }
-    /// coarse = P^T s (s: 1 per node, in node lanes; coarse: coarse_dofs()). Uses the object's
-    /// scratch: one transfer at a time.
-    void restrict_to(const Node4* s, double* coarse);
-    /// out += P u (out: 1 per node, in node lanes; u: coarse_dofs()). Uses the object's
-    /// scratch, as restrict_to.
-    void prolong_add(const double* u, Node4* out);
+    /// coarse = P^T s (s: 1 per node, in node lanes; coarse: coarse_dofs()).
+    void restrict_to(const Node4* s, double* coarse) const {
+        restrict_with([s](size_t i) { return s[i]; }, coarse);
+    }
+    /// out += P u (out: 1 per node, in node lanes; u: coarse_dofs()).
+    void prolong_add(const double* u, Node4* out) const {
+        prolong_with(u, [out](size_t i, Node4 value) { out[i] += value; });
+    }
+    /// restrict_to for s_i = node_value(i), computed as the pass reaches node i (a caller's
+    /// transform of its vector, e.g. a rotation, without an array for the result).
+    template <class NodeValue>
+    void restrict_with(const NodeValue& node_value, double* coarse) const {
+        // P_i^T s_i: the translations take s_i / sqrt(n_a); rotation k takes (g_k x d_i) . s_i =
+        // g_k . (d_i x s_i). Aggregate by aggregate, so that the sums stay in registers.
+        for (size_t a = 0; a < static_cast<size_t>(aggregates_); ++a) {
+            Node4 translation{}, moment{};
+            for (int32_t k = member_start_[a]; k < member_start_[a + 1]; ++k) {
+                const size_t i = static_cast<size_t>(members_[static_cast<size_t>(k)]);
+                const Node4 s = node_value(i);
+                translation += s;
+                moment += node_cross(offset_[i], s);
+            }
+            store_restriction(a, translation, moment, coarse);
+        }
+    }
+    /// sink(i, (P u)_i) for each node i in turn, aggregate by aggregate (prolong_add with the
+    /// caller's use of each node's value, e.g. rotated into its own vector).
+    template <class NodeSink>
+    void prolong_with(const double* u, const NodeSink& sink) const {
+        // P_i u = t_a / sqrt(n_a) + w_a x d_i, w_a = G_a r_a for aggregate a's translation t_a
+        // and rotation modes r_a.
+        for (size_t a = 0; a < static_cast<size_t>(aggregates_); ++a) {
+            const double* ua = u + 6 * a;
+            const Node4 translation = scale_[a] * load_node(ua), turn = block_times(&gauge_[3 * a], load_node(ua + 3));
+            for (int32_t k = member_start_[a]; k < member_start_[a + 1]; ++k) {
+                const size_t i = static_cast<size_t>(members_[static_cast<size_t>(k)]);
+                sink(i, translation + node_cross(turn, offset_[i]));
+            }
+        }
+    }
     /// out := P^T A P for the matrix rows, over two pseudo-nodes of 3 DOFs per aggregate
     /// (translations, rotations), pattern and values; an inert DOF gets 1 on the diagonal, so
     /// that out is positive definite where A is. Allocates; on failure out is as it was.
     void galerkin(const BlockRows& rows, SparseSystem& out) const;
 
 private:
+    /// a x b, by lane permutations (a_yzx b_zxy - a_zxy b_yzx), where element-wise products
+    /// would take the lanes apart into scalars; the fourth lane stays 0 if a's or b's is.
+    static Node4 node_cross(Node4 a, Node4 b) {
+        const Node4 a1 = __builtin_shufflevector(a, a, 1, 2, 0, 3), b2 = __builtin_shufflevector(b, b, 2, 0, 1, 3);
+        const Node4 a2 = __builtin_shufflevector(a, a, 2, 0, 1, 3), b1 = __builtin_shufflevector(b, b, 1, 2, 0, 3);
+        return a1 * b2 - a2 * b1;
+    }
+    /// Aggregate a's six coarse entries from the sums over its nodes of s_i and d_i x s_i.
+    void store_restriction(size_t a, Node4 translation, Node4 moment, double* coarse) const {
+        translation *= scale_[a];
+        for (int k = 0; k < 3; ++k) {
+            const Node4 g = gauge_[3 * a + static_cast<size_t>(k)] * moment;
+            coarse[6 * a + static_cast<size_t>(k)] = translation[k];
+            coarse[6 * a + 3 + static_cast<size_t>(k)] = g[0] + g[1] + g[2];
+        }
+    }
     /// P's 3 x 6 block of node i.
     Eigen::Matrix<double, 3, 6> block(size_t node) const;
     /// Row a of P^T A P, its blocks for aggregates b >= a, appended to columns and blocks;
-    /// members: the nodes of each aggregate (CSR); slot: -1 per aggregate on entry and on return.
-    void galerkin_row(const BlockRows& rows, int32_t a, const vec<int32_t>& member_start, const vec<int32_t>& members,
-                      vec<int32_t>& slot, vec<int32_t>& columns, vec<Eigen::Matrix<double, 6, 6>>& blocks) const;
+    /// slot: -1 per aggregate on entry and on return.
+    void galerkin_row(const BlockRows& rows, int32_t a, vec<int32_t>& slot, vec<int32_t>& columns,
+                      vec<Eigen::Matrix<double, 6, 6>>& blocks) const;
 
     int32_t aggregates_ = 0;
     vec<int32_t> aggregate_;   // per node
+    vec<int32_t> member_start_;  // per aggregate + 1: where its nodes start in members_
+    vec<int32_t> members_;       // the nodes, aggregate by aggregate (in node order within each)
     vec<Node4> offset_;        // per node, d_i: its rest position less its aggregate's centroid
     vec<double> scale_;        // per aggregate, 1 / sqrt(its nodes)
     vec<Node4> gauge_;         // per aggregate, G_a's three columns
     vec<uint8_t> inert_;       // per coarse DOF: 1 if its column of P is zero
-    vec<Node4> lanes_;         // per aggregate, 2: the transfers' sums (translation, rotation)
 };
 
 }  // namespace sh

@@ -50,12 +50,11 @@ void WarpedMultigrid::build(const SparseSystem& a0, const double* rest) {
     const int32_t nodes = blocks_.node_count();
     build_coarse(a0, rest);
     inverse_diagonal_.assign(3 * static_cast<size_t>(nodes), Node4{});
-    turn_.assign(6 * static_cast<size_t>(nodes), Node4{});
+    turn_.assign(3 * static_cast<size_t>(nodes), Node4{});
     z_.assign(static_cast<size_t>(nodes), Node4{});
     pushed_.assign(static_cast<size_t>(nodes), Node4{});
     residual_.assign(static_cast<size_t>(nodes), Node4{});
     change_.assign(static_cast<size_t>(nodes), Node4{});
-    coarse_local_.assign(static_cast<size_t>(nodes), Node4{});
     built_ = true;
 }
 
@@ -64,11 +63,8 @@ void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
     system_ = &a;
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
         const double* R = rotations + 9 * static_cast<size_t>(i);  // row-major
-        Node4* turn = &turn_[6 * static_cast<size_t>(i)];
-        for (int c = 0; c < 3; ++c) {
-            turn[c] = Node4{R[c], R[3 + c], R[6 + c], 0.0};                  // R's columns
-            turn[3 + c] = Node4{R[3 * c], R[3 * c + 1], R[3 * c + 2], 0.0};  // R^T's
-        }
+        Node4* turn = &turn_[3 * static_cast<size_t>(i)];
+        for (int c = 0; c < 3; ++c) turn[c] = Node4{R[c], R[3 + c], R[6 + c], 0.0};  // R's columns
     }
     for (int32_t i = 0; i < blocks_.node_count(); ++i) {
         double diagonal[3][3];
@@ -112,13 +108,14 @@ void WarpedMultigrid::first_sweep(const double* r) {
 }
 
 void WarpedMultigrid::coarse_correction() {
-    const size_t n = static_cast<size_t>(blocks_.node_count());
-    for (size_t i = 0; i < n; ++i) coarse_local_[i] = block_times(&turn_[6 * i + 3], residual_[i]);  // R^T e
-    prolongation_.restrict_to(coarse_local_.data(), coarse_rhs_.data());
+    // Each node's rotation is applied as the transfer passes it (R^T e into the restriction,
+    // R into the prolongation's value), where a pass of its own would write and read the
+    // rotated vector once more.
+    prolongation_.restrict_with([this](size_t i) { return block_transpose_times(&turn_[3 * i], residual_[i]); },
+                                coarse_rhs_.data());
     coarse_solver_->solve(coarse_, coarse_rhs_.data(), coarse_solution_.data());
-    std::fill(coarse_local_.begin(), coarse_local_.end(), Node4{});
-    prolongation_.prolong_add(coarse_solution_.data(), coarse_local_.data());
-    for (size_t i = 0; i < n; ++i) z_[i] += block_times(&turn_[6 * i], coarse_local_[i]);  // R P u
+    prolongation_.prolong_with(coarse_solution_.data(),
+                               [this](size_t i, Node4 value) { z_[i] += block_times(&turn_[3 * i], value); });
 }
 
 void WarpedMultigrid::apply(const double* r, double* z) {

@@ -70,13 +70,12 @@ private:
     UpperBlocks blocks_;           // the system's block structure
     const SparseSystem* system_ = nullptr;  // the prepared system, read in place
     vec<Node4> inverse_diagonal_;  // 3 columns per node: the current diagonal blocks' inverses
-    vec<Node4> turn_;              // 6 per node: the columns of its rotation R, then of R^T
+    vec<Node4> turn_;              // 3 per node: the columns of its rotation R
     RigidProlongation prolongation_;
     SparseSystem coarse_;                 // P^T A0 P
     LinearSolverPtr coarse_solver_;       // its factorisation
     vec<double> coarse_rhs_;              // the restricted residual (6 per aggregate)
     vec<double> coarse_solution_;         // the coarse correction
-    vec<Node4> coarse_local_;             // R^T of the residual, then P of the coarse correction (rest frames)
     vec<Node4> z_;                        // the cycle's iterate
     vec<Node4> residual_;                 // r - A z_ after the first sweep
     vec<Node4> change_;                   // the backward sweep's change of z_

@@ -14,13 +14,18 @@ SH_INLINE Lanes positive_part(Lanes x) { return select(x > 0.0, x, Lanes{}); }
 
 // One Jacobi rotation per lane in plane (p, q) of the symmetric a, zeroing a[p][q]
 // (Golub and Van Loan's symmetric Schur step, written without dividing by a[p][q]);
-// v <- v J gathers the rotations.
+// v <- v J gathers the rotations. With d = a_qq - a_pp and r = sqrt(d^2 + 4 a_pq^2) the
+// rotation's tangent is t = 2 a_pq sign(d) / (|d| + r), and with k = 1 / sqrt(2 r (|d| + r))
+// its cosine and sine are (|d| + r) k and 2 a_pq sign(d) k (c^2 + s^2 = 1 by r's definition):
+// two square roots and one division in a row, where 1 / sqrt(1 + t^2) after t takes two of
+// each (the turns' latency is most of the frames' time).
 SH_INLINE void jacobi_turn(Lanes (&a)[3][3], Mat3L& v, int p, int q) {
     const Lanes apq = a[p][q], d = a[q][q] - a[p][p];
-    const Lanes magnitude = abs_lane(d) + lanes_sqrt(d * d + 4.0 * apq * apq);
+    const Lanes r = lanes_sqrt(d * d + 4.0 * apq * apq), magnitude = abs_lane(d) + r;
     const Lanes sign = select(d < 0.0, splat(-1.0), splat(1.0));
-    const Lanes t = select(magnitude > 0.0, 2.0 * apq * sign / select(magnitude > 0.0, magnitude, splat(1.0)), Lanes{});
-    const Lanes c = 1.0 / lanes_sqrt(1.0 + t * t), s = t * c;
+    const LaneMask turns = magnitude > 0.0;
+    const Lanes k = 1.0 / lanes_sqrt(select(turns, 2.0 * r * magnitude, splat(1.0)));
+    const Lanes c = select(turns, magnitude * k, splat(1.0)), s = select(turns, 2.0 * apq * sign * k, Lanes{});
     for (int k = 0; k < 3; ++k) {
         const Lanes kp = a[k][p], kq = a[k][q];
         a[k][p] = c * kp - s * kq;

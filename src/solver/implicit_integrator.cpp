@@ -539,7 +539,7 @@ bool NewtonStep::solve_by_multigrid() {
     try {
         cg = solve_for_update([&](const double* minus_g, double* delta) {
             return solve_preconditioned_cg(
-                matrix_.system.dof_count(), [&](const double* x, double* y) { matrix_.system.multiply(x, y); },
+                matrix_.system.dof_count(), [&](const double* x, double* y) { multigrid.multiply(x, y); },
                 multigrid, minus_g, delta, true, kKrylovForcing * s_.factor_reuse, cap, matrix_.cg);
         });
     } catch (const Error& e) {

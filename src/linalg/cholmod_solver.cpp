@@ -2,8 +2,8 @@
 // of the system per step). One cholmod_common per solver; the symbolic analysis (ordering,
 // elimination tree, supernodes) is kept in the cholmod_factor and reused by every factorize until
 // the pattern changes; solves reuse CHOLMOD's solution and workspace (cholmod_solve2).
-// CHOLMOD picks supernodal LL^T for 3D tet meshes of a few thousand nodes and up (unless told
-// to stay simplicial: CholmodLayout); it uses the system BLAS (OpenBLAS is about 2.5x faster
+// CHOLMOD picks supernodal LL^T for 3D tet meshes of a few thousand nodes and up (later where
+// laid out for solves: CholmodLayout); it uses the system BLAS (OpenBLAS is about 2.5x faster
 // there than the reference BLAS). Its OpenMP loops run on the calling thread (CallingThreadOnly
 // below).
 #if SOFTHAP_WITH_CHOLMOD
@@ -88,7 +88,7 @@ class CholmodSolver final : public LinearSolver {
 public:
     explicit CholmodSolver(CholmodLayout layout) {
         cholmod_start(&common_);
-        if (layout == CholmodLayout::Simplicial) common_.supernodal = CHOLMOD_SIMPLICIAL;
+        if (layout == CholmodLayout::ForSolves) common_.supernodal_switch = kSolvesSupernodalSwitch;
         common_.print = 0;  // never print (errors come back as sh::Error)
         common_.error_handler = nullptr;
         // Keep the factor as computed (supernodal LL^T or simplicial LDL^T): no conversion pass.
@@ -122,7 +122,7 @@ protected:
             flops_per_node_ = common_.fl / nodes;
         }
         // common_ holds the analysis of the order kept (cholmod_analyze_p sets both).
-        estimated_work_ = factor_work(common_.fl, common_.lnz, common_.supernodal == CHOLMOD_SIMPLICIAL ? 1.0 : kSupernodalSpeed);
+        estimated_work_ = factor_work(common_.fl, common_.lnz, factor_->is_super ? kSupernodalSpeed : 1.0);
     }
 
     bool do_elimination_order(EliminationOrder& out) const override {

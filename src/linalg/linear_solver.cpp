@@ -135,7 +135,7 @@ LinearSolverKind default_direct_solver() {
 
 LinearSolverPtr make_solve_often_solver() {
 #if SOFTHAP_WITH_CHOLMOD
-    return make_cholmod_solver(CholmodLayout::Simplicial);
+    return make_cholmod_solver(CholmodLayout::ForSolves);
 #else
     return make_ldlt_solver();
 #endif

@@ -117,15 +117,21 @@ LinearSolverPtr make_linear_solver(LinearSolverKind kind, double cg_tolerance, i
 LinearSolverKind default_direct_solver();
 
 /// The direct backend for a small system factorised once and solved many times (a multigrid's
-/// coarse level): CHOLMOD's simplicial factorisation where SOFTHAP_WITH_CHOLMOD, else LDL^T.
-/// A coarse factor of a few thousand DOF splits into hundreds of small supernodes, whose BLAS
-/// calls cost more per solve than a simplicial factor's plain loops: the raptor's coarse level
-/// (2,382 DOF, 106 k factor entries) solves in 0.15 ms against 0.21 supernodal.
+/// coarse level): CHOLMOD laid out for solves (CholmodLayout::ForSolves) where
+/// SOFTHAP_WITH_CHOLMOD, else LDL^T.
 LinearSolverPtr make_solve_often_solver();
 
-/// How CHOLMOD lays out its factor: as its analysis chooses (supernodal for 3D meshes of a few
-/// thousand nodes and up), or always simplicial.
-enum class CholmodLayout { Chosen, Simplicial };
+/// How CHOLMOD chooses between a supernodal and a simplicial factor. Chosen: its own default,
+/// supernodal from 40 flops per factor entry, which suits factorisations (dense kernels over
+/// supernodes). ForSolves: supernodal only from kSolvesSupernodalSwitch, where a solve's
+/// hundreds of small BLAS calls over thin supernodes cost more than a simplicial factor's
+/// plain loops.
+enum class CholmodLayout { Chosen, ForSolves };
+
+/// Measured on the multigrid's coarse levels, per solve, simplicial against supernodal: the
+/// raptor's (2,382 DOF, 68 flops per entry) 0.17-0.19 against 0.25 ms, the 20 k-tet cube's
+/// (1,080 DOF, 162 per entry) 0.22 against 0.18-0.19 ms.
+constexpr double kSolvesSupernodalSwitch = 100.0;
 
 /// The backends (make_linear_solver picks one of them).
 LinearSolverPtr make_cholmod_solver(CholmodLayout layout = CholmodLayout::Chosen);

@@ -105,7 +105,7 @@ void test_every_solver_solves_the_linked_system(void**) {
     solvers.push_back(sh::make_cg_solver(1e-14, 500));
 #if SOFTHAP_WITH_CHOLMOD
     solvers.push_back(sh::make_cholmod_solver());
-    solvers.push_back(sh::make_cholmod_solver(sh::CholmodLayout::Simplicial));
+    solvers.push_back(sh::make_cholmod_solver(sh::CholmodLayout::ForSolves));
 #endif
     solvers.push_back(sh::make_solve_often_solver());
     for (sh::LinearSolverPtr& solver : solvers) {

@@ -148,9 +148,12 @@ void FemBody::add_tangent(const double* xs, double stiffness_scale, double dampi
         const Mat3L* near = rotations_.last(model);
         // Two blocks at a time: their frames are found together (law_projected_derivatives).
         const size_t count = blocks_[model].size();
-        for (size_t k = 0; k < count; k += 2, slot += 2 * kLanes)
-            add_block_tangent(model, &blocks_[model][k], count - k >= 2 ? 2 : 1, near ? &near[k] : nullptr,
-                              &lane_tets[slot], xs, scale, position, system);
+        for (size_t k = 0; k < count; k += 2) {
+            const int pair = count - k >= 2 ? 2 : 1;
+            add_block_tangent(model, &blocks_[model][k], pair, near ? &near[k] : nullptr, &lane_tets[slot], xs, scale,
+                              position, system);
+            slot += static_cast<size_t>(pair) * kLanes;
+        }
     }
 }
 

@@ -87,12 +87,8 @@ public:
     void galerkin(const BlockRows& rows, SparseSystem& out) const;
 
 private:
-    /// a x b, by lane permutations (a_yzx b_zxy - a_zxy b_yzx), where element-wise products
-    /// would take the lanes apart into scalars; the fourth lane stays 0 if a's or b's is.
     static Node4 node_cross(Node4 a, Node4 b) {
-        const Node4 a1 = __builtin_shufflevector(a, a, 1, 2, 0, 3), b2 = __builtin_shufflevector(b, b, 2, 0, 1, 3);
-        const Node4 a2 = __builtin_shufflevector(a, a, 2, 0, 1, 3), b1 = __builtin_shufflevector(b, b, 1, 2, 0, 3);
-        return a1 * b2 - a2 * b1;
+        return Node4{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0], 0.0};
     }
     /// Aggregate a's six coarse entries from the sums over its nodes of s_i and d_i x s_i.
     void store_restriction(size_t a, Node4 translation, Node4 moment, double* coarse) const {

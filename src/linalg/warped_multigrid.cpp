@@ -155,8 +155,11 @@ double WarpedMultigrid::iteration_work() const {
     // the cycle; the transfers (per node a rotation and a cross product each way): they count
     // kCachedOperationWeight of a sparse solve's operation each. The coarse solve is a sparse
     // solve, whose factor the sweeps' passes push out of cache: its own work, at full weight.
-    // Measured on the raptor's 17,793 DOF: 0.39 ms per cycle against 0.35 for the trilinear
-    // grid's, which this puts at 1.22e6 against 1.01e6 operations.
+    // On the raptor's 17,793 DOF this counts 1.2e6 operations, 0.18 of a solve with the fine
+    // factor (6.9e6); measured in one busy hour, a cycle with its half product took 0.71-0.75
+    // ms (the sweeps 0.18-0.21 ms each, the coarse correction 0.23 of which its solve 0.13,
+    // the half product 0.11) and a fine solve 2.8-3.2 ms: 0.25 of one. The weights favour the
+    // multigrid a little against a factorisation's solves.
     const double stored = static_cast<double>(blocks_.block_count()) + blocks_.node_count();
     const double transfers = 60.0 * blocks_.node_count();
     return kCachedOperationWeight * ((2.0 * 36.0 + 18.0) * stored + transfers) + coarse_solver_->work().solve;

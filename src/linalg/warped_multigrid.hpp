@@ -1,8 +1,8 @@
 // A two-level multigrid cycle for the implicit step's matrix A = M + h D + h^2 K(x) under large
 // rotation, used as conjugate gradients' preconditioner. The coarse level is the rigid motions
 // of aggregates of nodes at the rest shape (linalg/rigid_prolongation.hpp: P), with
-// the Galerkin coarse matrix P^T A0 P of the matrix at rest, factorised once by the library's
-// direct solver; the current matrix differs from A0 mostly by each node's rotation R, so the
+// the Galerkin coarse matrix P^T A0 P of the matrix at rest, factorised once by the direct
+// solver laid out for solves (make_solve_often_solver); the current matrix differs from A0 mostly by each node's rotation R, so the
 // coarse correction is warped by them (restricted by P^T R^T, prolonged by R P) instead of
 // rebuilt. The smoother is block Gauss-Seidel on the
 // current matrix (3x3 node blocks, forward before and backward after the coarse correction,
@@ -46,9 +46,10 @@ public:
     /// row of A z equal to r but for the blocks left of its diagonal times the changes the
     /// sweep made after it (Eisenstat's observation), so only those blocks are read again.
     bool apply_with_product(const double* r, double* z, double* az) override;
-    /// y = A x for the prepared system (x, y: 3 per node; they must not overlap): the same
-    /// product as SparseSystem::multiply, by node blocks (one pass over the stored blocks'
-    /// values, no row indices), for CG's warm start. Uses the cycle's iterate as scratch.
+    /// y = A x for the prepared system (x, y: 3 per node; y may be x): the same product as
+    /// SparseSystem::multiply, by node blocks (one pass over the nodes, reading their stored
+    /// blocks' values and no row indices), for CG's warm start. Uses the cycle's iterate and
+    /// push sums as scratch.
     void multiply(const double* x, double* y);
     /// One apply's work plus CG's product (half a product, apply_with_product), in a sparse
     /// solve's operations (FactorWork). Once built.

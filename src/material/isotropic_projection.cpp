@@ -75,24 +75,32 @@ void symmetric_eigen(Lanes (&a)[N][3][3], Mat3L (&v)[N]) {
 }
 
 // The stretches' block with its negative eigenvalues set to zero, in the lanes where it is not
-// positive definite (strongly compressed elements; the others keep theirs unchanged).
+// positive definite (strongly compressed elements; the others keep theirs unchanged). The test
+// and the eigen-solve run on the block divided by its largest entry: its third minor cubes the
+// entries (beyond about 1e103 it overflows, below 1e-103 it underflows) and a Jacobi turn
+// squares them; the projection scales with the block, so the result is multiplied back.
 void project_stretch_block(Lanes (&k)[3][3]) {
-    const Lanes minor2 = k[0][0] * k[1][1] - k[0][1] * k[0][1];
-    const Lanes minor3 = k[0][0] * (k[1][1] * k[2][2] - k[1][2] * k[1][2]) -
-                         k[0][1] * (k[0][1] * k[2][2] - k[1][2] * k[0][2]) +
-                         k[0][2] * (k[0][1] * k[1][2] - k[1][1] * k[0][2]);
-    const LaneMask indefinite = !(k[0][0] > 0.0 && minor2 > 0.0 && minor3 > 0.0);
-    if (!any_lane(indefinite)) return;
+    Lanes size = Lanes{};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) size = max_lane(size, abs_lane(k[i][j]));
+    const Lanes scale = select(size > 0.0, 1.0 / select(size > 0.0, size, splat(1.0)), splat(1.0));
     Lanes a[1][3][3];
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) a[0][i][j] = k[i][j];
+        for (int j = 0; j < 3; ++j) a[0][i][j] = scale * k[i][j];
+    const Lanes(&u)[3][3] = a[0];
+    const Lanes minor2 = u[0][0] * u[1][1] - u[0][1] * u[0][1];
+    const Lanes minor3 = u[0][0] * (u[1][1] * u[2][2] - u[1][2] * u[1][2]) -
+                         u[0][1] * (u[0][1] * u[2][2] - u[1][2] * u[0][2]) +
+                         u[0][2] * (u[0][1] * u[1][2] - u[1][1] * u[0][2]);
+    const LaneMask indefinite = !(u[0][0] > 0.0 && minor2 > 0.0 && minor3 > 0.0);
+    if (!any_lane(indefinite)) return;
     Mat3L w[1];
     symmetric_eigen(a, w);
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) {
             Lanes sum = Lanes{};
             for (int m = 0; m < 3; ++m) sum += w[0].m[i][m] * positive_part(a[0][m][m]) * w[0].m[j][m];
-            k[i][j] = select(indefinite, sum, k[i][j]);
+            k[i][j] = select(indefinite, size * sum, k[i][j]);
         }
 }
 

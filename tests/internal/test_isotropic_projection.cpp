@@ -304,6 +304,42 @@ void extreme_scales(void**) {
     }
 }
 
+/// The projected derivative is linear in the stiffness (the projection commutes with a
+/// positive scale): at 1e-160 to 1e160 times a unit stiffness it is that multiple of the unit
+/// result. The stretch blocks are indefinite, one only through its determinant (its corner
+/// and leading pair are positive, a determinant cubes the entries), one with two eigenvalues
+/// 1e-7 apart (a Jacobi turn squares their gap).
+void stiffness_at_extreme_scales_scales_the_projection(void**) {
+    std::mt19937_64 rng(13);
+    const Eigen::Matrix3d f = rotation(rng) * Eigen::Vector3d(0.9, 1.1, 1.0).asDiagonal() * rotation(rng);
+    sh::Mat3L F;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) F.m[i][j] = sh::splat(f(i, j));
+    const sh::SingularFrameLanes frame = sh::singular_frames(F);
+    const double blocks[2][3][3] = {{{2.0, 1.0, 1.0}, {1.0, 2.0, 1.0}, {1.0, 1.0, -0.5}},
+                                    {{1.0, 1e-7, 0.3}, {1e-7, 1.0 + 1e-7, 0.2}, {0.3, 0.2, -1.0}}};
+    for (const auto& block : blocks) {
+        const auto projected = [&](double scale) {
+            sh::PrincipalStiffnessLanes k;
+            for (int a = 0; a < 3; ++a) {
+                for (int b = 0; b < 3; ++b) k.stretch[a][b] = sh::splat(scale * block[a][b]);
+                k.shear[a] = sh::splat(scale * (1.0 + a)), k.turn[a] = sh::splat(scale * (0.5 + a));
+            }
+            sh::StressDerivativeLanes out;
+            sh::projected_stress_derivatives(k, frame, out);
+            StressDerivative c;
+            for (int p = 0; p < 9; ++p)
+                for (int q = 0; q < 9; ++q) c(p, q) = out.c[p][q][0] / scale;
+            return c;
+        };
+        const StressDerivative unit = projected(1.0);
+        const Eigen::SelfAdjointEigenSolver<StressDerivative> eigen(unit);
+        assert_true(eigen.eigenvalues()(0) >= -1e-12);  // projected: the negative stretch mode is gone
+        for (const double scale : {1e-160, 1e-146, 1e120, 1e160})
+            assert_true((projected(scale) - unit).cwiseAbs().maxCoeff() <= 1e-12 * unit.cwiseAbs().maxCoeff());
+    }
+}
+
 /// An element collapsed onto a stretched line (F of rank one, or nearly: s = (5, d, d)), or
 /// inverted across a pair whose stretches nearly cancel beside a long third axis: the exact
 /// turn stiffness grows as 1 / (s_b + s_c) without bound there; the corotational law's
@@ -363,6 +399,7 @@ int main() {
         cmocka_unit_test(degenerate_stretches),
         cmocka_unit_test(singular_deformations),
         cmocka_unit_test(extreme_scales),
+        cmocka_unit_test(stiffness_at_extreme_scales_scales_the_projection),
         cmocka_unit_test(corotational_reference_is_the_derivative),
         cmocka_unit_test(corotational_turn_stays_bounded),
     };

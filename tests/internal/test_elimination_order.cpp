@@ -4,7 +4,9 @@
 // its original, must be kept (the analysis reports the uncut order's cost, not a fresh one), and
 // the solution must equal that of a fresh analysis; a poor suggestion (the reverse of a good
 // order) must be dropped for a fresh ordering, whose fill the test knows from a fresh analysis.
-// A backend that does not order by nodes ignores the suggestion.
+// A backend that does not order by nodes ignores the suggestion. Also the backend laid out for
+// solves (make_solve_often_solver): simplicial where CHOLMOD's supernodes would be thin, and
+// refusing an indefinite matrix as the others do.
 #include "linalg/linear_solver.hpp"
 #include "linalg/sparse_system.hpp"
 
@@ -14,6 +16,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <vector>
 
@@ -27,6 +30,7 @@ extern "C" {
 namespace {
 
 constexpr int kCells = 6;  // cubes per side
+constexpr int kThinSupernodeCells = 4;  // a block whose factor does 64 flops per entry (40-100)
 
 // A block of kCells^3 cubes, six tets each (Kuhn split), and the nodes of a cut: the copies
 // of the nodes at z = kCells / 2 with x < kCells / 2, taken by the tets above that plane.
@@ -157,7 +161,61 @@ void test_poor_suggestion_is_dropped_for_a_fresh_order(void**) {
     assert_true(chosen.nodes == good.nodes);
     assert_same_solution(solve(*given, system), solve(*fresh, system));
 }
+
+// The SPD system of assemble() on a block of cells^3 cubes.
+sh::SparseSystem laplacian_block(int cells) {
+    const std::vector<int32_t> tets = kuhn::block_tets(cells);
+    const int32_t nodes = kuhn::node_count(cells);
+    std::vector<int32_t> identity(static_cast<size_t>(nodes));
+    for (int32_t i = 0; i < nodes; ++i) identity[static_cast<size_t>(i)] = i;
+    sh::SparseSystem a;
+    a.build_pattern(tets.data(), tets.size() / 4, 4, identity.data(), nodes, nodes);
+    const std::array<double, 144> ke = kuhn::laplacian_element(0.0);
+    for (size_t e = 0; e < tets.size() / 4; ++e) a.add_element(e, ke.data(), 1.0);
+    std::vector<double> ones(3 * static_cast<size_t>(nodes), 1.0);
+    a.add_diagonal(ones.data(), 1.0);
+    return a;
+}
+
+// Laid out for solves, CHOLMOD keeps a factor simplicial where its own choice is supernodal:
+// a block whose factorisation does between 40 (CHOLMOD's switch) and kSolvesSupernodalSwitch
+// flops per factor entry. The layouts show in the factorisation's work estimate (a supernodal
+// one runs kSupernodalSpeed times a solve's speed, a simplicial one at it, both never under 12
+// solves), and both solve as the LDL^T backend does.
+void test_solve_often_layout_keeps_thin_supernodes_simplicial(void**) {
+    const sh::SparseSystem system = laplacian_block(kThinSupernodeCells);
+    sh::LinearSolverPtr chosen = sh::make_cholmod_solver(), for_solves = sh::make_solve_often_solver();
+    chosen->analyze(system);
+    for_solves->analyze(system);
+    const double entries = chosen->work().solve / 4.0;  // a solve's 4 operations per factor entry
+    const double per_entry = for_solves->work().factorize / entries;  // fl / lnz, at a solve's speed
+    assert_true(per_entry > 48.0 && per_entry < sh::kSolvesSupernodalSwitch);  // past the 12-solve floor
+    assert_true(chosen->work().factorize < 0.9 * for_solves->work().factorize);
+    sh::LinearSolverPtr ldlt = sh::make_ldlt_solver();
+    ldlt->analyze(system);
+    const std::vector<double> reference = solve(*ldlt, system);
+    assert_same_solution(solve(*chosen, system), reference);
+    assert_same_solution(solve(*for_solves, system), reference);
+}
 #endif
+
+// The solve-often backend (a simplicial factor, with or without CHOLMOD) refuses an indefinite
+// matrix by name, as the others do.
+void test_solve_often_solver_refuses_an_indefinite_matrix(void**) {
+    Block block;
+    sh::SparseSystem system;
+    block.assemble(system);
+    system.values()[static_cast<size_t>(system.diagonal_slot(100))] = -50.0;
+    sh::LinearSolverPtr solver = sh::make_solve_often_solver();
+    solver->analyze(system);
+    bool refused = false;
+    try {
+        solver->factorize(system);
+    } catch (const sh::Error& e) {
+        refused = e.status() == SH_ERR_SOLVER && std::strstr(e.message().c_str(), "not positive definite");
+    }
+    assert_true(refused);
+}
 
 void test_ldlt_ignores_the_suggestion(void**) {
     Block block;
@@ -198,7 +256,9 @@ int main(void) {
 #if SOFTHAP_WITH_CHOLMOD
         cmocka_unit_test(test_carried_order_is_kept_and_solves_the_same),
         cmocka_unit_test(test_poor_suggestion_is_dropped_for_a_fresh_order),
+        cmocka_unit_test(test_solve_often_layout_keeps_thin_supernodes_simplicial),
 #endif
+        cmocka_unit_test(test_solve_often_solver_refuses_an_indefinite_matrix),
         cmocka_unit_test(test_ldlt_ignores_the_suggestion),
         cmocka_unit_test(test_suggestion_of_the_wrong_size_is_refused),
     };

@@ -32,6 +32,18 @@ namespace {
 constexpr int kCells = 6;  // cubes per side
 constexpr int kThinSupernodeCells = 4;  // a block whose factor does 64 flops per entry (40-100)
 
+// The SPD system of a graph Laplacian per tet (4 I - ones, times I3) plus the identity on
+// tets over nodes, every node free (free index = node index).
+void assemble_laplacian(const std::vector<int32_t>& tets, int32_t nodes, sh::SparseSystem& a) {
+    std::vector<int32_t> identity(static_cast<size_t>(nodes));
+    for (int32_t i = 0; i < nodes; ++i) identity[static_cast<size_t>(i)] = i;
+    a.build_pattern(tets.data(), tets.size() / 4, 4, identity.data(), nodes, nodes);
+    const std::array<double, 144> ke = kuhn::laplacian_element(0.0);
+    for (size_t e = 0; e < tets.size() / 4; ++e) a.add_element(e, ke.data(), 1.0);
+    std::vector<double> ones(3 * static_cast<size_t>(nodes), 1.0);
+    a.add_diagonal(ones.data(), 1.0);
+}
+
 // A block of kCells^3 cubes, six tets each (Kuhn split), and the nodes of a cut: the copies
 // of the nodes at z = kCells / 2 with x < kCells / 2, taken by the tets above that plane.
 struct Block {
@@ -64,20 +76,7 @@ struct Block {
         }
     }
 
-    // The SPD system of a graph Laplacian per tet (4 I - ones, times I3) plus the identity,
-    // every node free (free index = node index).
-    void assemble(sh::SparseSystem& a) const {
-        std::vector<int32_t> identity(static_cast<size_t>(node_count));
-        for (int32_t i = 0; i < node_count; ++i) identity[static_cast<size_t>(i)] = i;
-        a.build_pattern(tets.data(), tets.size() / 4, 4, identity.data(), node_count, node_count);
-        std::array<double, 144> ke{};
-        for (int r = 0; r < 12; ++r)
-            for (int c = 0; c < 12; ++c)
-                if (r % 3 == c % 3) ke[static_cast<size_t>(12 * r + c)] = r / 3 == c / 3 ? 3.0 : -1.0;
-        for (size_t e = 0; e < tets.size() / 4; ++e) a.add_element(e, ke.data(), 1.0);
-        std::vector<double> ones(3 * static_cast<size_t>(node_count), 1.0);
-        a.add_diagonal(ones.data(), 1.0);
-    }
+    void assemble(sh::SparseSystem& a) const { assemble_laplacian(tets, node_count, a); }
 };
 
 // x with A x = b for b_d = d % 7 - 3, through solver analysed (already) for a.
@@ -162,18 +161,10 @@ void test_poor_suggestion_is_dropped_for_a_fresh_order(void**) {
     assert_same_solution(solve(*given, system), solve(*fresh, system));
 }
 
-// The SPD system of assemble() on a block of cells^3 cubes.
+// The SPD system of assemble_laplacian on a block of cells^3 cubes.
 sh::SparseSystem laplacian_block(int cells) {
-    const std::vector<int32_t> tets = kuhn::block_tets(cells);
-    const int32_t nodes = kuhn::node_count(cells);
-    std::vector<int32_t> identity(static_cast<size_t>(nodes));
-    for (int32_t i = 0; i < nodes; ++i) identity[static_cast<size_t>(i)] = i;
     sh::SparseSystem a;
-    a.build_pattern(tets.data(), tets.size() / 4, 4, identity.data(), nodes, nodes);
-    const std::array<double, 144> ke = kuhn::laplacian_element(0.0);
-    for (size_t e = 0; e < tets.size() / 4; ++e) a.add_element(e, ke.data(), 1.0);
-    std::vector<double> ones(3 * static_cast<size_t>(nodes), 1.0);
-    a.add_diagonal(ones.data(), 1.0);
+    assemble_laplacian(kuhn::block_tets(cells), kuhn::node_count(cells), a);
     return a;
 }
 

@@ -21,7 +21,6 @@
 
 #include <Eigen/Dense>
 
-#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 

@@ -12,6 +12,12 @@ constexpr int kMaxSweeps = 8;
 
 SH_INLINE Lanes positive_part(Lanes x) { return select(x > 0.0, x, Lanes{}); }
 
+// 1 / size per lane, 1 where size is 0: the factor that brings a matrix of that size to unit
+// size (a zero one stays as it is).
+SH_INLINE Lanes unit_scale(Lanes size) {
+    return select(size > 0.0, 1.0 / select(size > 0.0, size, splat(1.0)), splat(1.0));
+}
+
 // One Jacobi rotation per lane in plane (p, q) of the symmetric a, zeroing a[p][q]
 // (Golub and Van Loan's symmetric Schur step, written without dividing by a[p][q]);
 // v <- v J gathers the rotations. With d = a_qq - a_pp and r = sqrt(d^2 + 4 a_pq^2) the
@@ -83,7 +89,7 @@ void project_stretch_block(Lanes (&k)[3][3]) {
     Lanes size = Lanes{};
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) size = max_lane(size, abs_lane(k[i][j]));
-    const Lanes scale = select(size > 0.0, 1.0 / select(size > 0.0, size, splat(1.0)), splat(1.0));
+    const Lanes scale = unit_scale(size);
     Lanes a[1][3][3];
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) a[0][i][j] = scale * k[i][j];
@@ -142,8 +148,7 @@ void frames_of(const Mat3L* F, const Mat3L* const* near, SingularFrameLanes* out
     for (int n = 0; n < N; ++n) {
         // F scaled to unit size first: the polar iteration's scaling multiplies |F|^8, which
         // leaves the doubles' range for |F| beyond about 1e-40 or 1e39; the frame is the same.
-        const Lanes size = lanes_sqrt(ddot(F[n], F[n]));
-        scale[n] = select(size > 0.0, 1.0 / select(size > 0.0, size, splat(1.0)), splat(1.0));
+        scale[n] = unit_scale(lanes_sqrt(ddot(F[n], F[n])));
         Mat3L unit;
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) unit.m[i][j] = scale[n] * F[n].m[i][j];

@@ -10,8 +10,14 @@
 
 namespace sh {
 
-/// Tets processed together by the element kernels.
+/// Tets processed together by the element kernels: one vector register's worth of doubles
+/// where the target has AVX-512, half a register pair elsewhere (AVX2 has 16 registers of 4
+/// doubles: 8-double lanes take two each and the kernels' 3x3 and 9x9 matrices spill).
+#if defined(__AVX512F__)
 constexpr int kLanes = 8;
+#else
+constexpr int kLanes = 4;
+#endif
 
 /// kLanes doubles; arithmetic is element-wise.
 typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
@@ -39,10 +45,8 @@ SH_INLINE Lanes lanes_sqrt(Lanes a) {
     static_assert(kLanes == 8, "AVX-512 path assumes 8 double lanes");
     return _mm512_sqrt_pd(a);
 #elif defined(__AVX__)
-    static_assert(kLanes == 8, "AVX path assumes 8 double lanes");
-    const __m256d lo = _mm256_sqrt_pd(__m256d{a[0], a[1], a[2], a[3]});
-    const __m256d hi = _mm256_sqrt_pd(__m256d{a[4], a[5], a[6], a[7]});
-    return Lanes{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
+    static_assert(kLanes == 4, "AVX path assumes 4 double lanes");
+    return _mm256_sqrt_pd(a);
 #else
     for (int l = 0; l < kLanes; ++l) a[l] = std::sqrt(a[l]);
     return a;

@@ -9,7 +9,7 @@
 
 namespace sh {
 
-/// kLanes tets of one material model (832 bytes: 104 per tet, streamed once per force pass).
+/// kLanes tets of one material model (104 bytes per tet, streamed once per force pass).
 /// The Lame parameters are stored pre-multiplied by -V0: every material law is homogeneous of
 /// degree one in (lambda, mu), so the kernels get the nodal-force matrix -V0 P(F) Bm^T and the
 /// energy -V0 psi(F) without multiplying by the volume. Unused lanes repeat a real tet of the

@@ -121,12 +121,12 @@ void add_stretch_modes(const Lanes (&k)[3][3], const SingularFrameLanes& frame, 
         for (int q = p; q < 9; ++q) out.c[p][q] = ek[p][0] * e[q][0] + ek[p][1] * e[q][1] + ek[p][2] * e[q][2];
 }
 
-// out += each pair's shear and turn modes, on and above the diagonal, with their eigenvalues'
-// positive parts. With x = u_i v_j^T and y = u_j v_i^T the modes are (x +- y) / sqrt 2.
+// out += each pair's shear and turn modes, on and above the diagonal, with their eigenvalues
+// (projected: not negative). With x = u_i v_j^T and y = u_j v_i^T the modes are (x +- y) / sqrt 2.
 void add_pair_modes(const PrincipalStiffnessLanes& k, const SingularFrameLanes& frame, StressDerivativeLanes& out) {
     for (int m = 0; m < 3; ++m) {
         const int i = m == 0 ? 1 : 0, j = m == 2 ? 1 : 2;
-        const Lanes shear = 0.5 * positive_part(k.shear[m]), turn = 0.5 * positive_part(k.turn[m]);
+        const Lanes shear = 0.5 * k.shear[m], turn = 0.5 * k.turn[m];
         Lanes plus[9], minus[9];
         for (int p = 0; p < 9; ++p) {
             const Lanes x = frame.u.m[p / 3][i] * frame.v.m[p % 3][j], y = frame.u.m[p / 3][j] * frame.v.m[p % 3][i];
@@ -177,14 +177,21 @@ void singular_frame_pair(const Mat3L (&F)[2], const Mat3L* const (&near)[2], Sin
     frames_of<2>(F, near, out);
 }
 
+PrincipalStiffnessLanes projected_principal_stiffness(const PrincipalStiffnessLanes& stiffness) {
+    PrincipalStiffnessLanes projected = stiffness;
+    project_stretch_block(projected.stretch);
+    for (int m = 0; m < 3; ++m) {
+        projected.shear[m] = positive_part(stiffness.shear[m]);
+        projected.turn[m] = positive_part(stiffness.turn[m]);
+    }
+    return projected;
+}
+
 void projected_stress_derivatives(const PrincipalStiffnessLanes& stiffness, const SingularFrameLanes& frame,
                                   StressDerivativeLanes& out) {
-    Lanes k[3][3];
-    for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) k[a][b] = stiffness.stretch[a][b];
-    project_stretch_block(k);
-    add_stretch_modes(k, frame, out);
-    add_pair_modes(stiffness, frame, out);
+    const PrincipalStiffnessLanes projected = projected_principal_stiffness(stiffness);
+    add_stretch_modes(projected.stretch, frame, out);
+    add_pair_modes(projected, frame, out);
     for (int p = 0; p < 9; ++p)
         for (int q = 0; q < p; ++q) out.c[p][q] = out.c[q][p];
 }

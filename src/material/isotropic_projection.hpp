@@ -49,6 +49,12 @@ struct PrincipalStiffnessLanes {
     Lanes shear[3], turn[3];
 };
 
+/// stiffness with its negative eigenvalues set to zero, per lane: the stretch block projected to
+/// positive semi-definite where it is not positive definite, shear and turn clamped at zero.
+/// The modes and these eigenvalues are those of projected_stress_derivatives' dP/dF: a caller
+/// may contract them with its own map (the element stiffness) without forming dP/dF.
+PrincipalStiffnessLanes projected_principal_stiffness(const PrincipalStiffnessLanes& stiffness);
+
 /// dP/dF with its negative eigenvalues set to zero, per lane: the sum over the nine modes q of
 /// max(eigenvalue, 0) q q^T, in the frame's basis. Exactly dP/dF where it is positive
 /// semi-definite; the nearest positive semi-definite matrix elsewhere.

@@ -1,26 +1,22 @@
 // Tangent stiffness of FEM bodies for the implicit and static solvers:
 // K_e = V0 G^T C G with C = dP/dF (9x9) and G the map from nodal displacements to F
-// (dF_kj / dx_ak = g_a[j], g_a the shape-function gradients). For the laws whose C can be
-// indefinite (kProjectTangent in the material table; all isotropic), C is formed already
-// projected to positive semi-definite, from the law's analytic eigensystem in F's singular
-// frame; for the others, from the law's differential on the unit basis of F.
+// (model/element_stiffness.hpp). For the laws whose C can be indefinite (kProjectTangent in the
+// material table; all isotropic), K_e comes projected to positive semi-definite straight from
+// the law's analytic eigensystem in F's singular frame; for the others, C is formed from the
+// law's differential on the unit basis of F.
 #include "model/fem_body.hpp"
 
 #include "material/material_params.hpp"
 #include "material/isotropic_projection.hpp"
 #include "material/material_table.hpp"
 #include "linalg/sparse_system.hpp"
+#include "model/element_stiffness.hpp"
 #include "model/fem_kernel.hpp"
 
 #include <algorithm>
 
 namespace sh {
 namespace {
-
-// One element's stiffness per lane, by 3x3 node blocks: block[a][b][k][l] = K((a, k), (b, l)).
-struct StiffnessLanes {
-    Lanes block[4][4][3][3];
-};
 
 // dP/dF per lane of a batch of elements of one material model (a law that does not project:
 // see the material table), from its differential on the unit basis of F, symmetrised.
@@ -39,47 +35,21 @@ void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, StressDerivative
         for (int q = p + 1; q < 9; ++q) C.c[p][q] = C.c[q][p] = 0.5 * (C.c[p][q] + C.c[q][p]);
 }
 
-// dP/dF of a law that projects (all isotropic: see the material table's kProjectTangent) per
-// lane, projected to positive semi-definite: from the law's analytic eigensystem in F's
-// singular frame, whose polar rotation starts from near where the body keeps its elements'
-// rotations (the last force pass's: see BlockRotations).
-// count (1 or 2) batches at once: their frames are found together (singular_frame_pair).
+// dP/dF's element stiffness for a law that projects (all isotropic: see the material table's
+// kProjectTangent), per lane, projected to positive semi-definite: from the law's analytic
+// eigensystem in F's singular frame, whose polar rotation starts from near where the body keeps
+// its elements' rotations (the last force pass's: see BlockRotations). Nodes 1..3's blocks;
+// complete_node_zero adds node 0's. count (1 or 2) blocks b at once: their frames are found
+// together (singular_frame_pair).
 template <class Material>
-void law_projected_derivatives(int count, const Mat3L (&F)[2], const Lanes (&lambda)[2], const Lanes (&mu)[2],
-                               const Mat3L* const (&near)[2], StressDerivativeLanes (&C)[2]) {
+void law_projected_stiffness(int count, const TetBlock* b, const Mat3L (&F)[2], const Lanes (&lambda)[2],
+                             const Lanes (&mu)[2], const Mat3L* const (&near)[2], StiffnessLanes (&K)[2]) {
     SingularFrameLanes frame[2];
     if (count == 2) singular_frame_pair(F, near, frame);
     else frame[0] = singular_frames(F[0], near[0]);
     for (int n = 0; n < count; ++n)
-        projected_stress_derivatives(Material::principal_stiffness(frame[n].s, lambda[n], mu[n]), frame[n], C[n]);
-}
-
-// K = V0 G^T C G per lane, for symmetric C and the shape-function gradients g[a - 1] of nodes
-// a = 1..3 (rows of the inverse rest edge matrix): the blocks (a, b), 1 <= a <= b, from
-// K((a, k), (b, l)) = V0 sum_jm g_a[j] C((k, j), (l, m)) g_b[m]; their mirror images below the
-// diagonal; and node 0's, whose gradient is -(g_1 + g_2 + g_3), as minus the sums of the others.
-void element_stiffness(const StressDerivativeLanes& C, const Lanes (&g)[3][3], Lanes volume, StiffnessLanes& K) {
-    for (int b = 1; b < 4; ++b) {
-        Lanes cg[9][3];  // cg[q][l] = sum_m C(q, (l, m)) g_b[m]
-        for (int q = 0; q < 9; ++q)
-            for (int l = 0; l < 3; ++l)
-                cg[q][l] = C.c[q][3 * l] * g[b - 1][0] + C.c[q][3 * l + 1] * g[b - 1][1] + C.c[q][3 * l + 2] * g[b - 1][2];
-        for (int a = 1; a <= b; ++a)
-            for (int k = 0; k < 3; ++k)
-                for (int l = 0; l < 3; ++l) {
-                    const Lanes v = volume * (g[a - 1][0] * cg[3 * k][l] + g[a - 1][1] * cg[3 * k + 1][l] +
-                                              g[a - 1][2] * cg[3 * k + 2][l]);
-                    K.block[a][b][k][l] = K.block[b][a][l][k] = v;
-                }
-    }
-    for (int b = 1; b < 4; ++b)
-        for (int k = 0; k < 3; ++k)
-            for (int l = 0; l < 3; ++l)
-                K.block[0][b][k][l] = K.block[b][0][l][k] =
-                    -(K.block[1][b][k][l] + K.block[2][b][k][l] + K.block[3][b][k][l]);
-    for (int k = 0; k < 3; ++k)
-        for (int l = 0; l < 3; ++l)
-            K.block[0][0][k][l] = -(K.block[0][1][k][l] + K.block[0][2][k][l] + K.block[0][3][k][l]);
+        modal_element_stiffness(projected_principal_stiffness(Material::principal_stiffness(frame[n].s, lambda[n], mu[n])),
+                                frame[n], b[n].Bm.m, K[n]);
 }
 
 }  // namespace
@@ -118,18 +88,22 @@ void FemBody::add_block_tangent(int model, const TetBlock* b, int count, const M
         lambda[n] = -b[n].lambda_w, mu[n] = -b[n].mu_w;
         frame_near[n] = near ? &near[n] : nullptr;
     }
-    StressDerivativeLanes C[2];
+    StiffnessLanes K[2];
     visit_material(model, [&](auto law) {
         using Law = decltype(law);
-        if constexpr (Law::kProjectTangent)
-            law_projected_derivatives<Law>(count, F, lambda, mu, frame_near, C);
-        else
-            for (int n = 0; n < count; ++n) stress_derivatives<Law>(F[n], lambda[n], mu[n], C[n]);
+        if constexpr (Law::kProjectTangent) {
+            law_projected_stiffness<Law>(count, b, F, lambda, mu, frame_near, K);
+        } else {
+            for (int n = 0; n < count; ++n) {
+                StressDerivativeLanes C;
+                stress_derivatives<Law>(F[n], lambda[n], mu[n], C);
+                element_stiffness(C, b[n].Bm.m, K[n]);
+            }
+        }
     });
-    StiffnessLanes K;
-    const double* blocks = reinterpret_cast<const double*>(&K.block[0][0][0][0]);  // a vector aliases a double
     for (int n = 0; n < count; ++n) {
-        element_stiffness(C[n], b[n].Bm.m, splat(1.0), K);
+        complete_node_zero(K[n]);
+        const double* blocks = reinterpret_cast<const double*>(&K[n].block[0][0][0][0]);  // a vector aliases a double
         for (int l = 0; l < kLanes; ++l, ++tets)
             if (*tets >= 0) system.add_element_lane(static_cast<size_t>(*tets), position++, blocks + l, kLanes, scale);
     }

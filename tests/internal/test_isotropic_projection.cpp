@@ -5,11 +5,14 @@
 // itself checked against central differences of P), fully eigendecomposed (Eigen's
 // SelfAdjointEigenSolver) with its negative eigenvalues set to zero. For the laws that project
 // (StVK, neo-Hookean, corotational) at stretched, compressed, inverted and degenerate
-// deformations.
+// deformations. The element stiffness formed from the projected modes without C
+// (model/element_stiffness.hpp) against G^T C G formed densely from the same reference, for
+// random element shapes.
 #include "material/corotational_material.hpp"
 #include "material/isotropic_projection.hpp"
 #include "material/neohookean_material.hpp"
 #include "material/stvk_material.hpp"
+#include "model/element_stiffness.hpp"
 
 #include <Eigen/Dense>
 
@@ -135,6 +138,53 @@ void check_frame(const sh::SingularFrameLanes& frame, int l, const Eigen::Matrix
     assert_true((v.transpose() * v - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-14);
 }
 
+/// G (9x12), the map from a tet's nodal displacements to F, for node gradients g_1..g_3 (rows of
+/// g) and g_0 = -(g_1 + g_2 + g_3): dF_kj / dx_ak = g_a[j].
+Eigen::Matrix<double, 9, 12> displacement_gradient(const Eigen::Matrix3d& g) {
+    Eigen::Matrix<double, 9, 12> G = Eigen::Matrix<double, 9, 12>::Zero();
+    for (int a = 0; a < 4; ++a) {
+        const Eigen::Vector3d ga = a == 0 ? Eigen::Vector3d(-g.colwise().sum().transpose()) : Eigen::Vector3d(g.row(a - 1).transpose());
+        for (int k = 0; k < 3; ++k)
+            for (int j = 0; j < 3; ++j) G(3 * k + j, 3 * a + k) = ga(j);
+    }
+    return G;
+}
+
+/// Lane l of K as a 12x12 matrix.
+Eigen::Matrix<double, 12, 12> lane(const sh::StiffnessLanes& K, int l) {
+    Eigen::Matrix<double, 12, 12> r;
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+            for (int k = 0; k < 3; ++k)
+                for (int m = 0; m < 3; ++m) r(3 * a + k, 3 * b + m) = K.block[a][b][k][m][l];
+    return r;
+}
+
+/// The element stiffness from frame's projected modes, for random shape gradients per lane,
+/// against G^T c G formed densely (c: lane l's expected projected dP/dF, per lane).
+template <class Law>
+void check_element_stiffness(const sh::SingularFrameLanes& frame, const StressDerivative* expected, int count) {
+    std::mt19937_64 rng(static_cast<unsigned>(count) * 7919u + static_cast<unsigned>(frame.s[0][0] * 1e6));
+    std::uniform_real_distribution<double> entry(-2.0, 2.0);
+    Eigen::Matrix3d g[sh::kLanes];
+    sh::Lanes gl[3][3];
+    for (int l = 0; l < sh::kLanes; ++l) {
+        g[l] = Eigen::Matrix3d::NullaryExpr([&](Eigen::Index, Eigen::Index) { return entry(rng); });
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) gl[i][j][l] = g[l](i, j);
+    }
+    sh::StiffnessLanes K;
+    sh::modal_element_stiffness(sh::projected_principal_stiffness(Law::principal_stiffness(frame.s, sh::splat(2.0), sh::splat(1.0))),
+                                frame, gl, K);
+    sh::complete_node_zero(K);
+    for (int l = 0; l < count; ++l) {
+        const Eigen::Matrix<double, 9, 12> G = displacement_gradient(g[l]);
+        const Eigen::Matrix<double, 12, 12> reference = G.transpose() * expected[l] * G;
+        const double scale = std::max(reference.cwiseAbs().maxCoeff(), expected[l].cwiseAbs().maxCoeff());
+        assert_true((lane(K, l) - reference).cwiseAbs().maxCoeff() <= 1e-10 * scale);
+    }
+}
+
 /// Projects Law's derivative at up to kLanes deformations at once (one per lane, the last
 /// repeated into the rest) and compares each lane with the reference; returns the reference's
 /// negative eigenvalues (those the projection removed).
@@ -149,11 +199,13 @@ int check_lanes(const Eigen::Matrix3d* fs, int count) {
     sh::projected_stress_derivatives(Law::principal_stiffness(frame.s, sh::splat(2.0), sh::splat(1.0)), frame,
                                      projected);
     int removed = 0;
+    StressDerivative expected[sh::kLanes];
     for (int l = 0; l < count; ++l) {
         check_frame(frame, l, fs[l]);
         StressDerivative mine;
         for (int p = 0; p < 9; ++p)
             for (int q = 0; q < 9; ++q) mine(p, q) = projected.c[p][q][l];
+        expected[l] = mine;
         if (!reference_defined<Law>(frame, l)) {  // finite and positive semi-definite only
             assert_true(mine.allFinite());
             const Eigen::SelfAdjointEigenSolver<StressDerivative> eigen(mine);
@@ -163,11 +215,13 @@ int check_lanes(const Eigen::Matrix3d* fs, int count) {
         const StressDerivative c = reference<Law>(fs[l], 2.0, 1.0);
         // The reference's projection, which is positive semi-definite.
         const double scale = c.cwiseAbs().maxCoeff();
-        assert_true((mine - clamped(c)).cwiseAbs().maxCoeff() <= 1e-10 * scale);
+        expected[l] = clamped(c);
+        assert_true((mine - expected[l]).cwiseAbs().maxCoeff() <= 1e-10 * scale);
         const Eigen::SelfAdjointEigenSolver<StressDerivative> after(mine), before(c);
         assert_true(after.eigenvalues()(0) >= -1e-10 * scale);
         removed += static_cast<int>((before.eigenvalues().array() < -1e-10 * scale).count());
     }
+    check_element_stiffness<Law>(frame, expected, count);
     return removed;
 }
 

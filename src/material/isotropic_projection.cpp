@@ -140,25 +140,83 @@ void add_pair_modes(const PrincipalStiffnessLanes& k, const SingularFrameLanes& 
     }
 }
 
-// The frames of N batches at once (their eigen-solves interleaved: symmetric_eigen).
+// A Gram batch's frames stand where every lane's F is well-conditioned: its smallest
+// eigenvalue of F^T F is at least this fraction of its largest (singular values within a factor
+// of about 3). There u = F v / s is as accurate as the polar path's r v: F^T F's eigen-solve
+// leaves off-diagonal parts of about 1e-15 |F|^2, which u^T F v carries divided by s, within
+// round-off of |F| while s is within that factor of |F|.
+constexpr double kGramConditioning = 0.1;
+
+// Lanes a Gram batch may serve: det F > 0 (F^T F does not see the sign of det F, which the
+// frame must carry) and finite.
+SH_INLINE bool gram_batch(const Mat3L& unit) {
+    const Lanes d = det(unit);
+    return !any_lane(!(d > 0.0));
+}
+
+// A Gram batch's frame from F (at unit size), the eigenvalues of F^T F on a's diagonal and its
+// eigenvectors v: w_i = F v_i has length s_i and direction u_i; u_0 and u_1 are made
+// orthonormal (Gram-Schmidt) and u_2 = u_0 x u_1 (v is a rotation, a product of Jacobi turns,
+// and so is u, as in the polar path), and s_i = u_i . F v_i. False, with out untouched, if a lane is not
+// as well-conditioned as kGramConditioning asks.
+bool gram_frame(const Mat3L& unit, const Lanes (&a)[3][3], const Mat3L& v, Lanes scale, SingularFrameLanes& out) {
+    const Lanes largest = max_lane(max_lane(a[0][0], a[1][1]), a[2][2]);
+    const Lanes smallest = -max_lane(max_lane(-a[0][0], -a[1][1]), -a[2][2]);
+    if (any_lane(!(smallest >= kGramConditioning * largest))) return false;
+    const Mat3L w = mul(unit, v);  // column i: F v_i
+    Lanes u[3][3];                  // u[i]: column i of u
+    for (int i = 0; i < 2; ++i)
+        for (int k = 0; k < 3; ++k) u[i][k] = w.m[k][i];
+    const Lanes along = u[0][0] * u[1][0] + u[0][1] * u[1][1] + u[0][2] * u[1][2];
+    const Lanes length0 = u[0][0] * u[0][0] + u[0][1] * u[0][1] + u[0][2] * u[0][2];
+    for (int k = 0; k < 3; ++k) u[1][k] -= (along / length0) * u[0][k];
+    for (int i = 0; i < 2; ++i) {
+        const Lanes inverse = 1.0 / lanes_sqrt(u[i][0] * u[i][0] + u[i][1] * u[i][1] + u[i][2] * u[i][2]);
+        for (int k = 0; k < 3; ++k) u[i][k] *= inverse;
+    }
+    for (int k = 0; k < 3; ++k) u[2][k] = u[0][(k + 1) % 3] * u[1][(k + 2) % 3] - u[0][(k + 2) % 3] * u[1][(k + 1) % 3];
+    out.v = v;
+    for (int i = 0; i < 3; ++i) {
+        for (int k = 0; k < 3; ++k) out.u.m[k][i] = u[i][k];
+        out.s[i] = (u[i][0] * w.m[0][i] + u[i][1] * w.m[1][i] + u[i][2] * w.m[2][i]) / scale;
+    }
+    return true;
+}
+
+// The frames of N batches at once (their eigen-solves interleaved: symmetric_eigen). A batch
+// with no rotation to start from (near null) and det F > 0 in every lane solves F^T F where the
+// others solve sym(r^T F) after a polar iteration: u then comes from F v directly and the polar
+// iteration (five to eight Newton steps) is saved. Where its lanes are not well-conditioned
+// enough for that (gram_frame), the batch is solved again the polar way (gram false).
 template <int N>
-void frames_of(const Mat3L* F, const Mat3L* const* near, SingularFrameLanes* out) {
+void frames_of(const Mat3L* F, const Mat3L* const* near, SingularFrameLanes* out, bool gram = true) {
     Lanes a[N][3][3], scale[N];
-    Mat3L r[N], v[N];
+    Mat3L r[N], v[N], unit[N];
+    bool by_gram[N];
     for (int n = 0; n < N; ++n) {
         // F scaled to unit size first: the polar iteration's scaling multiplies |F|^8, which
         // leaves the doubles' range for |F| beyond about 1e-40 or 1e39; the frame is the same.
         scale[n] = unit_scale(lanes_sqrt(ddot(F[n], F[n])));
-        Mat3L unit;
         for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) unit.m[i][j] = scale[n] * F[n].m[i][j];
-        r[n] = near[n] ? polar_rotation_near(unit, *near[n]) : polar_rotation(unit);  // the same rotation as F's
-        const Mat3L m = mul_tn(r[n], unit);
+            for (int j = 0; j < 3; ++j) unit[n].m[i][j] = scale[n] * F[n].m[i][j];
+        by_gram[n] = gram && !near[n] && gram_batch(unit[n]);
+        if (by_gram[n]) {
+            const Mat3L m = mul_tn(unit[n], unit[n]);
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) a[n][i][j] = m.m[i][j];
+            continue;
+        }
+        r[n] = near[n] ? polar_rotation_near(unit[n], *near[n]) : polar_rotation(unit[n]);  // the same rotation as F's
+        const Mat3L m = mul_tn(r[n], unit[n]);
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) a[n][i][j] = 0.5 * (m.m[i][j] + m.m[j][i]);
     }
     symmetric_eigen(a, v);
     for (int n = 0; n < N; ++n) {
+        if (by_gram[n]) {
+            if (!gram_frame(unit[n], a[n], v[n], scale[n], out[n])) frames_of<1>(&F[n], &near[n], &out[n], false);
+            continue;
+        }
         out[n].v = v[n];
         for (int i = 0; i < 3; ++i) out[n].s[i] = a[n][i][i] / scale[n];
         out[n].u = mul(r[n], v[n]);

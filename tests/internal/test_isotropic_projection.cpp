@@ -302,6 +302,18 @@ void inverted_elements(void**) {
     assert_true(check<sh::CorotationalMaterial>(fs) > 0);
 }
 
+/// Flattened elements, det F > 0 but singular values far apart (down to 1e-6 of the largest):
+/// their frames are as accurate as those of mild strains, in the same batches as mild ones.
+void flattened_elements(void**) {
+    std::mt19937_64 rng(13);
+    Deformations fs;
+    for (int n = 0; n < 40; ++n)
+        add_rotated(fs, rng, {Eigen::Vector3d(1.0, 0.3, 1e-2), Eigen::Vector3d(1.1, 0.9, 1.0), Eigen::Vector3d(2.0, 1e-3, 1e-6),
+                              Eigen::Vector3d(1.0, 1.0, 0.05)});
+    check<sh::StvkMaterial>(fs);
+    check<sh::NeoHookeanMaterial>(fs);
+}
+
 /// Repeated singular values (the frame is not unique there) and pure rotations (the rest
 /// shape, turned), in the same batches as distinct ones (each lane converges on its own).
 void degenerate_stretches(void**) {
@@ -451,6 +463,7 @@ int main() {
         cmocka_unit_test(mixed_elements),
         cmocka_unit_test(inverted_elements),
         cmocka_unit_test(degenerate_stretches),
+        cmocka_unit_test(flattened_elements),
         cmocka_unit_test(singular_deformations),
         cmocka_unit_test(extreme_scales),
         cmocka_unit_test(stiffness_at_extreme_scales_scales_the_projection),

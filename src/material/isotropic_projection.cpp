@@ -184,10 +184,11 @@ bool gram_frame(const Mat3L& unit, const Lanes (&a)[3][3], const Mat3L& v, Lanes
 }
 
 // The frames of N batches at once (their eigen-solves interleaved: symmetric_eigen). A batch
-// with no rotation to start from (near null) and det F > 0 in every lane solves F^T F where the
-// others solve sym(r^T F) after a polar iteration: u then comes from F v directly and the polar
-// iteration (five to eight Newton steps) is saved. Where its lanes are not well-conditioned
-// enough for that (gram_frame), the batch is solved again the polar way (gram false).
+// with det F > 0 in every lane solves F^T F where the others solve sym(r^T F) after a polar
+// iteration (from near where given): u then comes from F v directly, and the polar iteration
+// (five to eight Newton steps cold, one or two from near) is saved. Where its lanes are not
+// well-conditioned enough for that (gram_frame), the batch is solved again the polar way
+// (gram false).
 template <int N>
 void frames_of(const Mat3L* F, const Mat3L* const* near, SingularFrameLanes* out, bool gram = true) {
     Lanes a[N][3][3], scale[N];
@@ -199,7 +200,7 @@ void frames_of(const Mat3L* F, const Mat3L* const* near, SingularFrameLanes* out
         scale[n] = unit_scale(lanes_sqrt(ddot(F[n], F[n])));
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) unit[n].m[i][j] = scale[n] * F[n].m[i][j];
-        by_gram[n] = gram && !near[n] && gram_batch(unit[n]);
+        by_gram[n] = gram && gram_batch(unit[n]);
         if (by_gram[n]) {
             const Mat3L m = mul_tn(unit[n], unit[n]);
             for (int i = 0; i < 3; ++i)

@@ -23,11 +23,13 @@ struct SingularFrameLanes {
     Lanes s[3];
 };
 
-/// F's singular frames, from its polar rotations r (F = r S, S symmetric, det r = +1): v and s
-/// are S's eigenvectors and eigenvalues (cyclic Jacobi, to round-off) and u = r v. S is
-/// symmetric and about as large as F, so its eigenvalues are as accurate as F's entries, where
-/// those of F^T F (which square F's) would lose the small singular values. near, if not null,
-/// holds rotations close to r (an earlier pass's) to start the polar iteration from.
+/// F's singular frames, to round-off of |F|. Where every lane's F is well-conditioned (det F > 0,
+/// singular values within a factor of about 3) from F^T F: v its eigenvectors (cyclic Jacobi)
+/// and u = F v / s made orthonormal. Elsewhere from F's polar rotations r (F = r S, S symmetric,
+/// det r = +1): v and s are S's eigenvectors and eigenvalues and u = r v; S is about as large as
+/// F, so its eigenvalues are as accurate as F's entries, where those of F^T F (which square F's)
+/// would lose the small singular values. near, if not null, holds rotations close to r (an
+/// earlier pass's) to start the polar iteration from.
 SingularFrameLanes singular_frames(const Mat3L& F, const Mat3L* near = nullptr);
 
 /// singular_frames of two batches at once (near[n]: as near there, per batch): the same frames,

@@ -23,14 +23,15 @@ SH_INLINE Lanes unit_scale(Lanes size) {
 // v <- v J gathers the rotations. With d = a_qq - a_pp and r = sqrt(d^2 + 4 a_pq^2) the
 // rotation's tangent is t = 2 a_pq sign(d) / (|d| + r), and with k = 1 / sqrt(2 r (|d| + r))
 // its cosine and sine are (|d| + r) k and 2 a_pq sign(d) k (c^2 + s^2 = 1 by r's definition):
-// two square roots and one division in a row, where 1 / sqrt(1 + t^2) after t takes two of
-// each (the turns' latency is most of the frames' time).
+// a square root and an inverse square root in a row (lanes_rsqrt), where 1 / sqrt(1 + t^2)
+// after t takes two of each of a square root and a division (the turns' latency is most of
+// the frames' time).
 SH_INLINE void jacobi_turn(Lanes (&a)[3][3], Mat3L& v, int p, int q) {
     const Lanes apq = a[p][q], d = a[q][q] - a[p][p];
     const Lanes r = lanes_sqrt(d * d + 4.0 * apq * apq), magnitude = abs_lane(d) + r;
     const Lanes sign = select(d < 0.0, splat(-1.0), splat(1.0));
     const LaneMask turns = magnitude > 0.0;
-    const Lanes k = 1.0 / lanes_sqrt(select(turns, 2.0 * r * magnitude, splat(1.0)));
+    const Lanes k = lanes_rsqrt(select(turns, 2.0 * r * magnitude, splat(1.0)));
     const Lanes c = select(turns, magnitude * k, splat(1.0)), s = select(turns, 2.0 * apq * sign * k, Lanes{});
     for (int k = 0; k < 3; ++k) {
         const Lanes kp = a[k][p], kq = a[k][q];
@@ -171,7 +172,7 @@ bool gram_frame(const Mat3L& unit, const Lanes (&a)[3][3], const Mat3L& v, Lanes
     const Lanes length0 = u[0][0] * u[0][0] + u[0][1] * u[0][1] + u[0][2] * u[0][2];
     for (int k = 0; k < 3; ++k) u[1][k] -= (along / length0) * u[0][k];
     for (int i = 0; i < 2; ++i) {
-        const Lanes inverse = 1.0 / lanes_sqrt(u[i][0] * u[i][0] + u[i][1] * u[i][1] + u[i][2] * u[i][2]);
+        const Lanes inverse = lanes_rsqrt(u[i][0] * u[i][0] + u[i][1] * u[i][1] + u[i][2] * u[i][2]);
         for (int k = 0; k < 3; ++k) u[i][k] *= inverse;
     }
     for (int k = 0; k < 3; ++k) u[2][k] = u[0][(k + 1) % 3] * u[1][(k + 2) % 3] - u[0][(k + 2) % 3] * u[1][(k + 1) % 3];

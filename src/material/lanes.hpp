@@ -60,6 +60,23 @@ SH_INLINE bool any_lane(LaneMask mask) {
     return false;
 }
 
+/// Element-wise 1 / sqrt(a), to about an ulp. With AVX-512 a 14-bit estimate refined by two
+/// Newton steps (y <- y (3 - a y^2) / 2, each doubling the bits), which the vector units finish
+/// sooner than a square root and a division in a row (each of those holds its unit for many
+/// cycles); where a lane is below 1e-290 (0, denormal: a / 2 loses bits there) or not a
+/// number, and without AVX-512, that square root and division.
+SH_INLINE Lanes lanes_rsqrt(Lanes a) {
+#if defined(__AVX512F__)
+    if (_mm512_cmp_pd_mask(a, _mm512_set1_pd(1e-290), _CMP_NGE_UQ) == 0) {
+        Lanes y = _mm512_rsqrt14_pd(a);
+        const Lanes half = 0.5 * a;
+        y = y * (1.5 - (half * y) * y);  // (half y) y: y^2 alone overflows for a below 1e-308
+        return y * (1.5 - (half * y) * y);
+    }
+#endif
+    return 1.0 / lanes_sqrt(a);
+}
+
 /// Sum of the lanes.
 SH_INLINE double lane_sum(Lanes a) {
     double s = 0.0;

@@ -84,11 +84,13 @@ void WarpedMultigrid::prepare(const SparseSystem& a, const double* rotations) {
 
 void WarpedMultigrid::backward_sweep(const double* r, double* z) {
     // Row J sums its right part from the pushes of the nodes after it (already new) and its
-    // left part from the blocks it holds (the nodes before it, not yet changed).
-    std::fill(pushed_.begin(), pushed_.end(), Node4{});
+    // left part from the blocks it holds (the nodes before it, not yet changed). pushed_ is
+    // zero between passes: each row's sum is cleared once read, where a pass of its own would
+    // clear them all first.
     for (int32_t j = blocks_.node_count() - 1; j >= 0; --j) {
         const size_t n = static_cast<size_t>(j);
         const Node4 s = load_node(r + 3 * n) - pushed_[n] - blocks_.pull(*system_, j, z_.data());
+        pushed_[n] = Node4{};
         const Node4 updated = block_times(&inverse_diagonal_[3 * n], s);
         blocks_.push(*system_, j, updated, pushed_.data());
         change_[n] = updated - z_[n];
@@ -98,10 +100,11 @@ void WarpedMultigrid::backward_sweep(const double* r, double* z) {
 }
 
 void WarpedMultigrid::first_sweep(const double* r) {
-    // residual_ gathers -U z_ from each node's push once its value is final.
-    std::fill(residual_.begin(), residual_.end(), Node4{});
+    // residual_ gathers -U z_ from each node's push once its value is final. Row J's pushes
+    // come from the nodes after it, so it is cleared when the pass reaches it.
     for (int32_t j = 0; j < blocks_.node_count(); ++j) {
         const size_t n = static_cast<size_t>(j);
+        residual_[n] = Node4{};
         z_[n] = block_times(&inverse_diagonal_[3 * n], load_node(r + 3 * n) - blocks_.pull(*system_, j, z_.data()));
         blocks_.push(*system_, j, -z_[n], residual_.data());
     }
@@ -139,14 +142,16 @@ void WarpedMultigrid::multiply(const double* x, double* y) {
     // Node J's row gathers A_JI x_I from its blocks (I < J) and its diagonal block's product;
     // the blocks push A_IJ x_J into the rows before it, whose sums are final once the pass is
     // over.
-    std::fill(pushed_.begin(), pushed_.end(), Node4{});
     for (int32_t j = 0; j < blocks_.node_count(); ++j) {
         const size_t n = static_cast<size_t>(j);
         z_[n] = load_node(x + 3 * n);
         pushed_[n] += blocks_.diagonal_times(*system_, j, z_[n]) + blocks_.pull(*system_, j, z_.data());
         blocks_.push(*system_, j, z_[n], pushed_.data());
     }
-    for (size_t n = 0; n < pushed_.size(); ++n) store_node(pushed_[n], y + 3 * n);
+    for (size_t n = 0; n < pushed_.size(); ++n) {
+        store_node(pushed_[n], y + 3 * n);
+        pushed_[n] = Node4{};  // zero between passes (see backward_sweep)
+    }
 }
 
 double WarpedMultigrid::iteration_work() const {

@@ -84,7 +84,7 @@ private:
     vec<Node4> z_;                        // the cycle's iterate
     vec<Node4> residual_;                 // r - A z_ after the first sweep
     vec<Node4> change_;                   // the backward sweep's change of z_
-    vec<Node4> pushed_;                   // the backward sweep's sums from the nodes after each
+    vec<Node4> pushed_;                   // the backward sweep's sums from the nodes after each (0 between passes)
 };
 
 }  // namespace sh

@@ -94,16 +94,22 @@ struct NeoHookeanMaterial {
             for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][j] + b.m[i][j];
         return r;
     }
-    /// q - log(1 + q) for q > -1, to round-off relative to itself: near q = 0 the difference
-    /// is q^2/2 while each term is q, so it is summed as a series in u = q / (2 + q), where
-    /// log(1 + q) = 2 atanh(u) and q = 2u / (1 - u): q - log(1 + q) = 2u^2 / (1 - u) - 2 sum_k
-    /// u^(2k+1) / (2k+1), k >= 1, whose terms fall by u^2 < 0.02 each for |q| < 1/4.
-    static double q_minus_log1p(double q) {
-        if (!(std::fabs(q) < 0.25)) return q - std::log1p(q);
-        const double u = q / (2.0 + q), u2 = u * u;
-        double series = 0.0;
+    /// q - log(1 + q) per lane for q > -1, to round-off relative to itself: near q = 0 the
+    /// difference is q^2/2 while each term is q, so it is summed as a series in u = q / (2 + q),
+    /// where log(1 + q) = 2 atanh(u) and q = 2u / (1 - u): q - log(1 + q) = 2u^2 / (1 - u) -
+    /// 2 sum_k u^(2k+1) / (2k+1), k >= 1, whose terms fall by u^2 < 0.02 each for |q| < 1/4.
+    /// The series runs on all lanes at once; lanes outside that range (strong strains) take
+    /// the difference itself, one at a time.
+    static SH_INLINE Lanes q_minus_log1p(Lanes q) {
+        const Lanes u = q / (2.0 + q), u2 = u * u;
+        Lanes series = Lanes{};
         for (int k = 12; k >= 1; --k) series = u2 * (1.0 / (2 * k + 1) + series);
-        return 2.0 * u2 / (1.0 - u) - 2.0 * u * series;
+        Lanes out = 2.0 * u2 / (1.0 - u) - 2.0 * u * series;
+        const LaneMask far = !(abs_lane(q) < 0.25);
+        if (any_lane(far))
+            for (int k = 0; k < kLanes; ++k)
+                if (far[k]) out[k] = q[k] - std::log1p(q[k]);
+        return out;
     }
     /// psi(F).
     static SH_INLINE Lanes energy(const Mat3L& F, Lanes lambda, Lanes mu) {
@@ -130,9 +136,7 @@ struct NeoHookeanMaterial {
         const Lanes safe = select(near_rest, plus, splat(1.0));
         const Lanes j1 = select(near_rest, (2.0 * tr + 2.0 * second_invariant + third) / safe, J - 1.0);
         const Lanes second = select(near_rest, (tr * j1 - 2.0 * second_invariant - third) / safe, tr - j1);
-        Lanes g;
-        for (int k = 0; k < kLanes; ++k) g[k] = q_minus_log1p(0.5 * tr[k]);
-        return 0.5 * m * g + 0.75 * m * second + 0.5 * l * j1 * j1;
+        return 0.5 * m * q_minus_log1p(0.5 * tr) + 0.75 * m * second + 0.5 * l * j1 * j1;
     }
 };
 

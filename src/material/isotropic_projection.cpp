@@ -111,36 +111,6 @@ void project_stretch_block(Lanes (&k)[3][3]) {
         }
 }
 
-// out = E K E^T on and above the diagonal: E's columns are the stretch modes u_a v_a^T.
-void add_stretch_modes(const Lanes (&k)[3][3], const SingularFrameLanes& frame, StressDerivativeLanes& out) {
-    Lanes e[9][3], ek[9][3];
-    for (int p = 0; p < 9; ++p)
-        for (int a = 0; a < 3; ++a) e[p][a] = frame.u.m[p / 3][a] * frame.v.m[p % 3][a];
-    for (int p = 0; p < 9; ++p)
-        for (int b = 0; b < 3; ++b) ek[p][b] = e[p][0] * k[0][b] + e[p][1] * k[1][b] + e[p][2] * k[2][b];
-    for (int p = 0; p < 9; ++p)
-        for (int q = p; q < 9; ++q) out.c[p][q] = ek[p][0] * e[q][0] + ek[p][1] * e[q][1] + ek[p][2] * e[q][2];
-}
-
-// out += each pair's shear and turn modes, on and above the diagonal, with their eigenvalues
-// (projected: not negative). With x = u_i v_j^T and y = u_j v_i^T the modes are (x +- y) / sqrt 2.
-void add_pair_modes(const PrincipalStiffnessLanes& k, const SingularFrameLanes& frame, StressDerivativeLanes& out) {
-    for (int m = 0; m < 3; ++m) {
-        const int i = m == 0 ? 1 : 0, j = m == 2 ? 1 : 2;
-        const Lanes shear = 0.5 * k.shear[m], turn = 0.5 * k.turn[m];
-        Lanes plus[9], minus[9];
-        for (int p = 0; p < 9; ++p) {
-            const Lanes x = frame.u.m[p / 3][i] * frame.v.m[p % 3][j], y = frame.u.m[p / 3][j] * frame.v.m[p % 3][i];
-            plus[p] = x + y;
-            minus[p] = x - y;
-        }
-        for (int p = 0; p < 9; ++p) {
-            const Lanes sp = shear * plus[p], tm = turn * minus[p];
-            for (int q = p; q < 9; ++q) out.c[p][q] += sp * plus[q] + tm * minus[q];
-        }
-    }
-}
-
 // A Gram batch's frames stand where every lane's F is well-conditioned: its smallest
 // eigenvalue of F^T F is at least this fraction of its largest (singular values within a factor
 // of about 3). There u = F v / s is as accurate as the polar path's r v: F^T F's eigen-solve
@@ -245,15 +215,6 @@ PrincipalStiffnessLanes projected_principal_stiffness(const PrincipalStiffnessLa
         projected.turn[m] = positive_part(stiffness.turn[m]);
     }
     return projected;
-}
-
-void projected_stress_derivatives(const PrincipalStiffnessLanes& stiffness, const SingularFrameLanes& frame,
-                                  StressDerivativeLanes& out) {
-    const PrincipalStiffnessLanes projected = projected_principal_stiffness(stiffness);
-    add_stretch_modes(projected.stretch, frame, out);
-    add_pair_modes(projected, frame, out);
-    for (int p = 0; p < 9; ++p)
-        for (int q = 0; q < p; ++q) out.c[p][q] = out.c[q][p];
 }
 
 }  // namespace sh

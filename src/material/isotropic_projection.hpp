@@ -53,14 +53,10 @@ struct PrincipalStiffnessLanes {
 
 /// stiffness with its negative eigenvalues set to zero, per lane: the stretch block projected to
 /// positive semi-definite where it is not positive definite, shear and turn clamped at zero.
-/// The modes and these eigenvalues are those of projected_stress_derivatives' dP/dF: a caller
-/// may contract them with its own map (the element stiffness) without forming dP/dF.
+/// With the frame's modes these give the projected dP/dF, the sum over the nine modes q of
+/// max(eigenvalue, 0) q q^T: exactly dP/dF where it is positive semi-definite, the nearest
+/// positive semi-definite matrix elsewhere. The element stiffness contracts them with its own
+/// map without forming dP/dF (model/element_stiffness.hpp: modal_element_stiffness).
 PrincipalStiffnessLanes projected_principal_stiffness(const PrincipalStiffnessLanes& stiffness);
-
-/// dP/dF with its negative eigenvalues set to zero, per lane: the sum over the nine modes q of
-/// max(eigenvalue, 0) q q^T, in the frame's basis. Exactly dP/dF where it is positive
-/// semi-definite; the nearest positive semi-definite matrix elsewhere.
-void projected_stress_derivatives(const PrincipalStiffnessLanes& stiffness, const SingularFrameLanes& frame,
-                                  StressDerivativeLanes& out);
 
 }  // namespace sh

@@ -20,9 +20,8 @@ struct StiffnessLanes {
 void element_stiffness(const StressDerivativeLanes& C, const Lanes (&g)[3][3], StiffnessLanes& K);
 
 /// The same K for the C whose modes lie in frame (F = U diag(s) V^T) with eigenvalues k (as
-/// projected_principal_stiffness gives them), without forming C: equal, to round-off, to
-/// element_stiffness of projected_stress_derivatives(k, frame) when k is already projected.
-/// About two thirds of the multiplications. Node 0's blocks: complete_node_zero.
+/// projected_principal_stiffness gives them), without forming C: about two thirds of the
+/// multiplications of element_stiffness after forming C. Node 0's blocks: complete_node_zero.
 void modal_element_stiffness(const PrincipalStiffnessLanes& k, const SingularFrameLanes& frame,
                              const Lanes (&g)[3][3], StiffnessLanes& K);
 

@@ -37,10 +37,10 @@ void stress_derivatives(const Mat3L& F, Lanes lambda, Lanes mu, StressDerivative
 
 // dP/dF's element stiffness for a law that projects (all isotropic: see the material table's
 // kProjectTangent), per lane, projected to positive semi-definite: from the law's analytic
-// eigensystem in F's singular frame, whose polar rotation (where it needs one) starts from near
-// where the body keeps its elements' rotations (the last force pass's: see BlockRotations). Nodes 1..3's blocks;
-// complete_node_zero adds node 0's. count (1 or 2) blocks b at once: their frames are found
-// together (singular_frame_pair).
+// eigensystem in F's singular frame, whose polar rotation (where it needs one) starts from
+// near where the body keeps its elements' rotations (the last force pass's: see
+// BlockRotations). Nodes 1..3's blocks; complete_node_zero adds node 0's. count (1 or 2)
+// blocks b at once: their frames are found together (singular_frame_pair).
 template <class Material>
 void law_projected_stiffness(int count, const TetBlock* b, const Mat3L (&F)[2], const Lanes (&lambda)[2],
                              const Lanes (&mu)[2], const Mat3L* const (&near)[2], StiffnessLanes (&K)[2]) {

@@ -213,6 +213,63 @@ static void test_factor_reuse_nonlinear(void** state) {
     assert_ok(sh_mesh_destroy(bar));
 }
 
+/* A step's reported elastic energy and sh_body_get_elastic_energy are the energy of the body's
+ * state now, however it came about: against the same positions on a body never stepped (computed
+ * afresh), at its rest shape (zero), and after its Young's modulus doubles (every law's energy is
+ * linear in (lambda, mu): it doubles). */
+static void test_energy_follows_state(void** state) {
+    (void)state;
+    sh_mesh* bar = sh_test_box(0.1, 0.01, 0.01, 10, 1, 1);
+    sh_test_mesh_arrays m = sh_test_mesh_arrays_of(bar);
+    const int n = m.node_count;
+    int32_t fixed[8];
+    const int fixed_count = sh_test_nodes_at(m.nodes, n, 0, 0.0, fixed);
+    double* x = malloc(sizeof(double) * 3 * n);
+    sh_world* world = sh_test_world(-9.81);
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = bar;
+    def.material.model = SH_MATERIAL_NEOHOOKEAN;
+    def.material.young = 1e4;
+    def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+    sh_body_id body, fresh;
+    assert_ok(sh_fem_body_create(world, &def, &body));
+    assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
+    assert_ok(sh_fem_body_create(world, &def, &fresh));
+    assert_ok(sh_body_fix_nodes(world, fresh, fixed, fixed_count));
+    sh_step_report report;
+    for (int s = 0; s < 10; ++s) assert_ok(sh_world_step(world, 5e-3, &report));
+    /* Both bodies took the same steps: put the fresh one where the stepped one is. */
+    assert_ok(sh_body_get_positions(world, body, x, n));
+    double energy, reference;
+    assert_ok(sh_body_get_elastic_energy(world, body, &energy));
+    assert_true(energy > 0.0);
+    sh_world* other = sh_test_world(0.0);
+    sh_body_id alone;
+    assert_ok(sh_fem_body_create(other, &def, &alone));
+    assert_ok(sh_body_set_positions(other, alone, x, n));
+    assert_ok(sh_body_get_elastic_energy(other, alone, &reference));
+    assert_close(energy, reference, 1e-12 * reference);
+    assert_close(report.elastic_energy, 2.0 * reference, 2e-12 * reference); /* both bodies */
+    assert_ok(sh_body_set_positions(world, body, m.nodes, n));
+    assert_ok(sh_body_get_elastic_energy(world, body, &energy));
+    assert_true(fabs(energy) <= 1e-12 * reference);
+    assert_ok(sh_body_set_positions(world, body, x, n));
+    sh_material stiffer = def.material;
+    stiffer.young *= 2.0;
+    int32_t* all = malloc(sizeof(int32_t) * (size_t)m.tet_count);
+    for (int32_t t = 0; t < m.tet_count; ++t) all[t] = t;
+    assert_ok(sh_body_set_material(world, body, all, m.tet_count, &stiffer));
+    free(all);
+    assert_ok(sh_body_get_elastic_energy(world, body, &energy));
+    assert_close(energy, 2.0 * reference, 2e-12 * reference);
+    assert_ok(sh_world_destroy(other));
+    assert_ok(sh_world_destroy(world));
+    sh_test_mesh_arrays_free(&m);
+    free(x);
+    assert_ok(sh_mesh_destroy(bar));
+}
+
 /* On a deforming liver (a large nonlinear system, where no closed form exists) CHOLMOD, LDLT and
  * CG solve the same linearised systems, so they give the same steps. */
 static void test_backends_agree(void** state) {
@@ -261,6 +318,7 @@ int main(void) {
         cmocka_unit_test(test_oscillator_order),
         cmocka_unit_test(test_factor_reuse_exact_and_invalidated),
         cmocka_unit_test(test_factor_reuse_nonlinear),
+        cmocka_unit_test(test_energy_follows_state),
         cmocka_unit_test(test_backends_agree),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

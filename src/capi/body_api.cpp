@@ -175,7 +175,7 @@ SH_API sh_status sh_body_get_elastic_energy(const sh_world* world, sh_body_id bo
     return capi::guard([&] {
         const Body& b = body_of(world, body);
         capi::require_pointer(out_energy, "out_energy");
-        *out_energy = b.elastic_energy(b.x.data());
+        *out_energy = b.elastic_energy_recalled(b.x.data());
     });
 }
 

@@ -131,4 +131,13 @@ void Body::set_node_damping(const double* coefficients) {
     ++matrix_version;
 }
 
+double Body::elastic_energy_recalled(const double* x) const {
+    double value = 0.0;
+    return energy_memo_.recall(x, this->x.size(), topology_version, matrix_version, value) ? value : elastic_energy(x);
+}
+
+void Body::remember_elastic_energy(const double* x, double value) noexcept {
+    energy_memo_.remember(x, this->x.size(), topology_version, matrix_version, value);
+}
+
 }  // namespace sh

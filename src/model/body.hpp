@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/memory.hpp"
+#include "model/elastic_energy_memo.hpp"
 
 #include <softhap/softhap.h>
 
@@ -77,6 +78,15 @@ public:
     /// the elastic energy at x, as the two calls would, with its round-off scale; from one
     /// pass over the elements.
     virtual ElasticEnergy add_elastic_forces_and_energy(const double* x, double* f) const = 0;
+
+    /// elastic_energy(x), recalled without a pass over the elements where x is, bit for bit,
+    /// the positions remember_elastic_energy was last given, and no element or material has
+    /// changed since.
+    double elastic_energy_recalled(const double* x) const;
+
+    /// Keeps value as the elastic energy at x (3 per node): positions an evaluation just took
+    /// it at, which the next caller of elastic_energy_recalled may ask about.
+    void remember_elastic_energy(const double* x, double value) noexcept;
 
     /// Largest stable step of an undamped leapfrog step, 2 / omega_max, at state x (s).
     virtual double stable_step(const double* x) const = 0;
@@ -198,6 +208,9 @@ public:
     /// Forces from outside the body (contact), attached by the world during a step; null when
     /// nothing touches the body.
     const ExternalField* field = nullptr;
+
+private:
+    ElasticEnergyMemo energy_memo_;  // the last remembered elastic energy
 };
 
 }  // namespace sh

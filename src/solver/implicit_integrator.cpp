@@ -424,6 +424,7 @@ void NewtonStep::evaluate() {
         }
         push2 += body_push2;
         const Body::ElasticEnergy elastic = body.add_elastic_forces_and_energy(body.x.data(), f);
+        body.remember_elastic_energy(body.x.data(), elastic.value);
         double* damping = nullptr;  // -D0 v, the lagged internal damping force
         if (body.has_internal_damping()) {
             damping = stepped.workspace.stage_a[2].data();

@@ -89,7 +89,7 @@ double NewtonProblem::potential_energy(const double g[3], double load_factor, bo
         const Body& b = *m.body;
         const double* x = at_start ? m.workspace.x0.data() : b.x.data();
         const double work = load_work(m, g, x);
-        const double elastic = b.elastic_energy(x), field = b.field ? b.field->energy(x) : 0.0;
+        const double elastic = b.elastic_energy_recalled(x), field = b.field ? b.field->energy(x) : 0.0;
         total += elastic + field - load_factor * work;
         scale += std::fabs(elastic) + std::fabs(field) + std::fabs(load_factor * work);
     });

@@ -500,7 +500,7 @@ void World::add_energies(sh_step_report& r) const {
             r.kinetic_energy += 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
             r.potential_energy -= m * (gravity[0] * x[0] + gravity[1] * x[1] + gravity[2] * x[2]);
         }
-        r.elastic_energy += body->elastic_energy(body->x.data());
+        r.elastic_energy += body->elastic_energy_recalled(body->x.data());
     });
 }
 

@@ -1,6 +1,7 @@
 #include "solver/node_rotations.hpp"
 
 #include "core/vec3.hpp"
+#include "linalg/node_lanes.hpp"
 #include "material/lanes.hpp"
 #include "material/polar_decomposition.hpp"
 
@@ -44,63 +45,89 @@ vec<NodeRotations::Edge> unique_edges(const Body& body, const vec<int32_t>& free
         edge.weight = 1.0;
         edges.push_back(edge);
     }
-    // In the free nodes' order (a Z-order through the rest shape: solver/free_node_order.hpp),
-    // so that each edge's sums land near the last one's; the file's numbers may jump anywhere.
-    // As unsigned numbers a fixed end (-1) comes last, so the lower key is the first free end.
-    const auto key = [](const NodeRotations::Edge& edge) {
-        const uint32_t a = static_cast<uint32_t>(edge.free_a), b = static_cast<uint32_t>(edge.free_b);
-        return std::make_pair(std::min(a, b), std::max(a, b));
-    };
-    std::sort(edges.begin(), edges.end(),
-              [&](const NodeRotations::Edge& p, const NodeRotations::Edge& q) { return key(p) < key(q); });
     return edges;
 }
 
-// Adds weight (x_b - x_a)(r_b - r_a)^T over the edges into out at each free end (9 per free
-// node): the sum over the element edges from each free node, x and r node positions. An
-// edge's product is the same from either end.
-void add_edge_products(const vec<NodeRotations::Edge>& edges, const double* x, const double* r, vec<double>& out) {
-    for (const NodeRotations::Edge& edge : edges) {
-        double dx[3], dr[3], product[9];
-        sub3(at(x, edge.b), at(x, edge.a), dx);
-        sub3(at(r, edge.b), at(r, edge.a), dr);
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) product[3 * i + j] = edge.weight * dx[i] * dr[j];
-        for (const int32_t k : {edge.free_a, edge.free_b}) {
-            if (k < 0) continue;
-            double* s = &out[9 * static_cast<size_t>(k)];
-            for (int q = 0; q < 9; ++q) s[q] += product[q];
-        }
-    }
+// Q^-1 of a free node's rest edges (Q = q, row-major, in place); a node whose edges lie in a
+// plane or on a line (springs) takes Q scaled, S Q / |Q|^2, whose rotation is still S's.
+void invert_rest_moment(double* q) {
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> m(q);
+    const double det = m.determinant(), size = m.squaredNorm();
+    if (det > 1e-9 * size * std::sqrt(size)) m = m.inverse().eval();
+    else m /= std::max(size, 1e-300);
 }
 
 }  // namespace
 
 void NodeRotations::reset(const Body& body, const vec<int32_t>& dof_to_global) {
     const size_t free_nodes = dof_to_global.size() / 3;
-    vec<int32_t> free_of(body.x.size() / 3, -1);
-    for (size_t k = 0; k < free_nodes; ++k) free_of[static_cast<size_t>(dof_to_global[3 * k]) / 3] = static_cast<int32_t>(k);
-    vec<Edge> edges = unique_edges(body, free_of);
-    vec<double> shape(9 * free_nodes, 0.0), inverse_rest(9 * free_nodes, 0.0), rotation(9 * free_nodes, 0.0);
-    add_edge_products(edges, body.rest.data(), body.rest.data(), inverse_rest);
+    vec<int32_t> free_of(body.x.size() / 3, -1), node(free_nodes);
     for (size_t k = 0; k < free_nodes; ++k) {
-        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> q(&inverse_rest[9 * k]);
-        const double det = q.determinant(), size = q.squaredNorm();
-        // A node whose edges lie in a plane or on a line (springs): S alone, scaled.
-        if (det > 1e-9 * size * std::sqrt(size)) q = q.inverse().eval();
-        else q /= std::max(size, 1e-300);
-        rotation[9 * k] = rotation[9 * k + 4] = rotation[9 * k + 8] = 1.0;
+        node[k] = dof_to_global[3 * k] / 3;
+        free_of[static_cast<size_t>(node[k])] = static_cast<int32_t>(k);
     }
-    edges_.swap(edges), shape_.swap(shape), inverse_rest_.swap(inverse_rest), rotation_.swap(rotation);
+    const vec<Edge> edges = unique_edges(body, free_of);
+    vec<int32_t> start(free_nodes + 1, 0);
+    for (const Edge& edge : edges)
+        for (const int32_t k : {edge.free_a, edge.free_b})
+            if (k >= 0) ++start[static_cast<size_t>(k) + 1];
+    for (size_t k = 0; k < free_nodes; ++k) start[k + 1] += start[k];
+    // Each end's entry holds the other end and w (X_j - X_k), from which c follows once Q is known.
+    vec<int32_t> neighbour(static_cast<size_t>(start[free_nodes])), next(start.begin(), start.end() - 1);
+    vec<double> difference(3 * neighbour.size()), moment(9 * free_nodes, 0.0);
+    const double* X = body.rest.data();
+    for (const Edge& edge : edges) {
+        const int32_t ends[2][2] = {{edge.free_a, edge.b}, {edge.free_b, edge.a}};
+        for (const auto& end : ends) {
+            const int32_t k = end[0];
+            if (k < 0) continue;
+            const size_t e = static_cast<size_t>(next[static_cast<size_t>(k)]++);
+            neighbour[e] = end[1];
+            double d[3];
+            sub3(at(X, end[1]), at(X, node[static_cast<size_t>(k)]), d);
+            double* q = &moment[9 * static_cast<size_t>(k)];
+            for (int i = 0; i < 3; ++i) {
+                difference[3 * e + static_cast<size_t>(i)] = edge.weight * d[i];
+                for (int j = 0; j < 3; ++j) q[3 * i + j] += edge.weight * d[i] * d[j];
+            }
+        }
+    }
+    vec<float> coefficient(3 * neighbour.size());
+    for (size_t k = 0; k < free_nodes; ++k) {
+        double* q = &moment[9 * k];
+        invert_rest_moment(q);
+        for (int32_t e = start[k]; e < start[k + 1]; ++e) {
+            const double* w_d = &difference[3 * static_cast<size_t>(e)];
+            for (int i = 0; i < 3; ++i)
+                coefficient[3 * static_cast<size_t>(e) + static_cast<size_t>(i)] =
+                    static_cast<float>(q[3 * i] * w_d[0] + q[3 * i + 1] * w_d[1] + q[3 * i + 2] * w_d[2]);
+        }
+    }
+    vec<double> rotation(9 * free_nodes, 0.0);
+    for (size_t k = 0; k < free_nodes; ++k) rotation[9 * k] = rotation[9 * k + 4] = rotation[9 * k + 8] = 1.0;
+    node_.swap(node), entry_start_.swap(start), neighbour_.swap(neighbour), coefficient_.swap(coefficient);
+    rotation_.swap(rotation);
+}
+
+void NodeRotations::gather_gradient(size_t k, const double* x, Mat3L& f, int lane) const {
+    // F's columns, each a sum of the edge vectors d = x_j - x_k times one entry of c; the
+    // entries go two at a time into two sets of sums, which halves the wait on the adds.
+    const Node4 xk = load_node(at(x, node_[k]));
+    Node4 even[3] = {}, odd[3] = {};
+    const auto add = [&](int32_t e, Node4* sums) {
+        const Node4 d = load_node(at(x, neighbour_[static_cast<size_t>(e)])) - xk;
+        const float* c = &coefficient_[3 * static_cast<size_t>(e)];
+        for (int col = 0; col < 3; ++col) sums[col] += d * static_cast<double>(c[col]);
+    };
+    int32_t e = entry_start_[k];
+    const int32_t end = entry_start_[k + 1];
+    for (; e + 1 < end; e += 2) add(e, even), add(e + 1, odd);
+    if (e < end) add(e, even);
+    for (int r = 0; r < 3; ++r)
+        for (int col = 0; col < 3; ++col) f.m[r][col][lane] = even[col][r] + odd[col][r];
 }
 
 const double* NodeRotations::update(const Body& body) {
-    std::fill(shape_.begin(), shape_.end(), 0.0);
-    add_edge_products(edges_, body.x.data(), body.rest.data(), shape_);
-    for (size_t k = 0; k < size(); ++k) {
-        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s(&shape_[9 * k]);
-        s = (s * Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(&inverse_rest_[9 * k])).eval();
-    }
     // kLanes nodes at a time; the last group's spare lanes repeat its first node.
     const size_t n = size();
     double turn = 0.0;
@@ -108,11 +135,9 @@ const double* NodeRotations::update(const Body& body) {
         Mat3L f, near;
         for (int l = 0; l < kLanes; ++l) {
             const size_t k = first + static_cast<size_t>(l) < n ? first + static_cast<size_t>(l) : first;
+            gather_gradient(k, body.x.data(), f, l);
             for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c) {
-                    f.m[r][c][l] = shape_[9 * k + 3 * static_cast<size_t>(r) + static_cast<size_t>(c)];
-                    near.m[r][c][l] = rotation_[9 * k + 3 * static_cast<size_t>(r) + static_cast<size_t>(c)];
-                }
+                for (int c = 0; c < 3; ++c) near.m[r][c][l] = rotation_[9 * k + 3 * static_cast<size_t>(r) + static_cast<size_t>(c)];
         }
         const Mat3L found = polar_rotation_near(f, near, kNodeRotationSettled2);
         for (int l = 0; l < kLanes && first + static_cast<size_t>(l) < n; ++l) {

@@ -128,6 +128,45 @@ struct Potential {
     bool finite() const { return std::isfinite(value) && std::isfinite(scale); }
 };
 
+// One body's part of the residual's norms and of Phi (body_residual).
+struct ResidualSums {
+    double sum2 = 0.0;  ///< sum of the residual's squares
+    double max = 0.0;   ///< its largest magnitude
+    Potential phi;      ///< the kinetic, mass-damping, lagged internal damping and load terms
+};
+
+// Per free DOF d of stepped's body: the residual m (v - v0) + h m c v - h (f + f_d + f_ext + m g)
+// into residual[d] (damping: the lagged internal damping force f_d, or null), and its sums.
+// In the nodes' order: the free order (solver/free_node_order.hpp) would scatter the reads of
+// every node array; only the residual's writes jump. The sums are local, where sums kept
+// through the caller's members would be stored and reloaded at every DOF (the residual's writes
+// might alias them).
+ResidualSums body_residual(const SteppedBody& stepped, const double* f, const double* damping, const double g[3],
+                           double h, double* residual) {
+    const Body& body = *stepped.body;
+    const vec<int32_t>& free_index = stepped.newton->free_index;
+    const double* v0 = stepped.workspace.v0.data();
+    ResidualSums sums;
+    for (size_t j = 0; j < body.x.size(); ++j) {
+        const size_t node = j / 3;
+        if (free_index[node] < 0) continue;
+        const size_t d = 3 * static_cast<size_t>(free_index[node]) + j % 3;
+        const double m = body.mass[node], v = body.v[j], dv = v - v0[j];
+        const double c = body.mass_damping(node);
+        const double load = body.applied_load(j, g), fd = damping ? damping[j] : 0.0;
+        const double r_d = m * dv + h * m * c * v - h * (f[j] + fd + load);
+        residual[d] = r_d;
+        sums.sum2 += r_d * r_d;
+        sums.max = std::max(sums.max, std::fabs(r_d));
+        const double terms[4] = {0.5 * m * dv * dv, 0.5 * h * m * c * v * v, -0.5 * h * v * fd, -h * v * load};
+        for (const double t : terms) {
+            sums.phi.value += t;
+            sums.phi.scale += std::fabs(t);
+        }
+    }
+    return sums;
+}
+
 // One implicit step of the bodies of a NewtonProblem as the minimisation of its incremental
 // potential over the end-of-step velocities v (x = x0 + h v):
 //   Phi(v) = 1/2 (v - v0)^T M (v - v0) + h/2 v^T C v + h/2 v^T D0 v + E(x) + P(x) + h W(v)
@@ -439,26 +478,11 @@ void NewtonStep::evaluate() {
         evaluated_energy_ += elastic.value + field_energy;
         phi.value += elastic.value + field;
         phi.scale += elastic.scale + std::fabs(field);  // what its round-off is relative to
-        // In the nodes' order: the free order (solver/free_node_order.hpp) would scatter the
-        // reads of every node array; only the residual's writes jump.
-        const vec<int32_t>& free_index = state.free_index;
-        for (size_t j = 0; j < body.x.size(); ++j) {
-            const size_t node = j / 3;
-            if (free_index[node] < 0) continue;
-            const size_t d = 3 * static_cast<size_t>(free_index[node]) + j % 3;
-            const double m = body.mass[node], v = body.v[j], dv = v - stepped.workspace.v0[j];
-            const double c = body.mass_damping(node);
-            const double load = body.applied_load(j, g_), fd = damping ? damping[j] : 0.0;
-            const double r_d = m * dv + h * m * c * v - h * (f[j] + fd + load);
-            matrix_.residual[offset + d] = r_d;
-            sum2 += r_d * r_d;
-            r_max_ = std::max(r_max_, std::fabs(r_d));
-            const double terms[4] = {0.5 * m * dv * dv, 0.5 * h * m * c * v * v, -0.5 * h * v * fd, -h * v * load};
-            for (const double t : terms) {
-                phi.value += t;
-                phi.scale += std::fabs(t);
-            }
-        }
+        const ResidualSums sums = body_residual(stepped, f, damping, g_, h, matrix_.residual.data() + offset);
+        sum2 += sums.sum2;
+        r_max_ = std::max(r_max_, sums.max);
+        phi.value += sums.phi.value;
+        phi.scale += sums.phi.scale;
     });
     r_ = std::sqrt(sum2);
     phi_ = phi;

@@ -107,6 +107,17 @@ static void test_factor_reuse_exact_and_invalidated(void** state) {
     }
 }
 
+/* The defaults with mesh, model and E = 10 kPa, stepped by implicit Euler. */
+static sh_fem_body_def soft_implicit_def(const sh_mesh* mesh, sh_material_model model) {
+    sh_fem_body_def def;
+    sh_fem_body_def_default(&def);
+    def.mesh = mesh;
+    def.material.model = model;
+    def.material.young = 1e4;
+    def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+    return def;
+}
+
 /* Largest backward Euler residual |m (v1 - v0) - dt (f(x1) + m g)| over the free nodes, and
  * largest |x1 - x0 - dt v1|, from the body's state before (x0, v0) and after the step, with the
  * elastic forces f evaluated apart from the step (sh_body_get_elastic_forces). */
@@ -159,12 +170,7 @@ static void test_factor_reuse_nonlinear(void** state) {
     int factorizations[3] = {0, 0, 0}, iterations[3] = {0, 0, 0};
     for (int k = 0; k < 3; ++k) { /* 0: exact Newton, 1: Newton with reuse, 2: linearised with reuse */
         sh_world* world = sh_test_world(g_z);
-        sh_fem_body_def def;
-        sh_fem_body_def_default(&def);
-        def.mesh = bar;
-        def.material.model = SH_MATERIAL_STVK;
-        def.material.young = 1e4;
-        def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+        sh_fem_body_def def = soft_implicit_def(bar, SH_MATERIAL_STVK);
         def.implicit.newton_max_iterations = k < 2 ? 30 : 1;
         def.implicit.newton_tolerance = 1e-10;
         def.implicit.factor_reuse = k == 0 ? 0.0 : 0.25;
@@ -226,12 +232,7 @@ static void test_energy_follows_state(void** state) {
     const int fixed_count = sh_test_nodes_at(m.nodes, n, 0, 0.0, fixed);
     double* x = malloc(sizeof(double) * 3 * n);
     sh_world* world = sh_test_world(-9.81);
-    sh_fem_body_def def;
-    sh_fem_body_def_default(&def);
-    def.mesh = bar;
-    def.material.model = SH_MATERIAL_NEOHOOKEAN;
-    def.material.young = 1e4;
-    def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+    sh_fem_body_def def = soft_implicit_def(bar, SH_MATERIAL_NEOHOOKEAN);
     sh_body_id body, fresh;
     assert_ok(sh_fem_body_create(world, &def, &body));
     assert_ok(sh_body_fix_nodes(world, body, fixed, fixed_count));
@@ -287,12 +288,7 @@ static void test_backends_agree(void** state) {
     double* x = malloc(sizeof(double) * 3 * n);
     for (int k = 0; k < solver_count; ++k) {
         sh_world* world = sh_test_world(-9.81);
-        sh_fem_body_def def;
-        sh_fem_body_def_default(&def);
-        def.mesh = liver;
-        def.material.model = SH_MATERIAL_NEOHOOKEAN;
-        def.material.young = 1e4;
-        def.integrator = SH_INTEGRATOR_IMPLICIT_EULER;
+        sh_fem_body_def def = soft_implicit_def(liver, SH_MATERIAL_NEOHOOKEAN);
         def.implicit.linear_solver = solvers[k];
         def.implicit.cg_tolerance = 1e-12;
         def.implicit.factor_reuse = 0.0; /* every backend solves the same linearised systems */

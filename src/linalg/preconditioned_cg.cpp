@@ -59,10 +59,11 @@ PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::fun
     const bool fused = preconditioner.apply_with_product(r.data(), z.data(), q.data());
     std::copy(z.begin(), z.end(), p.begin());
     double rz = dot(r, z);
+    double carried = fused ? dot(p, q) : 0.0;  // p^T q, from the pass that made them where fused
     while (out.iterations < max_iterations) {
         if (!fused) multiply(p.data(), q.data());
         ++out.iterations;
-        const double curvature = dot(p, q);
+        const double curvature = fused ? carried : dot(p, q);
         if (!(curvature > 0.0) || !(rz > 0.0)) break;
         const double alpha = rz / curvature;
         double rr = 0.0;  // |r|^2 in the same pass: one read of r where a dot of its own takes two
@@ -82,9 +83,15 @@ PreconditionedCgResult solve_preconditioned_cg(int32_t dof_count, const std::fun
         const double rz_next = dot(r, z);
         const double beta = rz_next / rz;
         rz = rz_next;
-        for (size_t i = 0; i < n; ++i) {
-            p[i] = z[i] + beta * p[i];
-            if (fused) q[i] = work.az[i] + beta * q[i];  // the loop invariant: the compiler splits the loop on it
+        if (fused) {
+            carried = 0.0;
+            for (size_t i = 0; i < n; ++i) {
+                p[i] = z[i] + beta * p[i];
+                q[i] = work.az[i] + beta * q[i];
+                carried += p[i] * q[i];  // the next curvature, in the same pass
+            }
+        } else {
+            for (size_t i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];
         }
     }
     out.seconds = now_seconds() - t0;

@@ -136,7 +136,7 @@ double Body::elastic_energy_recalled(const double* x) const {
     return energy_memo_.recall(x, this->x.size(), topology_version, matrix_version, value) ? value : elastic_energy(x);
 }
 
-void Body::remember_elastic_energy(const double* x, double value) noexcept {
+void Body::remember_elastic_energy(const double* x, double value) {
     energy_memo_.remember(x, this->x.size(), topology_version, matrix_version, value);
 }
 

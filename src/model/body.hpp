@@ -85,8 +85,9 @@ public:
     double elastic_energy_recalled(const double* x) const;
 
     /// Keeps value as the elastic energy at x (3 per node): positions an evaluation just took
-    /// it at, which the next caller of elastic_energy_recalled may ask about.
-    void remember_elastic_energy(const double* x, double value) noexcept;
+    /// it at, which the next caller of elastic_energy_recalled may ask about. Allocates the
+    /// first time and when the body grew (std::bad_alloc, keeping nothing).
+    void remember_elastic_energy(const double* x, double value);
 
     /// Largest stable step of an undamped leapfrog step, 2 / omega_max, at state x (s).
     virtual double stable_step(const double* x) const = 0;

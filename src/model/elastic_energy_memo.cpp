@@ -5,13 +5,9 @@
 namespace sh {
 
 void ElasticEnergyMemo::remember(const double* x, size_t count, uint64_t topology_version, uint64_t matrix_version,
-                                 double value) noexcept {
+                                 double value) {
     valid_ = false;  // until the copy is whole
-    try {
-        x_.assign(x, x + count);
-    } catch (...) {  // a cache: without room it keeps nothing and the next caller computes
-        return;
-    }
+    x_.assign(x, x + count);
     value_ = value;
     topology_version_ = topology_version;
     matrix_version_ = matrix_version;

@@ -17,9 +17,8 @@ namespace sh {
 class ElasticEnergyMemo {
 public:
     /// Keeps value as the energy at x[0..count) of version (allocates only when count grew;
-    /// without the memory it keeps nothing).
-    void remember(const double* x, size_t count, uint64_t topology_version, uint64_t matrix_version,
-                  double value) noexcept;
+    /// throws std::bad_alloc then, keeping nothing, as any allocation of the step would).
+    void remember(const double* x, size_t count, uint64_t topology_version, uint64_t matrix_version, double value);
     /// True, with the kept value in value, if x[0..count) is bit for bit where it was taken and
     /// the versions are the same.
     bool recall(const double* x, size_t count, uint64_t topology_version, uint64_t matrix_version, double& value) const;

@@ -48,8 +48,9 @@ vec<NodeRotations::Edge> unique_edges(const Body& body, const vec<int32_t>& free
     return edges;
 }
 
-// Q^-1 of a free node's rest edges (Q = q, row-major, in place); a node whose edges lie in a
-// plane or on a line (springs) takes Q scaled, S Q / |Q|^2, whose rotation is still S's.
+// Q^-1 of a free node's rest edges (Q = q, row-major, in place). A node whose edges lie in a
+// plane or on a line (springs) has no inverse: it takes Q / |Q|^2 instead, so that F = S Q /
+// |Q|^2 stays finite and its rotation is a rough one, which is all a preconditioner asks there.
 void invert_rest_moment(double* q) {
     Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> m(q);
     const double det = m.determinant(), size = m.squaredNorm();

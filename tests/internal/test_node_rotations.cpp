@@ -92,7 +92,9 @@ void test_affine_motion_gives_its_polar_factor(void**) {
         const Eigen::Matrix3d a = turn * stretch;
         move_affinely(body, a, Eigen::Vector3d(0.3, -1.0, 2.0));
         const double* found = rotations.update(body);
-        assert_true(largest_error(found, rotations.size(), polar_factor(a)) < 1e-6);
+        // The rotations settle to about 1e-3 rad per update, so within about 1e-6 of the polar
+        // factor (Newton's quadratic convergence): 1e-5 leaves room; a wrong F is off by 1e-2.
+        assert_true(largest_error(found, rotations.size(), polar_factor(a)) < 1e-5);
     }
 }
 

@@ -45,8 +45,10 @@
  * that falls more than two periods behind drops the deadlines it missed (counted) instead of
  * running a burst of late steps: the device's time stays the wall clock's, the hand moves on
  * through the dropped ticks holding the last force (as a device holds its last command) and the
- * next haptic step covers them with a longer dt; the full model only falls behind (its data
- * ages). The device thread asks for SCHED_FIFO and a 1 ns timer slack; without the privilege
+ * next haptic step covers up to four ticks' time with a longer dt. A longer stall's time is not
+ * simulated (counted): a step covering all of it would sub-step for as long as the stall was
+ * long, run past its own deadline and make the next tick late too. The full model only falls
+ * behind (its data ages). The device thread asks for SCHED_FIFO and a 1 ns timer slack; without the privilege
  * (CAP_SYS_NICE or an rtprio limit) it says so on stderr and runs at normal priority. Everything
  * the device thread writes is allocated and touched before the run, and it never prints (the
  * trace is kept in memory and written after each run). A production host would also lock its
@@ -108,6 +110,7 @@ static const double kHandMass = 0.1;       /* kg */
 static const double kHandStiffness = 200.0; /* N/m */
 static const double kContactStiffness = 2e5; /* tool's Hunt-Crossley lambda (N/m^1.5), see the header */
 static const int64_t kSpinNs = 50000;      /* spin this long before a device deadline (ns) */
+static const long kMaxCoveredTicks = 4;    /* a haptic step covers at most this many ticks' time */
 static const int kFifoPriority = 80;       /* SCHED_FIFO priority of the device thread */
 
 /* Phase end times of the target (s from the start of a run). */
@@ -200,6 +203,7 @@ typedef struct run {
     trace_row* rows;
     long row_count;
     long device_missed;   /* deadlines dropped */
+    long skipped_ticks;   /* dropped ticks whose time no haptic step covered (kMaxCoveredTicks) */
     int fifo_error;       /* errno of pthread_setschedparam, 0 if SCHED_FIFO */
     int bad_force;
     double largest_force, deepest;
@@ -306,14 +310,16 @@ static void* device_thread(void* arg) {
         int64_t before, after;
         sh_haptic_output out;
         sh_status status;
-        long missed;
+        long missed, covered;
 
         r->lateness[r->executed] = (double)(woke - deadline) * 1e-9;
         missed = drop_missed(r, &h, &tick, woke - deadline, dt, force);
 
         /* The device reads the hand's position, the haptic step renders the force. */
         before = now_ns();
-        status = sh_haptic_step(r->haptic, h.x, identity, (double)(missed + 1) * dt, &out);
+        covered = missed + 1 < kMaxCoveredTicks ? missed + 1 : kMaxCoveredTicks;
+        r->skipped_ticks += missed + 1 - covered;
+        status = sh_haptic_step(r->haptic, h.x, identity, (double)covered * dt, &out);
         after = now_ns();
         r->step_time[r->executed++] = (double)(after - before) * 1e-9;
         if (status != SH_OK && r->step_status == SH_OK) r->step_status = status;
@@ -389,9 +395,9 @@ static void summarise(run* r) {
     qsort(r->step_time, (size_t)n, sizeof(double), compare_doubles);
     qsort(r->model_time, (size_t)models, sizeof(double), compare_doubles);
     for (i = 0; i < n; ++i) late += r->lateness[i] * r->rate > 1.0;
-    fprintf(stderr, "haptic_loop: %.0f Hz (%s): %ld ticks run, %ld dropped; lateness p50 %.1f us, p99 %.1f us, "
-            "p99.9 %.1f us, max %.1f us; %ld ticks over a period late\n",
-            r->rate, r->fifo_error ? "normal priority" : "SCHED_FIFO", n, r->device_missed,
+    fprintf(stderr, "haptic_loop: %.0f Hz (%s): %ld ticks run, %ld dropped (%ld of them not simulated); lateness "
+            "p50 %.1f us, p99 %.1f us, p99.9 %.1f us, max %.1f us; %ld ticks over a period late\n",
+            r->rate, r->fifo_error ? "normal priority" : "SCHED_FIFO", n, r->device_missed, r->skipped_ticks,
             quantile(r->lateness, n, 0.5) * 1e6, quantile(r->lateness, n, 0.99) * 1e6,
             quantile(r->lateness, n, 0.999) * 1e6, r->lateness[n - 1] * 1e6, late);
     fprintf(stderr, "haptic_loop: %.0f Hz: haptic step p50 %.1f us, p99.9 %.1f us, max %.1f us (p99.9 is %.0f%% of "

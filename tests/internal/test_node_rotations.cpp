@@ -2,14 +2,19 @@
 // whose answer is known by hand: under an affine motion x = A X every node's least-squares
 // deformation gradient is A itself (its edges' differences are A times the rest ones), so
 // every node's rotation is A's polar factor, taken here from Eigen's SVD; the angle a rigid
-// turn by theta reports is 2 sin(theta / 2).
+// turn by theta reports is 2 sin(theta / 2). Under a motion that is not affine, each node's
+// rotation is the polar factor of its weighted least-squares fit S Q^-1, computed here
+// directly from the tets (each edge weighted by the tets that share it) with Eigen.
 #include "solver/node_rotations.hpp"
 
 #include "../internal/kuhn_block.hpp"
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
 
 extern "C" {
 #include <setjmp.h>
@@ -98,6 +103,53 @@ void test_affine_motion_gives_its_polar_factor(void**) {
     }
 }
 
+// Node i's least-squares gradient over its element edges, each weighted by the tets sharing
+// it: S Q^-1 with S = sum w (x_j - x_i)(X_j - X_i)^T, Q = sum w (X_j - X_i)(X_j - X_i)^T.
+Eigen::Matrix3d least_squares_gradient(const TetsOnly& body, const std::vector<int32_t>& tets, int32_t i) {
+    std::map<std::pair<int32_t, int32_t>, int> shared;  // edge (a < b) -> tets holding it
+    for (size_t t = 0; t < tets.size() / 4; ++t)
+        for (int p = 0; p < 4; ++p)
+            for (int q = p + 1; q < 4; ++q) {
+                const int32_t a = tets[4 * t + static_cast<size_t>(p)], b = tets[4 * t + static_cast<size_t>(q)];
+                ++shared[{std::min(a, b), std::max(a, b)}];
+            }
+    Eigen::Matrix3d S = Eigen::Matrix3d::Zero(), Q = Eigen::Matrix3d::Zero();
+    for (const auto& [edge, weight] : shared) {
+        if (edge.first != i && edge.second != i) continue;
+        const int32_t j = edge.first == i ? edge.second : edge.first;
+        const Eigen::Vector3d dX = Eigen::Map<const Eigen::Vector3d>(&body.rest[3 * static_cast<size_t>(j)]) -
+                                   Eigen::Map<const Eigen::Vector3d>(&body.rest[3 * static_cast<size_t>(i)]);
+        const Eigen::Vector3d dx = Eigen::Map<const Eigen::Vector3d>(&body.x[3 * static_cast<size_t>(j)]) -
+                                   Eigen::Map<const Eigen::Vector3d>(&body.x[3 * static_cast<size_t>(i)]);
+        S += weight * dx * dX.transpose();
+        Q += weight * dX * dX.transpose();
+    }
+    return S * Q.inverse();
+}
+
+void test_bent_block_gives_each_nodes_fit(void**) {
+    const std::vector<int32_t> tets = kuhn::block_tets(kCells);
+    TetsOnly body(kuhn::copies_rest(kCells, 1, 0.0), tets);
+    const sh::vec<int32_t> dofs = free_dofs(body);
+    sh::NodeRotations rotations;
+    rotations.reset(body, dofs);
+    // Bent about y by an angle growing with x, and sheared by a wave: every node's fit differs.
+    for (size_t i = 0; i < body.x.size() / 3; ++i) {
+        const double X = body.rest[3 * i], Y = body.rest[3 * i + 1], Z = body.rest[3 * i + 2];
+        const double bend = 0.25 * X;
+        body.x[3 * i] = X * std::cos(bend) + Z * std::sin(bend);
+        body.x[3 * i + 1] = Y + 0.1 * std::sin(X + Z);
+        body.x[3 * i + 2] = -X * std::sin(bend) + Z * std::cos(bend);
+    }
+    const double* found = rotations.update(body);
+    double worst = 0.0;
+    for (size_t k = 0; k < rotations.size(); ++k) {
+        const Eigen::Matrix3d expected = polar_factor(least_squares_gradient(body, tets, dofs[3 * k] / 3));
+        worst = std::fmax(worst, largest_error(found + 9 * k, 1, expected));
+    }
+    assert_true(worst < 1e-5);
+}
+
 void test_rigid_turn_reports_its_angle(void**) {
     TetsOnly body(kuhn::copies_rest(kCells, 1, 0.0), kuhn::block_tets(kCells));
     sh::NodeRotations rotations;
@@ -116,6 +168,7 @@ void test_rigid_turn_reports_its_angle(void**) {
 int main() {
     const CMUnitTest tests[] = {
         cmocka_unit_test(test_affine_motion_gives_its_polar_factor),
+        cmocka_unit_test(test_bent_block_gives_each_nodes_fit),
         cmocka_unit_test(test_rigid_turn_reports_its_angle),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);

@@ -239,7 +239,8 @@ static void enter_realtime(run* r) {
 }
 
 /* More than two periods late: drops the deadlines passed (counted). The hand moves on through
- * them holding the last force, as a device holds its last command; the next step covers them.
+ * them holding the last force, as a device holds its last command; the next step covers up to
+ * kMaxCoveredTicks of them (with its own tick).
  * Returns the ticks dropped. */
 static long drop_missed(run* r, simulated_hand* h, long* tick, int64_t late, double dt, const double force[3]) {
     long missed, j;
